@@ -1,0 +1,45 @@
+// Shared pieces of the tetstream subcommands: loading any input (mesh file or packed folder),
+// error reporting (plain text on stderr, JSON on stdout with --json) and timing.
+#pragma once
+#include <chrono>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "manifest.h"
+#include "mesh.h"
+#include "status.h"
+
+namespace tetstream::cli {
+
+using json = nlohmann::ordered_json;
+
+struct Input {
+  TetMesh mesh;
+  bool packed = false;
+  Manifest manifest;                // when packed
+  uint32_t chunksApplied = 0;       // when packed
+  std::vector<std::string> notes;   // what the reader did (converted fields, skipped cells)
+};
+
+// A packed dataset folder (with manifest.json) or a mesh file (.vtu, .vtk).
+Result loadInput(const std::string& path, Input& in);
+
+// Picks the field by name, or the dataset's default (isoField for packed data, else the first).
+// Returns its index or sets `r` to a MissingField error listing the available names.
+int chooseField(const Input& in, const std::string& name, Result& r);
+
+// Prints `r` and returns the process exit code (1).
+int reportError(const Result& r, bool asJson);
+
+void printJson(const json& j);
+
+class Stopwatch {
+ public:
+  double ms() const { return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0_).count(); }
+ private:
+  std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
+};
+
+}  // namespace tetstream::cli

@@ -1,0 +1,17 @@
+// The subcommands of `tetstream`. Each registers its options on the CLI11 app and returns a
+// runner that yields the process exit code.
+#pragma once
+#include <functional>
+
+#include <CLI/CLI.hpp>
+
+namespace tetstream::cli {
+
+using Runner = std::function<int()>;
+
+Runner addGen(CLI::App& app);
+Runner addPack(CLI::App& app);
+Runner addIso(CLI::App& app);
+Runner addInfo(CLI::App& app);
+
+}  // namespace tetstream::cli

@@ -1,0 +1,27 @@
+// tetstream: pack tetrahedral simulation meshes for progressive streaming, and inspect them.
+#include <cstdio>
+#include <map>
+
+#include "commands.h"
+#include "manifest.h"
+
+int main(int argc, char** argv) {
+  using namespace tetstream::cli;
+  CLI::App app{"tetstream: progressive isosurface streaming of tetrahedral meshes"};
+  app.set_version_flag("--version", std::string("tetstream ") + tetstream::kLibraryVersion);
+  app.require_subcommand(1);
+  std::map<CLI::App*, Runner> runners;
+  for (auto add : {addGen, addPack, addIso, addInfo}) {
+    size_t before = app.get_subcommands({}).size();
+    Runner run = add(app);
+    runners[app.get_subcommands({})[before]] = run;
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  for (auto& [sub, run] : runners)
+    if (sub->parsed()) return run();
+  return 2;
+}

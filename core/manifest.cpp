@@ -1,0 +1,269 @@
+#include "manifest.h"
+
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+#include "hash.h"
+
+namespace tetstream {
+namespace {
+
+using json = nlohmann::json;
+
+constexpr size_t kMaxManifestBytes = 16u << 20;
+constexpr int kMaxDepth = 32;
+constexpr size_t kMaxChunks = 65536;
+constexpr size_t kMaxFields = 64;
+constexpr uint64_t kMaxChunkBytes = 256ull << 20;
+constexpr uint64_t kMaxRawBytes = 1ull << 30;
+constexpr uint64_t kMaxCount = (1ull << 31) - 1;
+
+// nlohmann's DOM destructor and our walk would recurse on absurd nesting; refuse it up front.
+bool nestingWithin(std::string_view s, int limit) {
+  int depth = 0;
+  bool inString = false, escaped = false;
+  for (char c : s) {
+    if (inString) {
+      if (escaped) escaped = false;
+      else if (c == '\\') escaped = true;
+      else if (c == '"') inString = false;
+      continue;
+    }
+    if (c == '"') inString = true;
+    else if (c == '{' || c == '[') { if (++depth > limit) return false; }
+    else if (c == '}' || c == ']') --depth;
+  }
+  return true;
+}
+
+// Typed getters: the manifest is untrusted, so every access checks type and range and the
+// first problem is reported with the key's path.
+struct Reader {
+  std::string error;
+
+  const json* member(const json& obj, const char* key, const std::string& path) {
+    if (!error.empty()) return nullptr;
+    auto it = obj.find(key);
+    if (it == obj.end()) { error = "missing key '" + path + key + "'"; return nullptr; }
+    return &*it;
+  }
+  bool string(const json& obj, const char* key, const std::string& path, std::string& out) {
+    const json* v = member(obj, key, path);
+    if (!v) return false;
+    if (!v->is_string()) { error = "'" + path + key + "' must be a string"; return false; }
+    out = v->get_ref<const std::string&>();
+    return true;
+  }
+  bool integer(const json& obj, const char* key, const std::string& path, uint64_t lo, uint64_t hi, uint64_t& out) {
+    const json* v = member(obj, key, path);
+    if (!v) return false;
+    if (!v->is_number_unsigned()) { error = "'" + path + key + "' must be a non-negative integer"; return false; }
+    out = v->get<uint64_t>();
+    if (out < lo || out > hi) {
+      error = "'" + path + key + "' = " + std::to_string(out) + " is outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+      return false;
+    }
+    return true;
+  }
+  bool number(const json& obj, const char* key, const std::string& path, double& out) {
+    const json* v = member(obj, key, path);
+    if (!v) return false;
+    if (!v->is_number()) { error = "'" + path + key + "' must be a number"; return false; }
+    out = v->get<double>();
+    if (!std::isfinite(out)) { error = "'" + path + key + "' must be finite"; return false; }
+    return true;
+  }
+  bool vec3(const json& obj, const char* key, const std::string& path, float out[3]) {
+    const json* v = member(obj, key, path);
+    if (!v) return false;
+    if (!v->is_array() || v->size() != 3) { error = "'" + path + key + "' must be an array of 3 numbers"; return false; }
+    for (int k = 0; k < 3; ++k) {
+      const json& x = (*v)[size_t(k)];
+      if (!x.is_number() || !std::isfinite(x.get<double>())) { error = "'" + path + key + "' must hold finite numbers"; return false; }
+      out[k] = float(x.get<double>());
+    }
+    return true;
+  }
+};
+
+bool validChunkFileName(const std::string& f) {
+  const std::string prefix = "chunks/";
+  if (f.size() <= prefix.size() || f.size() > 128 || f.compare(0, prefix.size(), prefix) != 0) return false;
+  for (size_t i = prefix.size(); i < f.size(); ++i) {
+    char c = f[i];
+    bool ok = (c >= '0' && c <= '9') || (c >= 'a' && c <= 'z') || c == '-' || c == '.';
+    if (!ok) return false;
+  }
+  return f.find("..") == std::string::npos;
+}
+
+Result bad(const std::string& msg) { return fail(Status::BadManifest, "manifest: " + msg); }
+
+}  // namespace
+
+uint64_t Manifest::totalBytes() const {
+  uint64_t s = 0;
+  for (const ChunkInfo& c : chunks) s += c.bytes;
+  return s;
+}
+
+int Manifest::findField(std::string_view fieldName) const {
+  for (size_t i = 0; i < fields.size(); ++i)
+    if (fields[i].name == fieldName) return int(i);
+  return -1;
+}
+
+Result parseManifest(std::string_view text, Manifest& m) {
+  if (text.size() > kMaxManifestBytes) return fail(Status::TooLarge, "manifest: larger than 16 MiB");
+  if (!nestingWithin(text, kMaxDepth)) return bad("nested deeper than 32 levels");
+  json doc = json::parse(text.begin(), text.end(), nullptr, /*allow_exceptions=*/false);
+  if (doc.is_discarded()) return bad("not valid JSON");
+  if (!doc.is_object()) return bad("top level must be an object");
+
+  Reader r;
+  std::string format;
+  if (r.string(doc, "format", "", format) && format != "tetstream")
+    return bad("'format' is \"" + format + "\", expected \"tetstream\"");
+  uint64_t version = 0;
+  if (!r.error.empty()) return bad(r.error);
+  {
+    const json* v = r.member(doc, "formatVersion", "");
+    if (!v) return bad(r.error);
+    if (!v->is_number_unsigned() || v->get<uint64_t>() != kFormatVersion) {
+      return fail(Status::UnsupportedVersion,
+                  "manifest: formatVersion " + v->dump() + " is not supported (this reader reads version 1)");
+    }
+    version = v->get<uint64_t>();
+  }
+  m = Manifest{};
+  m.formatVersion = uint32_t(version);
+  if (auto it = doc.find("generator"); it != doc.end() && it->is_string()) m.generator = it->get<std::string>();
+  r.string(doc, "name", "", m.name);
+  if (const json* b = r.member(doc, "bounds", "")) {
+    if (!b->is_object()) return bad("'bounds' must be an object");
+    r.vec3(*b, "min", "bounds.", m.bounds.min);
+    r.vec3(*b, "max", "bounds.", m.bounds.max);
+    if (r.error.empty())
+      for (int k = 0; k < 3; ++k)
+        if (m.bounds.min[k] > m.bounds.max[k]) return bad("'bounds.min' exceeds 'bounds.max'");
+  }
+  uint64_t nv = 0, nt = 0;
+  r.integer(doc, "vertices", "", 4, kMaxCount, nv);
+  r.integer(doc, "tets", "", 1, kMaxCount, nt);
+  if (!r.error.empty()) return bad(r.error);
+  m.vertices = uint32_t(nv);
+  m.tets = uint32_t(nt);
+
+  const json* fields = r.member(doc, "fields", "");
+  if (!fields) return bad(r.error);
+  if (!fields->is_array() || fields->size() > kMaxFields) return bad("'fields' must be an array of at most 64 fields");
+  for (size_t i = 0; i < fields->size(); ++i) {
+    const json& f = (*fields)[i];
+    std::string path = "fields[" + std::to_string(i) + "].";
+    if (!f.is_object()) return bad("'" + path.substr(0, path.size() - 1) + "' must be an object");
+    FieldInfo fi;
+    double lo = 0, hi = 0;
+    r.string(f, "name", path, fi.name);
+    r.number(f, "min", path, lo);
+    r.number(f, "max", path, hi);
+    if (!r.error.empty()) return bad(r.error);
+    if (fi.name.empty() || fi.name.size() > 256) return bad("'" + path + "name' must have 1 to 256 characters");
+    if (lo > hi) return bad("'" + path + "min' exceeds max");
+    if (m.findField(fi.name) >= 0) return bad("field name '" + fi.name + "' appears twice");
+    fi.range = {float(lo), float(hi)};
+    m.fields.push_back(std::move(fi));
+  }
+  if (r.string(doc, "isoField", "", m.isoField) && !m.fields.empty() && m.findField(m.isoField) < 0)
+    return bad("'isoField' names a field that is not in 'fields'");
+  if (!r.error.empty()) return bad(r.error);
+
+  if (const json* q = r.member(doc, "quantization", "")) {
+    if (!q->is_object()) return bad("'quantization' must be an object");
+    if (auto it = q->find("lossless"); it != q->end() && it->is_boolean() && it->get<bool>()) {
+      m.lossless = true;
+    } else {
+      uint64_t pb = 0, fb = 0;
+      r.integer(*q, "positionBits", "quantization.", 8, 16, pb);
+      r.integer(*q, "fieldBits", "quantization.", 8, 16, fb);
+      m.positionBits = int(pb);
+      m.fieldBits = int(fb);
+    }
+  }
+  if (!r.error.empty()) return bad(r.error);
+
+  const json* chunks = r.member(doc, "chunks", "");
+  if (!chunks) return bad(r.error);
+  if (!chunks->is_array() || chunks->empty() || chunks->size() > kMaxChunks)
+    return bad("'chunks' must be an array of 1 to 65536 chunks");
+  for (size_t i = 0; i < chunks->size(); ++i) {
+    const json& c = (*chunks)[i];
+    std::string path = "chunks[" + std::to_string(i) + "].";
+    if (!c.is_object()) return bad("'" + path.substr(0, path.size() - 1) + "' must be an object");
+    ChunkInfo ci;
+    std::string kind, hash;
+    uint64_t v = 0, t = 0, s = 0;
+    r.string(c, "file", path, ci.file);
+    r.string(c, "kind", path, kind);
+    r.integer(c, "bytes", path, 1, kMaxChunkBytes, ci.bytes);
+    r.integer(c, "rawBytes", path, 16, kMaxRawBytes, ci.rawBytes);
+    r.string(c, "hash", path, hash);
+    r.integer(c, "vertices", path, 4, kMaxCount, v);
+    r.integer(c, "tets", path, 1, kMaxCount, t);
+    r.integer(c, "splits", path, 0, kMaxCount, s);
+    r.number(c, "fieldError", path, ci.fieldError);
+    if (!r.error.empty()) return bad(r.error);
+    if (!validChunkFileName(ci.file)) return bad("'" + path + "file' is not a plain name under chunks/");
+    if (kind != (i == 0 ? "base" : "splits"))
+      return bad("'" + path + "kind' must be \"" + (i == 0 ? "base" : "splits") + "\"");
+    ci.kind = i == 0 ? ChunkKind::Base : ChunkKind::Splits;
+    if (!parseHash(hash, &ci.hash)) return bad("'" + path + "hash' must be \"xxh3-64:\" and 16 hex digits");
+    ci.vertices = uint32_t(v);
+    ci.tets = uint32_t(t);
+    ci.splits = uint32_t(s);
+    if (i == 0 && s != 0) return bad("'chunks[0].splits' must be 0");
+    if (i > 0) {
+      const ChunkInfo& prev = m.chunks.back();
+      if (uint64_t(prev.vertices) + s != v) return bad("'" + path + "vertices' must equal the previous count plus 'splits'");
+      if (t < prev.tets) return bad("'" + path + "tets' decreases");
+    }
+    m.chunks.push_back(std::move(ci));
+  }
+  if (m.chunks.back().vertices != m.vertices || m.chunks.back().tets != m.tets)
+    return bad("the last chunk's counts differ from 'vertices'/'tets'");
+  return Result::success();
+}
+
+std::string writeManifest(const Manifest& m) {
+  json doc;
+  doc["format"] = "tetstream";
+  doc["formatVersion"] = m.formatVersion;
+  doc["generator"] = m.generator.empty() ? std::string("tetstream ") + kLibraryVersion : m.generator;
+  doc["name"] = m.name;
+  doc["bounds"] = {{"min", {m.bounds.min[0], m.bounds.min[1], m.bounds.min[2]}},
+                   {"max", {m.bounds.max[0], m.bounds.max[1], m.bounds.max[2]}}};
+  doc["vertices"] = m.vertices;
+  doc["tets"] = m.tets;
+  json fields = json::array();
+  for (const FieldInfo& f : m.fields) fields.push_back({{"name", f.name}, {"min", f.range.min}, {"max", f.range.max}});
+  doc["fields"] = fields;
+  doc["isoField"] = m.isoField;
+  if (m.lossless) doc["quantization"] = {{"lossless", true}};
+  else doc["quantization"] = {{"positionBits", m.positionBits}, {"fieldBits", m.fieldBits}};
+  json chunks = json::array();
+  for (const ChunkInfo& c : m.chunks) {
+    chunks.push_back({{"file", c.file},
+                      {"kind", c.kind == ChunkKind::Base ? "base" : "splits"},
+                      {"bytes", c.bytes},
+                      {"rawBytes", c.rawBytes},
+                      {"hash", formatHash(c.hash)},
+                      {"vertices", c.vertices},
+                      {"tets", c.tets},
+                      {"splits", c.splits},
+                      {"fieldError", c.fieldError}});
+  }
+  doc["chunks"] = chunks;
+  return doc.dump(1) + "\n";
+}
+
+}  // namespace tetstream

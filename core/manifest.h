@@ -1,0 +1,56 @@
+// manifest.json of a packed dataset (FORMAT.md §1): parsing with full validation of untrusted
+// input, and writing.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "mesh.h"
+#include "status.h"
+
+namespace tetstream {
+
+inline constexpr uint32_t kFormatVersion = 1;
+inline constexpr const char* kLibraryVersion = "0.1.0";
+
+enum class ChunkKind : uint8_t { Base = 1, Splits = 2 };
+
+struct FieldInfo {
+  std::string name;
+  Range range;
+};
+
+struct ChunkInfo {
+  std::string file;  // relative to the manifest's folder
+  ChunkKind kind = ChunkKind::Base;
+  uint64_t bytes = 0;     // compressed file size
+  uint64_t rawBytes = 0;  // decompressed size
+  uint64_t hash = 0;      // XXH3-64 of the file
+  uint32_t vertices = 0;  // counts after applying this chunk
+  uint32_t tets = 0;
+  uint32_t splits = 0;
+  double fieldError = 0;
+};
+
+struct Manifest {
+  uint32_t formatVersion = kFormatVersion;
+  std::string generator;
+  std::string name;
+  Bounds bounds;
+  uint32_t vertices = 0, tets = 0;  // full mesh
+  std::vector<FieldInfo> fields;
+  std::string isoField;
+  bool lossless = false;
+  int positionBits = 16, fieldBits = 16;
+  std::vector<ChunkInfo> chunks;
+
+  uint64_t totalBytes() const;
+  int findField(std::string_view name) const;
+};
+
+// Parses and validates; on failure `out` is unspecified and the message names the bad key.
+Result parseManifest(std::string_view json, Manifest& out);
+std::string writeManifest(const Manifest& m);
+
+}  // namespace tetstream

@@ -1,0 +1,63 @@
+#include "chunk_encode.h"
+
+#include <cstring>
+
+#include <zstd.h>
+
+#include "chunk.h"
+#include "hash.h"
+
+namespace tetstream {
+namespace {
+
+void putU16(std::vector<uint8_t>& b, uint16_t x) { b.push_back(uint8_t(x)); b.push_back(uint8_t(x >> 8)); }
+void putU32(std::vector<uint8_t>& b, uint32_t x) { for (int i = 0; i < 4; ++i) b.push_back(uint8_t(x >> (8 * i))); }
+template <typename T>
+void putArray(std::vector<uint8_t>& b, const std::vector<T>& a) {  // little-endian host (chunk.h)
+  size_t at = b.size();
+  b.resize(at + a.size() * sizeof(T));
+  if (!a.empty()) std::memcpy(b.data() + at, a.data(), a.size() * sizeof(T));
+}
+
+}  // namespace
+
+Result encodeBaseChunk(const TetMesh& mesh, uint32_t index, int level, std::vector<uint8_t>& file, ChunkInfo& info) {
+  std::vector<uint8_t> raw;
+  raw.reserve(kChunkHeaderBytes + kBaseHeaderBytes + 12 * size_t(mesh.vertexCount()) +
+              4 * mesh.fields.size() * mesh.vertexCount() + 16 * size_t(mesh.tetCount()));
+  raw.insert(raw.end(), kChunkMagic, kChunkMagic + 4);
+  putU16(raw, uint16_t(kFormatVersion));
+  putU16(raw, uint16_t(ChunkKind::Base));
+  putU32(raw, index);
+  putU32(raw, 0);
+  putU32(raw, mesh.vertexCount());
+  putU32(raw, mesh.tetCount());
+  putU32(raw, uint32_t(mesh.fields.size()));
+  putU32(raw, 0);
+  putArray(raw, mesh.positions);
+  for (const ScalarField& f : mesh.fields) putArray(raw, f.values);
+  putArray(raw, mesh.tets);
+
+  file.resize(ZSTD_compressBound(raw.size()));
+  ZSTD_CCtx* cctx = ZSTD_createCCtx();
+  if (!cctx) return fail(Status::TooLarge, "out of memory for the zstd context");
+  ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, level);
+  ZSTD_CCtx_setParameter(cctx, ZSTD_c_contentSizeFlag, 1);
+  ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 0);  // the manifest's hash covers the file
+  size_t n = ZSTD_compress2(cctx, file.data(), file.size(), raw.data(), raw.size());
+  ZSTD_freeCCtx(cctx);
+  if (ZSTD_isError(n)) return fail(Status::DecompressFailed, std::string("zstd: ") + ZSTD_getErrorName(n));
+  file.resize(n);
+
+  info.kind = ChunkKind::Base;
+  info.bytes = n;
+  info.rawBytes = raw.size();
+  info.hash = contentHash(file);
+  info.vertices = mesh.vertexCount();
+  info.tets = mesh.tetCount();
+  info.splits = 0;
+  info.fieldError = 0;
+  return Result::success();
+}
+
+}  // namespace tetstream

@@ -1,0 +1,455 @@
+#include "pack/mesh_io.h"
+
+#include <bit>
+#include <cctype>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <new>
+
+#include "pack/readers.h"
+
+namespace tetstream {
+namespace {
+
+std::string lowerExtension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+constexpr const char* kSupported = "supported: .vtu (VTK XML UnstructuredGrid), .vtk (legacy VTK UNSTRUCTURED_GRID)";
+
+Result readWholeFile(const std::string& path, std::string& bytes) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return fail(Status::IoError, path + ": cannot open (" + std::strerror(errno) + ")");
+  bytes.clear();
+  char buf[1 << 16];
+  size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) bytes.append(buf, n);
+  bool bad = std::ferror(f) != 0;
+  std::fclose(f);
+  if (bad) return fail(Status::IoError, path + ": read error");
+  return Result::success();
+}
+
+}  // namespace
+
+Result readMeshBytes(std::string_view bytes, const std::string& name, TetMesh& out, ReadReport& report) {
+  out = TetMesh{};
+  std::string ext = lowerExtension(name);
+  Result r;
+  // The readers allocate only what the input justifies, but a huge valid file can still exhaust
+  // memory; that must come back as a Result, not an exception through the library boundary.
+  try {
+    if (ext == ".vtu")
+      r = readVtu(bytes, name, out, report);
+    else if (ext == ".vtk")
+      r = readLegacyVtk(bytes, name, out, report);
+    else
+      return fail(Status::Unsupported, name + ": unsupported mesh format '" + ext + "'; " + kSupported);
+  } catch (const std::bad_alloc&) {
+    r = fail(Status::TooLarge, name + ": out of memory while reading");
+  } catch (...) {
+    r = fail(Status::Corrupt, name + ": internal error while reading");
+  }
+  if (!r) {
+    out = TetMesh{};
+    return r;
+  }
+  out.name = std::filesystem::path(name).stem().string();
+  return r;
+}
+
+Result readMesh(const std::string& path, TetMesh& out, ReadReport& report) {
+  out = TetMesh{};
+  std::string ext = lowerExtension(path);
+  if (ext != ".vtu" && ext != ".vtk")  // say so before reading a possibly large file
+    return fail(Status::Unsupported, path + ": unsupported mesh format '" + ext + "'; " + kSupported);
+  std::string bytes;
+  try {
+    if (Result r = readWholeFile(path, bytes); !r) return r;
+  } catch (const std::bad_alloc&) {
+    return fail(Status::TooLarge, path + ": out of memory while loading the file");
+  }
+  return readMeshBytes(bytes, path, out, report);
+}
+
+Result writeMesh(const std::string& path, const TetMesh& mesh) {
+  std::string ext = lowerExtension(path);
+  if (ext != ".vtu") return fail(Status::Unsupported, path + ": can only write .vtu, not '" + ext + "'");
+  try {
+    return writeVtu(path, mesh);
+  } catch (const std::bad_alloc&) {
+    return fail(Status::TooLarge, path + ": out of memory while writing");
+  }
+}
+
+// ------------------------------------------------------------------ shared by the readers
+namespace vtkio {
+
+size_t scalarSize(ScalarType t) {
+  switch (t) {
+    case ScalarType::Int8:
+    case ScalarType::UInt8:
+      return 1;
+    case ScalarType::Int16:
+    case ScalarType::UInt16:
+      return 2;
+    case ScalarType::Int32:
+    case ScalarType::UInt32:
+    case ScalarType::Float32:
+      return 4;
+    case ScalarType::Int64:
+    case ScalarType::UInt64:
+    case ScalarType::Float64:
+      return 8;
+  }
+  return 1;
+}
+
+static constexpr const char* kScalarNames[] = {"Int8",   "UInt8", "Int16",  "UInt16",  "Int32",
+                                               "UInt32", "Int64", "UInt64", "Float32", "Float64"};
+
+const char* scalarTypeName(ScalarType t) { return kScalarNames[int(t)]; }
+
+bool isIntegerType(ScalarType t) { return t != ScalarType::Float32 && t != ScalarType::Float64; }
+
+bool parseXmlScalarType(std::string_view name, ScalarType& t) {
+  for (int i = 0; i < 10; ++i)
+    if (name == kScalarNames[i]) {
+      t = ScalarType(i);
+      return true;
+    }
+  return false;
+}
+
+namespace {
+
+// std::byteswap is C++23.
+inline uint16_t bswap(uint16_t v) { return __builtin_bswap16(v); }
+inline uint32_t bswap(uint32_t v) { return __builtin_bswap32(v); }
+inline uint64_t bswap(uint64_t v) { return __builtin_bswap64(v); }
+
+template <class U>
+U loadRaw(const uint8_t* p, bool bigEndian) {
+  U v;
+  std::memcpy(&v, p, sizeof v);
+  if (bigEndian != (std::endian::native == std::endian::big)) v = bswap(v);
+  return v;
+}
+
+// Reads element i of type t as the C++ type T via its unsigned bit pattern.
+template <class T>
+T loadAs(const uint8_t* src, size_t i, ScalarType t, bool be) {
+  const uint8_t* p = src + i * scalarSize(t);
+  switch (t) {
+    case ScalarType::Int8:
+      return T(int8_t(*p));
+    case ScalarType::UInt8:
+      return T(*p);
+    case ScalarType::Int16:
+      return T(int16_t(loadRaw<uint16_t>(p, be)));
+    case ScalarType::UInt16:
+      return T(loadRaw<uint16_t>(p, be));
+    case ScalarType::Int32:
+      return T(int32_t(loadRaw<uint32_t>(p, be)));
+    case ScalarType::UInt32:
+      return T(loadRaw<uint32_t>(p, be));
+    case ScalarType::Int64:
+      return T(int64_t(loadRaw<uint64_t>(p, be)));
+    case ScalarType::UInt64:
+      return T(loadRaw<uint64_t>(p, be));
+    case ScalarType::Float32:
+      return T(std::bit_cast<float>(loadRaw<uint32_t>(p, be)));
+    case ScalarType::Float64:
+      return T(std::bit_cast<double>(loadRaw<uint64_t>(p, be)));
+  }
+  return T(0);
+}
+
+}  // namespace
+
+size_t decodeInts(const uint8_t* src, size_t count, ScalarType t, bool bigEndian, int64_t* dst) {
+  if (t == ScalarType::UInt64) {
+    for (size_t i = 0; i < count; ++i) {
+      uint64_t v = loadRaw<uint64_t>(src + 8 * i, bigEndian);
+      if (v > uint64_t(std::numeric_limits<int64_t>::max())) return i;
+      dst[i] = int64_t(v);
+    }
+    return count;
+  }
+  for (size_t i = 0; i < count; ++i) dst[i] = loadAs<int64_t>(src, i, t, bigEndian);
+  return count;
+}
+
+void decodeDoubles(const uint8_t* src, size_t count, ScalarType t, bool bigEndian, double* dst) {
+  for (size_t i = 0; i < count; ++i) dst[i] = loadAs<double>(src, i, t, bigEndian);
+}
+
+static bool isSpace(char c) { return c == ' ' || c == '\n' || c == '\r' || c == '\t' || c == '\f' || c == '\v'; }
+
+// Finds the next token; returns false at the end of the text.
+static bool nextToken(std::string_view text, size_t& pos, std::string_view& tok) {
+  while (pos < text.size() && isSpace(text[pos])) ++pos;
+  if (pos >= text.size()) return false;
+  size_t b = pos;
+  while (pos < text.size() && !isSpace(text[pos])) ++pos;
+  tok = text.substr(b, pos - b);
+  pos = b;
+  return true;
+}
+
+static bool parseDoubleToken(std::string_view tok, double& out) {
+  if (!tok.empty() && tok[0] == '+') tok.remove_prefix(1);
+  if (tok.empty()) return false;
+  auto [p, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), out);
+  // Out-of-range magnitudes become ±inf / 0 like strtod does; the finiteness check reports them.
+  if (ec == std::errc::result_out_of_range) {
+    bool neg = tok[0] == '-';
+    size_t e = tok.find_first_of("eE");
+    bool tiny = e != std::string_view::npos && e + 1 < tok.size() && tok[e + 1] == '-';
+    out = tiny ? (neg ? -0.0 : 0.0) : (neg ? -HUGE_VAL : HUGE_VAL);
+    return p == tok.data() + tok.size();
+  }
+  return ec == std::errc() && p == tok.data() + tok.size();
+}
+
+int parseNextDouble(std::string_view text, size_t& pos, double& out) {
+  std::string_view tok;
+  if (!nextToken(text, pos, tok)) return 0;
+  if (!parseDoubleToken(tok, out)) return -1;
+  pos += tok.size();
+  return 1;
+}
+
+int parseNextInt(std::string_view text, size_t& pos, int64_t& out) {
+  std::string_view tok;
+  if (!nextToken(text, pos, tok)) return 0;
+  std::string_view t = tok;
+  if (!t.empty() && t[0] == '+') t.remove_prefix(1);
+  auto [p, ec] = std::from_chars(t.data(), t.data() + t.size(), out);
+  if (ec != std::errc() || p != t.data() + t.size()) {
+    // Some writers print integer arrays as "4.0"; accept exactly integral values.
+    double d;
+    if (!parseDoubleToken(tok, d) || !(d >= -9.2e18 && d <= 9.2e18) || d != std::floor(d)) return -1;
+    out = int64_t(d);
+  }
+  pos += tok.size();
+  return 1;
+}
+
+bool parseU64(std::string_view s, uint64_t& out) {
+  if (s.empty()) return false;
+  auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
+  return ec == std::errc() && p == s.data() + s.size();
+}
+
+std::string printable(std::string_view s) {
+  std::string out(s.substr(0, 40));
+  for (char& c : out)
+    if (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126) c = '?';
+  return s.size() > 40 ? out + "..." : out;
+}
+
+std::string vtkCellTypeName(int64_t type) {
+  struct Name {
+    int id;
+    const char* name;
+  };
+  static constexpr Name kNames[] = {
+      {0, "VTK_EMPTY_CELL"},
+      {1, "VTK_VERTEX"},
+      {2, "VTK_POLY_VERTEX"},
+      {3, "VTK_LINE"},
+      {4, "VTK_POLY_LINE"},
+      {5, "VTK_TRIANGLE"},
+      {6, "VTK_TRIANGLE_STRIP"},
+      {7, "VTK_POLYGON"},
+      {8, "VTK_PIXEL"},
+      {9, "VTK_QUAD"},
+      {10, "VTK_TETRA"},
+      {11, "VTK_VOXEL"},
+      {12, "VTK_HEXAHEDRON"},
+      {13, "VTK_WEDGE"},
+      {14, "VTK_PYRAMID"},
+      {15, "VTK_PENTAGONAL_PRISM"},
+      {16, "VTK_HEXAGONAL_PRISM"},
+      {21, "VTK_QUADRATIC_EDGE"},
+      {22, "VTK_QUADRATIC_TRIANGLE"},
+      {23, "VTK_QUADRATIC_QUAD"},
+      {24, "VTK_QUADRATIC_TETRA"},
+      {25, "VTK_QUADRATIC_HEXAHEDRON"},
+      {26, "VTK_QUADRATIC_WEDGE"},
+      {27, "VTK_QUADRATIC_PYRAMID"},
+      {28, "VTK_BIQUADRATIC_QUAD"},
+      {29, "VTK_TRIQUADRATIC_HEXAHEDRON"},
+      {30, "VTK_QUADRATIC_LINEAR_QUAD"},
+      {31, "VTK_QUADRATIC_LINEAR_WEDGE"},
+      {32, "VTK_BIQUADRATIC_QUADRATIC_WEDGE"},
+      {33, "VTK_BIQUADRATIC_QUADRATIC_HEXAHEDRON"},
+      {34, "VTK_BIQUADRATIC_TRIANGLE"},
+      {35, "VTK_CUBIC_LINE"},
+      {36, "VTK_QUADRATIC_POLYGON"},
+      {37, "VTK_TRIQUADRATIC_PYRAMID"},
+      {41, "VTK_CONVEX_POINT_SET"},
+      {42, "VTK_POLYHEDRON"},
+      {51, "VTK_PARAMETRIC_CURVE"},
+      {52, "VTK_PARAMETRIC_SURFACE"},
+      {53, "VTK_PARAMETRIC_TRI_SURFACE"},
+      {54, "VTK_PARAMETRIC_QUAD_SURFACE"},
+      {55, "VTK_PARAMETRIC_TETRA_REGION"},
+      {56, "VTK_PARAMETRIC_HEX_REGION"},
+      {60, "VTK_HIGHER_ORDER_EDGE"},
+      {61, "VTK_HIGHER_ORDER_TRIANGLE"},
+      {62, "VTK_HIGHER_ORDER_QUAD"},
+      {63, "VTK_HIGHER_ORDER_POLYGON"},
+      {64, "VTK_HIGHER_ORDER_TETRAHEDRON"},
+      {65, "VTK_HIGHER_ORDER_WEDGE"},
+      {66, "VTK_HIGHER_ORDER_PYRAMID"},
+      {67, "VTK_HIGHER_ORDER_HEXAHEDRON"},
+      {68, "VTK_LAGRANGE_CURVE"},
+      {69, "VTK_LAGRANGE_TRIANGLE"},
+      {70, "VTK_LAGRANGE_QUADRILATERAL"},
+      {71, "VTK_LAGRANGE_TETRAHEDRON"},
+      {72, "VTK_LAGRANGE_HEXAHEDRON"},
+      {73, "VTK_LAGRANGE_WEDGE"},
+      {74, "VTK_LAGRANGE_PYRAMID"},
+      {75, "VTK_BEZIER_CURVE"},
+      {76, "VTK_BEZIER_TRIANGLE"},
+      {77, "VTK_BEZIER_QUADRILATERAL"},
+      {78, "VTK_BEZIER_TETRAHEDRON"},
+      {79, "VTK_BEZIER_HEXAHEDRON"},
+      {80, "VTK_BEZIER_WEDGE"},
+      {81, "VTK_BEZIER_PYRAMID"},
+  };
+  for (const Name& n : kNames)
+    if (n.id == type) return n.name;
+  return "VTK cell type " + std::to_string(type);
+}
+
+Result appendTets(const std::string& where, std::span<const int64_t> connectivity, std::span<const int64_t> offsets,
+                  std::span<const int64_t> types, uint64_t vertexBase, uint64_t pieceVertexCount, TetMesh& mesh,
+                  CellTally& tally) {
+  const size_t n = types.size();
+  if (offsets.size() != n + 1)
+    return fail(Status::Corrupt, where + ": " + std::to_string(n) + " cell types but " +
+                                     std::to_string(offsets.size() - 1) + " cells in the offsets");
+  const int64_t connSize = int64_t(connectivity.size());
+  if (offsets[0] < 0 || offsets[0] > connSize)
+    return fail(Status::Corrupt, where + ": first cell offset " + std::to_string(offsets[0]) +
+                                     " is outside the connectivity (" + std::to_string(connSize) + " ids)");
+  uint64_t tetCells = 0;
+  for (size_t c = 0; c < n; ++c)
+    if (types[c] == 10 || types[c] == 24) ++tetCells;
+  mesh.tets.reserve(mesh.tets.size() + 4 * tetCells);  // bounded by real data: types has n entries
+
+  for (size_t c = 0; c < n; ++c) {
+    const int64_t b = offsets[c], e = offsets[c + 1];
+    if (e < b || e > connSize)
+      return fail(Status::Corrupt, where + ": cell " + std::to_string(c) + " has offsets " + std::to_string(b) + ".." +
+                                       std::to_string(e) + ", outside 0.." + std::to_string(connSize) +
+                                       " or going backwards");
+    const int64_t type = types[c];
+    if (type != 10 && type != 24) {
+      ++tally.skipped[type];
+      continue;
+    }
+    const int64_t want = type == 10 ? 4 : 10;
+    if (e - b != want)
+      return fail(Status::Corrupt, where + ": cell " + std::to_string(c) + " is " + vtkCellTypeName(type) + " with " +
+                                       std::to_string(e - b) + " points, expected " + std::to_string(want));
+    for (int64_t k = b; k < e; ++k) {
+      int64_t id = connectivity[size_t(k)];
+      if (id < 0 || uint64_t(id) >= pieceVertexCount)
+        return fail(Status::OutOfRange, where + ": cell " + std::to_string(c) + " (" + vtkCellTypeName(type) +
+                                            ") references vertex " + std::to_string(id) + ", but there are " +
+                                            std::to_string(pieceVertexCount) + " points");
+    }
+    // Quadratic tets list their 4 corners first (VTK numbering), then the 6 mid-edge nodes.
+    for (int64_t k = b; k < b + 4; ++k) mesh.tets.push_back(uint32_t(vertexBase + uint64_t(connectivity[size_t(k)])));
+    if (type == 24) ++tally.quadraticTets;
+  }
+  tally.cells += n;
+  return Result::success();
+}
+
+std::vector<float> tuplesToScalars(std::span<const double> tuples, uint32_t components) {
+  std::vector<float> out(components ? tuples.size() / components : 0);
+  if (components == 1) {
+    for (size_t i = 0; i < out.size(); ++i) out[i] = float(tuples[i]);
+    return out;
+  }
+  for (size_t i = 0; i < out.size(); ++i) {
+    double s = 0;
+    for (uint32_t k = 0; k < components; ++k) {
+      double v = tuples[i * components + k];
+      s += v * v;
+    }
+    out[i] = float(std::sqrt(s));
+  }
+  return out;
+}
+
+std::string fieldNameFor(const std::string& arrayName, uint32_t components, ReadReport& report) {
+  if (components == 1) return arrayName;
+  std::string name = arrayName + "_magnitude";
+  report.notes.push_back("converted " + std::to_string(components) + "-component point array '" + arrayName +
+                         "' to its magnitude '" + name + "'");
+  return name;
+}
+
+void addField(TetMesh& mesh, ScalarField field, ReadReport& report) {
+  if (mesh.findField(field.name) >= 0) {
+    report.notes.push_back("dropped a second point array named '" + field.name + "'");
+    return;
+  }
+  mesh.fields.push_back(std::move(field));
+}
+
+Result finishMesh(const std::string& label, TetMesh& mesh, const CellTally& tally, ReadReport& report) {
+  if (mesh.positions.size() / 3 > kMaxVertices)
+    return fail(Status::TooLarge, label + ": " + std::to_string(mesh.positions.size() / 3) +
+                                      " points; tetstream indexes vertices with 32 bits");
+  if (mesh.tets.size() / 4 > 0xFFFFFFFFull) return fail(Status::TooLarge, label + ": more than 2^32-1 tetrahedra");
+
+  if (tally.quadraticTets)
+    report.notes.push_back("reduced " + std::to_string(tally.quadraticTets) +
+                           " VTK_QUADRATIC_TETRA (24) cells to their 4 corner vertices");
+  std::string found;
+  for (const auto& [type, count] : tally.skipped) {
+    std::string name = vtkCellTypeName(type);
+    report.notes.push_back("skipped " + std::to_string(count) + " cells of unsupported type " + name + " (" +
+                           std::to_string(type) + ")");
+    report.skippedCells.push_back({int(type), name, count});
+    found += (found.empty() ? "" : ", ") + std::to_string(count) + " " + name;
+  }
+
+  if (mesh.tets.empty())
+    return fail(Status::NoTets, label + ": no tetrahedra (VTK_TETRA or VTK_QUADRATIC_TETRA) among " +
+                                    std::to_string(tally.cells) + " cells" +
+                                    (found.empty() ? "" : " (found " + found + ")"));
+
+  const size_t nv = mesh.positions.size() / 3;
+  for (size_t v = 0; v < nv; ++v) {
+    const float* p = &mesh.positions[3 * v];
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+      char buf[128];
+      std::snprintf(buf, sizeof buf, "(%g, %g, %g)", double(p[0]), double(p[1]), double(p[2]));
+      return fail(Status::NonFinite, label + ": point " + std::to_string(v) + " has a non-finite coordinate " + buf);
+    }
+  }
+  for (const ScalarField& f : mesh.fields) {
+    size_t bad = 0;
+    for (float x : f.values) bad += !std::isfinite(x);
+    if (bad) report.notes.push_back("field '" + f.name + "' has " + std::to_string(bad) + " non-finite values");
+  }
+  return Result::success();
+}
+
+}  // namespace vtkio
+}  // namespace tetstream

@@ -1,0 +1,617 @@
+// VTK XML UnstructuredGrid reader. Layout reference: "VTK File Formats", XML section
+// (https://docs.vtk.org/en/latest/design_documents/VTKFileFormats.html) and vtkXMLWriter's
+// WriteBinaryDataInternal for the compressed-block header.
+//
+// A DataArray's payload is, in every binary encoding (inline base64, appended raw or base64):
+//   uncompressed: [nbytes]                                                     data
+//   zlib:         [nblocks][blockSize][lastBlockSize][csize_0 .. csize_n-1]    zlib blocks
+// each header word a UInt32 or UInt64 (header_type), in the file's byte order. lastBlockSize 0
+// means "a full block" (VTK); meshio writes the full size instead. Both are accepted.
+// Raw appended data is binary after `<AppendedData encoding="raw">` and `_`, so it is never handed
+// to pugixml: we parse only the XML before <AppendedData (closing </VTKFile> ourselves) and read
+// the payloads straight from the file bytes at each DataArray's offset.
+#include <zlib.h>
+
+#include <algorithm>
+#include <cstring>
+#include <pugixml.hpp>
+#include <set>
+
+#include "pack/readers.h"
+
+namespace tetstream {
+namespace {
+
+using namespace vtkio;
+
+// Guard against ratios zlib cannot produce (deflate tops out near 1032:1), so a forged block header
+// cannot make us allocate far more than the file holds.
+constexpr uint64_t kMaxZlibRatio = 1032;
+
+bool mulOverflows(uint64_t a, uint64_t b, uint64_t& out) { return __builtin_mul_overflow(a, b, &out); }
+
+// ------------------------------------------------------------------ payload bytes
+// The bytes of one binary payload, from raw appended data or from base64 text. Base64 is decoded
+// one 4-character group at a time, and a group ending in '=' does not end the stream: VTK encodes
+// the compressed-block header and the blocks as separate base64 strings and concatenates them
+// (meshio does the same for compressed data, but encodes header+data as one string otherwise).
+class ByteSource {
+ public:
+  static ByteSource raw(std::string_view bytes) { return ByteSource(bytes, false); }
+  static ByteSource base64(std::string_view text) { return ByteSource(text, true); }
+
+  // An upper bound on the bytes still available (exact for raw data).
+  uint64_t available() const {
+    uint64_t left = data_.size() - pos_;
+    return b64_ ? left / 4 * 3 + 3 + (pendingCount_ - pendingPos_) : left;
+  }
+
+  // Copies the next n bytes to dst. On failure returns false with error() set.
+  bool read(uint8_t* dst, size_t n) {
+    if (!b64_) {
+      if (data_.size() - pos_ < n) {
+        error_ = "data ends " + std::to_string(n - (data_.size() - pos_)) + " bytes early";
+        return false;
+      }
+      std::memcpy(dst, data_.data() + pos_, n);
+      pos_ += n;
+      return true;
+    }
+    while (n > 0) {
+      if (pendingPos_ == pendingCount_ && !decodeGroup()) return false;
+      size_t take = std::min<size_t>(n, size_t(pendingCount_ - pendingPos_));
+      std::memcpy(dst, pending_ + pendingPos_, take);
+      pendingPos_ += int(take);
+      dst += take;
+      n -= take;
+    }
+    return true;
+  }
+
+  const std::string& error() const { return error_; }
+
+ private:
+  ByteSource(std::string_view d, bool b64) : data_(d), b64_(b64) {}
+
+  static int value(char c) {
+    if (c >= 'A' && c <= 'Z') return c - 'A';
+    if (c >= 'a' && c <= 'z') return c - 'a' + 26;
+    if (c >= '0' && c <= '9') return c - '0' + 52;
+    if (c == '+') return 62;
+    if (c == '/') return 63;
+    if (c == '=') return 64;
+    return -1;
+  }
+
+  bool decodeGroup() {
+    int v[4];
+    int got = 0;
+    while (got < 4) {
+      if (pos_ >= data_.size()) {
+        error_ = got ? "base64 text ends inside a 4-character group" : "base64 text ends early";
+        return false;
+      }
+      char c = data_[pos_];
+      if (c == ' ' || c == '\n' || c == '\r' || c == '\t') {
+        ++pos_;
+        continue;
+      }
+      int x = value(c);
+      if (x < 0) {
+        char buf[64];
+        std::snprintf(buf, sizeof buf, "invalid base64 character 0x%02x", unsigned(static_cast<unsigned char>(c)));
+        error_ = buf;
+        return false;
+      }
+      v[got++] = x;
+      ++pos_;
+    }
+    // '=' may only pad the last one or two places of a group.
+    if (v[0] == 64 || v[1] == 64 || (v[2] == 64 && v[3] != 64)) {
+      error_ = "misplaced base64 padding '='";
+      return false;
+    }
+    uint32_t bits = uint32_t(v[0]) << 18 | uint32_t(v[1]) << 12 | uint32_t(v[2] & 63) << 6 | uint32_t(v[3] & 63);
+    pending_[0] = uint8_t(bits >> 16);
+    pending_[1] = uint8_t(bits >> 8);
+    pending_[2] = uint8_t(bits);
+    pendingCount_ = v[2] == 64 ? 1 : v[3] == 64 ? 2 : 3;
+    pendingPos_ = 0;
+    return true;
+  }
+
+  std::string_view data_;
+  size_t pos_ = 0;
+  bool b64_;
+  uint8_t pending_[3] = {0, 0, 0};
+  int pendingCount_ = 0, pendingPos_ = 0;
+  std::string error_;
+};
+
+// ------------------------------------------------------------------ file-level settings
+struct Vtu {
+  std::string label;
+  bool bigEndian = false;
+  bool header64 = false;
+  bool zlib = false;
+  bool hasAppended = false;
+  bool appendedBase64 = false;
+  std::string_view appended;        // after '_' up to </AppendedData>
+  std::set<std::string> encodings;  // seen, for ReadReport::format
+};
+
+// Message prefix for one DataArray: "a.vtu: DataArray 'offsets'" (+ " in Piece 2").
+struct ArrayRef {
+  std::string where;  // "a.vtu" or "a.vtu Piece 2"
+  std::string name;
+  std::string str() const { return where + ": DataArray '" + name + "'"; }
+};
+
+bool readHeaderWord(const Vtu& vtu, ByteSource& src, uint64_t& out) {
+  uint8_t b[8];
+  const int n = vtu.header64 ? 8 : 4;
+  if (!src.read(b, size_t(n))) return false;
+  out = 0;
+  for (int i = 0; i < n; ++i) out = out << 8 | b[vtu.bigEndian ? i : n - 1 - i];
+  return true;
+}
+
+// Reads one binary payload (header + data, compressed or not) into `bytes`: exactly
+// expectedBytes bytes, still in the file's byte order.
+Result readPayload(const Vtu& vtu, ByteSource& src, const ArrayRef& ref, uint64_t expectedBytes,
+                   std::vector<uint8_t>& bytes) {
+  auto srcError = [&](const char* stage) {
+    Status s = src.error().find("invalid") != std::string::npos || src.error().find("padding") != std::string::npos
+                   ? Status::Corrupt
+                   : Status::Truncated;
+    return fail(s, ref.str() + ": " + stage + ": " + src.error());
+  };
+  const uint64_t word = vtu.header64 ? 8 : 4;
+
+  if (!vtu.zlib) {
+    uint64_t n;
+    if (!readHeaderWord(vtu, src, n)) return srcError("reading the size header");
+    if (n != expectedBytes)
+      return fail(n > src.available() ? Status::Truncated : Status::Corrupt,
+                  ref.str() + ": header says " + std::to_string(n) + " bytes, expected " +
+                      std::to_string(expectedBytes) + (n > src.available() ? " (and the file holds fewer)" : ""));
+    if (n > src.available())
+      return fail(Status::Truncated, ref.str() + ": needs " + std::to_string(n) + " bytes, at most " +
+                                         std::to_string(src.available()) + " remain");
+    bytes.resize(n);
+    if (!src.read(bytes.data(), n)) return srcError("reading the data");
+    return Result::success();
+  }
+
+  uint64_t nblocks, blockSize, lastSize;
+  if (!readHeaderWord(vtu, src, nblocks)) return srcError("reading the compression header");
+  // The rest of the header (2 + nblocks words) must fit in what is left, or nblocks is a lie.
+  if (nblocks > src.available() / word)
+    return fail(Status::Truncated, ref.str() + ": compression header declares " + std::to_string(nblocks) +
+                                       " blocks, more than the file holds");
+  if (!readHeaderWord(vtu, src, blockSize) || !readHeaderWord(vtu, src, lastSize))
+    return srcError("reading the compression header");
+  std::vector<uint64_t> csize(nblocks);  // bounded: nblocks words fit in the remaining bytes
+  uint64_t compressedTotal = 0;
+  for (uint64_t b = 0; b < nblocks; ++b) {
+    if (!readHeaderWord(vtu, src, csize[b])) return srcError("reading the compressed block sizes");
+    if (csize[b] > src.available() || compressedTotal + csize[b] < compressedTotal)
+      return fail(Status::Truncated, ref.str() + ": compressed block " + std::to_string(b) + " of " +
+                                         std::to_string(nblocks) + " needs " + std::to_string(csize[b]) +
+                                         " bytes, more than the file holds");
+    compressedTotal += csize[b];
+  }
+  uint64_t total = 0;
+  if (nblocks > 0) {
+    uint64_t last = lastSize == 0 ? blockSize : lastSize;
+    if (last > blockSize)
+      return fail(Status::Corrupt, ref.str() + ": last block size " + std::to_string(last) +
+                                       " exceeds the block size " + std::to_string(blockSize));
+    if (mulOverflows(nblocks - 1, blockSize, total) || total + last < total)
+      return fail(Status::Corrupt, ref.str() + ": compression header sizes overflow");
+    total += last;
+  }
+  if (total != expectedBytes)
+    return fail(Status::Corrupt, ref.str() + ": compressed data holds " + std::to_string(total) + " bytes, expected " +
+                                     std::to_string(expectedBytes));
+  if (compressedTotal > src.available())
+    return fail(Status::Truncated, ref.str() + ": compressed blocks need " + std::to_string(compressedTotal) +
+                                       " bytes, at most " + std::to_string(src.available()) + " remain");
+  for (uint64_t b = 0; b < nblocks; ++b) {
+    uint64_t usize = (b + 1 == nblocks) ? total - (nblocks - 1) * blockSize : blockSize;
+    if (usize > csize[b] * kMaxZlibRatio + 64)
+      return fail(Status::Corrupt, ref.str() + ": block " + std::to_string(b) + " claims " + std::to_string(usize) +
+                                       " bytes from " + std::to_string(csize[b]) +
+                                       " compressed, beyond what zlib can produce");
+  }
+
+  bytes.resize(total);
+  std::vector<uint8_t> packed;
+  uint64_t at = 0;
+  for (uint64_t b = 0; b < nblocks; ++b) {
+    uint64_t usize = (b + 1 == nblocks) ? total - at : blockSize;
+    packed.resize(csize[b]);
+    if (!src.read(packed.data(), csize[b])) return srcError("reading a compressed block");
+    uLongf got = uLongf(usize);
+    int z = uncompress(bytes.data() + at, &got, packed.data(), uLong(csize[b]));
+    if (z != Z_OK || got != usize) {
+      const char* why = z == Z_DATA_ERROR  ? "corrupt zlib data (Z_DATA_ERROR)"
+                        : z == Z_BUF_ERROR ? "inflates to more than the header says (Z_BUF_ERROR)"
+                        : z == Z_MEM_ERROR ? "out of memory (Z_MEM_ERROR)"
+                        : z == Z_OK        ? "inflates to fewer bytes than the header says"
+                                           : "zlib error";
+      return fail(Status::DecompressFailed,
+                  ref.str() + ": zlib block " + std::to_string(b) + " of " + std::to_string(nblocks) + ": " + why);
+    }
+    at += usize;
+  }
+  return Result::success();
+}
+
+// The text of a DataArray: its character data, skipping child elements (VTK 9 puts
+// <InformationKey> elements inside arrays, before or after the numbers).
+std::string_view arrayText(pugi::xml_node da, std::string& storage) {
+  std::string_view single;
+  int parts = 0;
+  for (pugi::xml_node c = da.first_child(); c; c = c.next_sibling()) {
+    if (c.type() != pugi::node_pcdata && c.type() != pugi::node_cdata) continue;
+    std::string_view v = c.value();
+    if (parts == 0) single = v;
+    if (parts == 1) storage.assign(single);
+    if (parts >= 1) storage.append(" ").append(v);
+    ++parts;
+  }
+  return parts <= 1 ? single : std::string_view(storage);
+}
+
+// Reads a DataArray holding expectedValues numbers into out (int64_t or double).
+template <class T>
+Result readDataArray(Vtu& vtu, pugi::xml_node da, const ArrayRef& ref, uint64_t expectedValues, std::vector<T>& out) {
+  constexpr bool wantInts = std::is_same_v<T, int64_t>;
+  ScalarType type;
+  const char* typeName = da.attribute("type").value();
+  if (!parseXmlScalarType(typeName, type))
+    return fail(Status::Unsupported, ref.str() + ": type '" + typeName + "' is not a numeric type tetstream reads");
+  if (wantInts && !isIntegerType(type))
+    return fail(Status::Corrupt, ref.str() + ": must hold integers, found type " + typeName);
+  uint64_t expectedBytes;
+  if (mulOverflows(expectedValues, scalarSize(type), expectedBytes))
+    return fail(Status::TooLarge, ref.str() + ": " + std::to_string(expectedValues) + " values overflow a 64-bit size");
+
+  std::string_view format = da.attribute("format").value();
+  std::string storage;
+  if (format == "ascii") {
+    vtu.encodings.insert("ascii");
+    std::string_view text = arrayText(da, storage);
+    // Each value takes at least one character and a separator, so this bound is real data.
+    out.clear();
+    out.reserve(size_t(std::min<uint64_t>(expectedValues, text.size() / 2 + 1)));
+    size_t pos = 0;
+    for (uint64_t i = 0; i < expectedValues; ++i) {
+      T v;
+      int r;
+      if constexpr (wantInts)
+        r = parseNextInt(text, pos, v);
+      else
+        r = parseNextDouble(text, pos, v);
+      if (r == 0)
+        return fail(Status::Corrupt,
+                    ref.str() + ": has " + std::to_string(i) + " of " + std::to_string(expectedValues) + " values");
+      if (r < 0) {
+        std::string_view tok = text.substr(pos, text.substr(pos).find_first_of(" \t\r\n"));
+        return fail(Status::Corrupt, ref.str() + ": value " + std::to_string(i) + " '" + printable(tok) + "' is not " +
+                                         (wantInts ? "an integer" : "a number"));
+      }
+      out.push_back(v);
+    }
+    double extra;
+    if (parseNextDouble(text, pos, extra) != 0)
+      return fail(Status::Corrupt,
+                  ref.str() + ": has more than the expected " + std::to_string(expectedValues) + " values");
+    return Result::success();
+  }
+
+  ByteSource src = ByteSource::raw({});
+  if (format == "binary") {
+    vtu.encodings.insert("inline base64");
+    src = ByteSource::base64(arrayText(da, storage));
+  } else if (format == "appended") {
+    if (!vtu.hasAppended)
+      return fail(Status::Corrupt, ref.str() + ": format=\"appended\" but the file has no <AppendedData> section");
+    uint64_t offset;
+    if (!parseU64(da.attribute("offset").value(), offset))
+      return fail(Status::Corrupt,
+                  ref.str() + ": offset '" + da.attribute("offset").value() + "' is not a non-negative integer");
+    if (offset >= vtu.appended.size())
+      return fail(Status::Truncated, ref.str() + ": offset " + std::to_string(offset) + " is beyond the " +
+                                         std::to_string(vtu.appended.size()) + " bytes of appended data");
+    vtu.encodings.insert(vtu.appendedBase64 ? "appended base64" : "appended raw");
+    src = vtu.appendedBase64 ? ByteSource::base64(vtu.appended.substr(offset))
+                             : ByteSource::raw(vtu.appended.substr(offset));
+  } else {
+    return fail(Status::Unsupported,
+                ref.str() + ": format '" + std::string(format) + "' (expected ascii, binary or appended)");
+  }
+
+  std::vector<uint8_t> bytes;
+  if (Result r = readPayload(vtu, src, ref, expectedBytes, bytes); !r) return r;
+  out.resize(expectedValues);
+  if constexpr (wantInts) {
+    size_t ok = decodeInts(bytes.data(), expectedValues, type, vtu.bigEndian, out.data());
+    if (ok != expectedValues)
+      return fail(Status::OutOfRange, ref.str() + ": value " + std::to_string(ok) + " exceeds the Int64 range");
+  } else {
+    decodeDoubles(bytes.data(), expectedValues, type, vtu.bigEndian, out.data());
+  }
+  return Result::success();
+}
+
+pugi::xml_node findArray(pugi::xml_node parent, const char* name) {
+  for (pugi::xml_node da : parent.children("DataArray"))
+    if (std::strcmp(da.attribute("Name").value(), name) == 0) return da;
+  return {};
+}
+
+Result readCount(pugi::xml_node node, const char* attr, const std::string& where, uint64_t& out) {
+  if (!parseU64(node.attribute(attr).value(), out))
+    return fail(Status::Corrupt,
+                where + ": " + attr + "='" + node.attribute(attr).value() + "' is not a non-negative integer");
+  return Result::success();
+}
+
+Result readComponents(pugi::xml_node da, const ArrayRef& ref, uint64_t& comps) {
+  comps = 1;
+  if (!da.attribute("NumberOfComponents")) return Result::success();
+  if (!parseU64(da.attribute("NumberOfComponents").value(), comps) || comps == 0 || comps > kMaxComponents)
+    return fail(Status::Corrupt, ref.str() + ": NumberOfComponents='" + da.attribute("NumberOfComponents").value() +
+                                     "' (expected 1.." + std::to_string(kMaxComponents) + ")");
+  return Result::success();
+}
+
+struct PieceResult {
+  std::vector<ScalarField> fields;
+  std::vector<std::string> cellArrays;
+};
+
+// Reads one Piece: appends its points and tets to mesh, returns its point fields.
+Result readPiece(Vtu& vtu, pugi::xml_node piece, const std::string& where, TetMesh& mesh, CellTally& tally,
+                 ReadReport& report, bool notePieceConversions, PieceResult& pr) {
+  uint64_t np, nc;
+  if (Result r = readCount(piece, "NumberOfPoints", where, np); !r) return r;
+  if (Result r = readCount(piece, "NumberOfCells", where, nc); !r) return r;
+  const uint64_t vertexBase = mesh.positions.size() / 3;
+  if (np > kMaxVertices || vertexBase + np > kMaxVertices)
+    return fail(Status::TooLarge,
+                where + ": " + std::to_string(vertexBase + np) + " points; tetstream indexes vertices with 32 bits");
+
+  // Points
+  if (np > 0) {
+    pugi::xml_node da = piece.child("Points").child("DataArray");
+    ArrayRef ref{where, da ? da.attribute("Name").as_string("Points") : "Points"};
+    if (!da)
+      return fail(Status::Corrupt, where + ": NumberOfPoints=" + std::to_string(np) + " but no <Points> DataArray");
+    uint64_t comps;
+    if (Result r = readComponents(da, ref, comps); !r) return r;
+    if (comps != 3)
+      return fail(Status::Corrupt, ref.str() + ": points have " + std::to_string(comps) + " components, expected 3");
+    std::vector<double> p;
+    if (Result r = readDataArray(vtu, da, ref, np * 3, p); !r) return r;
+    mesh.positions.reserve(mesh.positions.size() + p.size());
+    for (double x : p) mesh.positions.push_back(float(x));
+  }
+
+  // Cells: offsets first, since the last offset is the connectivity length.
+  if (nc > 0) {
+    pugi::xml_node cells = piece.child("Cells");
+    pugi::xml_node daOff = findArray(cells, "offsets"), daTypes = findArray(cells, "types"),
+                   daConn = findArray(cells, "connectivity");
+    for (auto [node, name] : {std::pair{daOff, "offsets"}, {daTypes, "types"}, {daConn, "connectivity"}})
+      if (!node)
+        return fail(Status::Corrupt,
+                    where + ": NumberOfCells=" + std::to_string(nc) + " but <Cells> has no DataArray '" + name + "'");
+    std::vector<int64_t> ends, offsets, types, conn;
+    if (Result r = readDataArray(vtu, daOff, {where, "offsets"}, nc, ends); !r) return r;
+    int64_t connSize = ends.back();
+    if (connSize < 0)
+      return fail(Status::Corrupt,
+                  where + ": DataArray 'offsets': last offset " + std::to_string(connSize) + " is negative");
+    if (Result r = readDataArray(vtu, daTypes, {where, "types"}, nc, types); !r) return r;
+    if (Result r = readDataArray(vtu, daConn, {where, "connectivity"}, uint64_t(connSize), conn); !r) return r;
+    // VTU offsets are cell ends; appendTets wants starts plus the final end.
+    offsets.reserve(ends.size() + 1);
+    offsets.push_back(0);
+    offsets.insert(offsets.end(), ends.begin(), ends.end());
+    ends = {};
+    if (Result r = appendTets(where, conn, offsets, types, vertexBase, np, mesh, tally); !r) return r;
+  }
+
+  // Point data
+  int index = 0;
+  for (pugi::xml_node da : piece.child("PointData").children("DataArray")) {
+    std::string name = da.attribute("Name").value();
+    if (name.empty()) name = "array" + std::to_string(index);
+    ++index;
+    ArrayRef ref{where, name};
+    ScalarType type;
+    if (!parseXmlScalarType(da.attribute("type").value(), type)) {
+      if (notePieceConversions)
+        report.notes.push_back("skipped point array '" + name + "' of non-numeric type '" +
+                               da.attribute("type").value() + "'");
+      continue;
+    }
+    uint64_t comps;
+    if (Result r = readComponents(da, ref, comps); !r) return r;
+    std::vector<double> values;
+    if (Result r = readDataArray(vtu, da, ref, np * comps, values); !r) return r;
+    ReadReport scratch;
+    ScalarField f{fieldNameFor(name, uint32_t(comps), notePieceConversions ? report : scratch),
+                  tuplesToScalars(values, uint32_t(comps))};
+    pr.fields.push_back(std::move(f));
+  }
+  for (pugi::xml_node da : piece.child("CellData").children("DataArray"))
+    pr.cellArrays.push_back(da.attribute("Name").value());
+  return Result::success();
+}
+
+// Locates <AppendedData ...> and its '_' marker in the raw bytes. xmlEnd is where the parsable XML
+// stops; dataBegin/dataEnd bound the payload area.
+Result locateAppended(std::string_view bytes, const std::string& label, size_t& xmlEnd, bool& found, bool& base64,
+                      std::string_view& data) {
+  found = false;
+  size_t tag = bytes.find("<AppendedData");
+  if (tag == std::string_view::npos) {
+    xmlEnd = bytes.size();
+    return Result::success();
+  }
+  found = true;
+  xmlEnd = tag;
+  size_t gt = bytes.find('>', tag);
+  if (gt == std::string_view::npos || gt - tag > 4096)
+    return fail(Status::Truncated, label + ": the <AppendedData> tag is not closed");
+  // Parse the start tag alone, as an empty element, to read its attributes.
+  std::string tagXml(bytes.substr(tag, gt - tag));
+  if (!tagXml.empty() && tagXml.back() == '/') tagXml.pop_back();
+  tagXml += "/>";
+  pugi::xml_document tdoc;
+  if (!tdoc.load_buffer(tagXml.data(), tagXml.size()))
+    return fail(Status::Corrupt, label + ": malformed <AppendedData> tag");
+  std::string_view encoding = tdoc.first_child().attribute("encoding").value();
+  if (encoding == "raw")
+    base64 = false;
+  else if (encoding == "base64")
+    base64 = true;
+  else
+    return fail(Status::Unsupported,
+                label + ": AppendedData encoding '" + std::string(encoding) + "' (expected raw or base64)");
+
+  size_t p = gt + 1;
+  while (p < bytes.size() && (bytes[p] == ' ' || bytes[p] == '\n' || bytes[p] == '\r' || bytes[p] == '\t')) ++p;
+  if (p >= bytes.size()) return fail(Status::Truncated, label + ": file ends after <AppendedData>");
+  if (bytes[p] != '_') return fail(Status::Corrupt, label + ": expected '_' to start the appended data");
+  ++p;
+  // The data ends at the last </AppendedData>, which must be followed by </VTKFile>. Requiring both
+  // catches a file cut inside or right after its binary payload.
+  size_t close = bytes.rfind("</AppendedData>");
+  if (close == std::string_view::npos || close < p)
+    return fail(Status::Truncated, label + ": file ends inside <AppendedData> (no </AppendedData>)");
+  size_t after = bytes.find_first_not_of(" \t\r\n", close + 15);
+  if (after == std::string_view::npos || bytes.substr(after, 10) != "</VTKFile>")
+    return fail(Status::Truncated, label + ": file ends before </VTKFile>");
+  data = bytes.substr(p, close - p);
+  return Result::success();
+}
+
+}  // namespace
+
+Result readVtu(std::string_view bytes, const std::string& label, TetMesh& out, ReadReport& report) {
+  out = TetMesh{};
+  // Sniff before XML parsing so a legacy file or junk gets a clear message.
+  size_t start = 0;
+  if (bytes.substr(0, 3) == "\xEF\xBB\xBF") start = 3;
+  start = std::min(bytes.size(), bytes.find_first_not_of(" \t\r\n", start));
+  if (start >= bytes.size() || bytes[start] != '<') {
+    std::string hint = bytes.substr(start, 14) == "# vtk DataFile" ? " (it is a legacy VTK file; name it .vtk)" : "";
+    return fail(bytes.empty() ? Status::Truncated : Status::BadMagic,
+                label + ": not a VTK XML file: " + (bytes.empty() ? "empty" : "does not start with '<'") + hint);
+  }
+
+  Vtu vtu;
+  vtu.label = label;
+  size_t xmlEnd;
+  if (Result r = locateAppended(bytes, label, xmlEnd, vtu.hasAppended, vtu.appendedBase64, vtu.appended); !r) return r;
+  std::string xml(bytes.substr(0, xmlEnd));
+  if (vtu.hasAppended) xml += "</VTKFile>";
+
+  pugi::xml_document doc;
+  pugi::xml_parse_result pr = doc.load_buffer_inplace(xml.data(), xml.size(), pugi::parse_default, pugi::encoding_utf8);
+  if (!pr) {
+    // pugixml reports where the broken element starts, not where the text stops; a file that does
+    // not end with </VTKFile> was cut short.
+    std::string_view tail = bytes.substr(0, bytes.find_last_not_of(" \t\r\n") + 1);
+    bool cut = !vtu.hasAppended && !tail.ends_with("</VTKFile>");
+    return fail(cut ? Status::Truncated : Status::Corrupt, label + ": " + (cut ? "file ends before </VTKFile>; " : "") +
+                                                               "malformed XML at byte " + std::to_string(pr.offset) +
+                                                               ": " + pr.description());
+  }
+  pugi::xml_node root = doc.document_element();
+  if (std::strcmp(root.name(), "VTKFile") != 0)
+    return fail(Status::BadMagic, label + ": root element is <" + root.name() + ">, expected <VTKFile>");
+  std::string_view type = root.attribute("type").value();
+  if (type != "UnstructuredGrid")
+    return fail(Status::Unsupported, label + ": VTKFile type '" + std::string(type) +
+                                         "' is not supported; tetstream reads UnstructuredGrid (.vtu)");
+
+  std::string_view order = root.attribute("byte_order").value();
+  if (order == "BigEndian")
+    vtu.bigEndian = true;
+  else if (!order.empty() && order != "LittleEndian")
+    return fail(Status::Corrupt,
+                label + ": byte_order '" + std::string(order) + "' (expected LittleEndian or BigEndian)");
+  std::string_view header = root.attribute("header_type").value();
+  if (header == "UInt64")
+    vtu.header64 = true;
+  else if (!header.empty() && header != "UInt32")
+    return fail(Status::Unsupported, label + ": header_type '" + std::string(header) + "' (expected UInt32 or UInt64)");
+  std::string_view compressor = root.attribute("compressor").value();
+  if (compressor == "vtkZLibDataCompressor")
+    vtu.zlib = true;
+  else if (!compressor.empty())
+    return fail(Status::Unsupported, label + ": compressor '" + std::string(compressor) +
+                                         "' is not supported; re-save with zlib or without compression");
+
+  pugi::xml_node grid = root.child("UnstructuredGrid");
+  if (!grid) return fail(Status::Corrupt, label + ": <VTKFile> has no <UnstructuredGrid>");
+  std::vector<pugi::xml_node> pieces;
+  for (pugi::xml_node p : grid.children("Piece")) pieces.push_back(p);
+  if (pieces.empty()) return fail(Status::Corrupt, label + ": <UnstructuredGrid> has no <Piece>");
+
+  TetMesh mesh;
+  CellTally tally;
+  std::vector<ScalarField> fields;
+  std::vector<bool> keep;
+  std::set<std::string> cellArrays;
+  for (size_t k = 0; k < pieces.size(); ++k) {
+    std::string where = pieces.size() == 1 ? label : label + " Piece " + std::to_string(k);
+    PieceResult pr;
+    if (Result r = readPiece(vtu, pieces[k], where, mesh, tally, report, k == 0, pr); !r) return r;
+    cellArrays.insert(pr.cellArrays.begin(), pr.cellArrays.end());
+    if (k == 0) {
+      fields = std::move(pr.fields);
+      keep.assign(fields.size(), true);
+      continue;
+    }
+    // Several pieces: a field survives only if every piece has it.
+    for (size_t i = 0; i < fields.size(); ++i) {
+      auto it = std::find_if(pr.fields.begin(), pr.fields.end(),
+                             [&](const ScalarField& f) { return f.name == fields[i].name; });
+      if (it == pr.fields.end()) {
+        if (keep[i])
+          report.notes.push_back("dropped point array '" + fields[i].name + "': Piece " + std::to_string(k) +
+                                 " lacks it");
+        keep[i] = false;
+      } else {
+        fields[i].values.insert(fields[i].values.end(), it->values.begin(), it->values.end());
+      }
+    }
+  }
+  for (size_t i = 0; i < fields.size(); ++i)
+    if (keep[i]) addField(mesh, std::move(fields[i]), report);
+  if (!cellArrays.empty()) {
+    std::string names;
+    for (const std::string& n : cellArrays) names += (names.empty() ? "'" : ", '") + n + "'";
+    report.notes.push_back("ignored cell data arrays " + names + " (tetstream reads point data only)");
+  }
+  if (pieces.size() > 1) report.notes.push_back("concatenated " + std::to_string(pieces.size()) + " pieces");
+
+  std::string enc;
+  for (const std::string& e : vtu.encodings) enc += (enc.empty() ? "" : ", ") + e;
+  report.format = "VTK XML UnstructuredGrid (" + (enc.empty() ? std::string("no arrays") : enc) +
+                  (vtu.zlib ? ", zlib" : "") + (vtu.header64 ? ", UInt64 header" : ", UInt32 header") +
+                  (vtu.bigEndian ? ", BigEndian" : "") + ")";
+
+  if (Result r = finishMesh(label, mesh, tally, report); !r) return r;
+  out = std::move(mesh);
+  return Result::success();
+}
+
+}  // namespace tetstream

@@ -1,0 +1,96 @@
+#include "validate.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "adjacency.h"
+#include "tet_tables.h"
+
+namespace tetstream {
+namespace {
+
+double longestEdgeSquared(const float* p, const uint32_t* v) {
+  double best = 0;
+  for (const auto& e : kTetEdges) {
+    const float* a = p + 3 * size_t(v[e[0]]);
+    const float* b = p + 3 * size_t(v[e[1]]);
+    double d = 0;
+    for (int k = 0; k < 3; ++k) d += (double(a[k]) - b[k]) * (double(a[k]) - b[k]);
+    best = std::max(best, d);
+  }
+  return best;
+}
+
+void note(std::vector<std::string>& out, uint64_t count, const std::string& what) {
+  if (count) out.push_back(std::to_string(count) + " " + what);
+}
+
+}  // namespace
+
+ValidationReport validateMesh(const TetMesh& m) {
+  ValidationReport r;
+  const uint32_t V = m.vertexCount(), T = m.tetCount();
+  r.noTets = T == 0;
+  for (uint32_t i = 0; i < V; ++i)
+    for (int k = 0; k < 3; ++k)
+      if (!std::isfinite(m.positions[3 * size_t(i) + k])) { ++r.nonFinitePositions; break; }
+  for (const ScalarField& f : m.fields)
+    for (float x : f.values) r.nonFiniteFieldValues += !std::isfinite(x);
+
+  std::vector<uint8_t> used(V, 0);
+  bool indicesOk = true, geometryOk = r.nonFinitePositions == 0;
+  for (uint32_t t = 0; t < T; ++t) {
+    const uint32_t* v = &m.tets[4 * size_t(t)];
+    bool inRange = v[0] < V && v[1] < V && v[2] < V && v[3] < V;
+    if (!inRange) { ++r.outOfRangeIndices; indicesOk = false; continue; }
+    for (int k = 0; k < 4; ++k) used[v[k]] = 1;
+    if (v[0] == v[1] || v[0] == v[2] || v[0] == v[3] || v[1] == v[2] || v[1] == v[3] || v[2] == v[3]) {
+      ++r.repeatedVertexTets;
+      continue;
+    }
+    if (!geometryOk) continue;
+    double vol6 = 6.0 * tetVolume(m, t);
+    double l2 = longestEdgeSquared(m.positions.data(), v);
+    if (std::abs(vol6) <= 1e-9 * l2 * std::sqrt(l2)) ++r.zeroVolumeTets;
+    else if (vol6 > 0) ++r.positiveTets;
+    else ++r.negativeTets;
+  }
+  for (uint8_t u : used) r.unusedVertices += !u;
+  r.invertedTets = std::min(r.positiveTets, r.negativeTets);
+
+  if (indicesOk && T > 0) {
+    // Duplicates: sort the sorted vertex quadruples.
+    std::vector<std::array<uint32_t, 4>> quads(T);
+    for (uint32_t t = 0; t < T; ++t) {
+      std::copy_n(&m.tets[4 * size_t(t)], 4, quads[t].begin());
+      std::sort(quads[t].begin(), quads[t].end());
+    }
+    std::sort(quads.begin(), quads.end());
+    for (size_t i = 1; i < quads.size(); ++i) r.duplicateTets += quads[i] == quads[i - 1];
+
+    FaceAdjacency adj;
+    buildFaceAdjacency(m.tets, V, adj);
+    r.nonManifoldFaces = adj.nonManifoldFaces;
+    std::vector<uint32_t> boundary;
+    extractBoundary(m.tets, adj, boundary);
+    r.boundaryFaces = boundary.size() / 3;
+    r.nonManifoldBoundaryEdges = countNonManifoldBoundaryEdges(boundary);
+  }
+
+  if (r.noTets) r.findings.push_back("the mesh has no tetrahedra");
+  note(r.findings, r.outOfRangeIndices, "tetrahedra reference a vertex that does not exist");
+  note(r.findings, r.repeatedVertexTets, "tetrahedra use the same vertex twice");
+  note(r.findings, r.nonFinitePositions, "vertices have NaN or infinite coordinates");
+  note(r.findings, r.invertedTets, std::string("tetrahedra are inverted (oriented against the other ") +
+                                       std::to_string(std::max(r.positiveTets, r.negativeTets)) + ")");
+  note(r.findings, r.zeroVolumeTets, "tetrahedra have zero volume (flat)");
+  note(r.findings, r.duplicateTets, "tetrahedra duplicate another one");
+  note(r.findings, r.unusedVertices, "vertices are not used by any tetrahedron");
+  note(r.findings, r.nonFiniteFieldValues, "field values are NaN or infinite");
+  note(r.findings, r.nonManifoldFaces, "faces are shared by more than two tetrahedra (non-manifold)");
+  note(r.findings, r.nonManifoldBoundaryEdges, "boundary edges are not shared by exactly two boundary faces (non-manifold boundary)");
+  return r;
+}
+
+}  // namespace tetstream

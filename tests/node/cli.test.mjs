@@ -1,0 +1,86 @@
+// The CLI as a user meets it: help, JSON output, and clear errors with a nonzero exit on bad input.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import fs from 'node:fs';
+import path from 'node:path';
+import { cli, tempDir, packedHarmonic } from './helpers.mjs';
+
+test('--help on the tool and every subcommand', () => {
+  const top = cli('--help');
+  assert.equal(top.status, 0);
+  for (const sub of ['gen', 'pack', 'iso', 'info']) assert.match(top.stdout, new RegExp(sub));
+  for (const [sub, opt] of [['gen', '--n'], ['pack', '--field'], ['iso', '--value'], ['info', '--json']]) {
+    const r = cli(sub, '--help');
+    assert.equal(r.status, 0, sub);
+    assert.match(r.stdout, new RegExp(opt), `${sub} --help mentions ${opt}`);
+  }
+  assert.notEqual(cli().status, 0, 'no subcommand is an error');
+  assert.notEqual(cli('frobnicate').status, 0);
+});
+
+test('gen, pack, info and iso work together and report JSON', () => {
+  const { vtu, pack, dir } = packedHarmonic(12);
+  const infoMesh = cli('info', vtu, '--json').json;
+  assert.equal(infoMesh.vertices, 12 ** 3);
+  assert.equal(infoMesh.tets, 11 ** 3 * 6);
+  assert.equal(infoMesh.fields[0].name, 'harmonic');
+  assert.ok(infoMesh.fields[0].max <= 1.0001 && infoMesh.fields[0].min < 0);
+  assert.equal(infoMesh.validation.ok, true, JSON.stringify(infoMesh.validation.findings));
+
+  const infoPack = cli('info', pack, '--json').json;
+  assert.equal(infoPack.packed, true);
+  assert.equal(infoPack.tets, infoMesh.tets);
+  assert.equal(infoPack.format.formatVersion, 1);
+
+  const a = cli('iso', vtu, '--value', '0.2', '--json').json;
+  const b = cli('iso', pack, '--value', '0.2', '--json').json;
+  for (const k of ['triangles', 'vertices', 'area']) assert.equal(a[k], b[k], k);
+  assert.ok(a.triangles > 100 && a.area > 0 && a.ms >= 0);
+
+  const ply = path.join(dir, 's.ply');
+  const w = cli('iso', pack, '--value', '0.2', '-o', ply);
+  assert.equal(w.status, 0);
+  const header = fs.readFileSync(ply).subarray(0, 400).toString('latin1');
+  assert.match(header, /^ply\nformat binary_little_endian 1.0/);
+  assert.match(header, new RegExp(`element face ${a.triangles}`));
+});
+
+test('bad input gives a clear error and a nonzero exit, never a crash', () => {
+  const dir = tempDir('bad');
+  const { vtu } = packedHarmonic(4, 'badsrc');
+  const good = fs.readFileSync(vtu);
+  const write = (name, bytes) => { const p = path.join(dir, name); fs.writeFileSync(p, bytes); return p; };
+  const ascii = (cells, points, offsets = '4', type = '10') => `<?xml version="1.0"?>
+<VTKFile type="UnstructuredGrid" version="0.1" byte_order="LittleEndian">
+<UnstructuredGrid><Piece NumberOfPoints="4" NumberOfCells="1">
+<Points><DataArray type="Float32" NumberOfComponents="3" format="ascii">${points}</DataArray></Points>
+<Cells><DataArray type="Int32" Name="connectivity" format="ascii">${cells}</DataArray>
+<DataArray type="Int32" Name="offsets" format="ascii">${offsets}</DataArray>
+<DataArray type="UInt8" Name="types" format="ascii">${type}</DataArray></Cells>
+<PointData><DataArray type="Float32" Name="f" format="ascii">0 1 2 3</DataArray></PointData>
+</Piece></UnstructuredGrid></VTKFile>`;
+  const okPoints = '0 0 0 1 0 0 0 1 0 0 0 1';
+  const cases = [
+    ['missing file', [path.join(dir, 'nope.vtu')], /nope\.vtu/],
+    ['truncated', [write('trunc.vtu', good.subarray(0, good.length >> 1))], /./],
+    ['wrong magic', [write('magic.vtu', Buffer.from('hello world, not xml'))], /./],
+    ['unknown extension', [write('mesh.xyz', good)], /xyz|format|extension/i],
+    ['index out of range', [write('idx.vtu', ascii('0 1 2 99', okPoints))], /99|range/i],
+    ['NaN coordinate', [write('nan.vtu', ascii('0 1 2 3', '0 0 0 nan 0 0 0 1 0 0 0 1'))], /nan|finite/i],
+    ['no tetrahedra', [write('empty.vtu', ascii('0 1 2', okPoints, '3', '5'))], /tetra/i],
+  ];
+  for (const [what, args, msg] of cases) {
+    for (const cmd of [['info'], ['iso', '--value', '0'], ['pack', '-o', path.join(dir, 'out')]]) {
+      const r = cli(cmd[0], ...args, ...cmd.slice(1));
+      assert.equal(r.signal, null, `${what}: ${cmd[0]} crashed`);
+      assert.equal(r.status, 1, `${what}: ${cmd[0]} exit ${r.status} ${r.stderr}`);
+      assert.match(r.stderr, /^tetstream: error: /, `${what}: ${cmd[0]}`);
+      assert.match(r.stderr, msg, `${what}: ${cmd[0]}: ${r.stderr}`);
+    }
+  }
+  const missing = cli('iso', vtu, '--value', '0', '--field', 'pressure', '--json');
+  assert.equal(missing.status, 1);
+  assert.match(missing.stderr, /pressure/);
+  assert.match(missing.stderr, /harmonic/, 'lists the fields that exist');
+  assert.equal(missing.json.error.status, 'missing-field');
+});

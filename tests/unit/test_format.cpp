@@ -1,0 +1,240 @@
+// Packed format: round trip through files, determinism, and hostile manifests and chunks.
+#include <gtest/gtest.h>
+
+#include <zstd.h>
+
+#include <filesystem>
+#include <limits>
+
+#include "chunk.h"
+#include "dataset.h"
+#include "hash.h"
+#include "pack/chunk_encode.h"
+#include "pack/generators.h"
+#include "pack/packer.h"
+#include "test_helpers.h"
+
+using namespace tetstream;
+
+namespace {
+
+// A folder for one test under this suite's scratch folder (removed at exit).
+std::string tempDir(const std::string& name) {
+  static test::ScratchDir root("format");
+  std::string dir = root.path + "/" + name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+TetMesh harmonic(uint32_t n) {
+  TetMesh m = makeGridMesh(n);
+  addHarmonicField(m);
+  addDistanceField(m);
+  m.name = "harmonic";
+  return m;
+}
+
+std::string packed(const std::string& name, const TetMesh& m, PackSummary* summary = nullptr) {
+  std::string dir = tempDir(name);
+  PackSummary s;
+  Result r = packMesh(m, dir, PackOptions{}, s);
+  EXPECT_TRUE(r) << r.message;
+  if (summary) *summary = s;
+  return dir;
+}
+
+}  // namespace
+
+TEST(Format, PackThenLoadIsExact) {
+  TetMesh m = harmonic(9);
+  std::string dir = packed("roundtrip", m);
+  Dataset ds;
+  Result r = loadPackedDir(dir, ds);
+  ASSERT_TRUE(r) << r.message;
+  EXPECT_EQ(ds.mesh.positions, m.positions);
+  EXPECT_EQ(ds.mesh.tets, m.tets);
+  ASSERT_EQ(ds.mesh.fields.size(), 2u);
+  EXPECT_EQ(ds.mesh.fields[0].name, "harmonic");
+  EXPECT_EQ(ds.mesh.fields[0].values, m.fields[0].values);
+  EXPECT_EQ(ds.mesh.fields[1].values, m.fields[1].values);
+  EXPECT_EQ(ds.manifest.isoField, "harmonic");
+  EXPECT_EQ(ds.chunksApplied, 1u);
+}
+
+TEST(Format, PackOrientsTetsPositively) {
+  TetMesh m = harmonic(5);
+  for (uint32_t t = 0; t < m.tetCount(); t += 2) std::swap(m.tets[4 * t + 1], m.tets[4 * t + 2]);
+  PackSummary s;
+  std::string dir = packed("orient", m, &s);
+  EXPECT_EQ(s.flippedTets, (m.tetCount() + 1) / 2);
+  Dataset ds;
+  ASSERT_TRUE(loadPackedDir(dir, ds));
+  for (uint32_t t = 0; t < ds.mesh.tetCount(); ++t) EXPECT_GT(tetVolume(ds.mesh, t), 0);
+}
+
+TEST(Format, PackIsDeterministic) {
+  TetMesh m = harmonic(7);
+  std::string a = packed("det-a", m), b = packed("det-b", m);
+  EXPECT_EQ(test::loadFile(a + "/manifest.json"), test::loadFile(b + "/manifest.json"));
+  Dataset ds;
+  ASSERT_TRUE(loadPackedDir(a, ds));
+  const std::string f = ds.manifest.chunks[0].file;
+  EXPECT_EQ(test::loadBytes(a + "/" + f), test::loadBytes(b + "/" + f));
+}
+
+TEST(Format, RepackReplacesStaleChunks) {
+  std::string dir = tempDir("repack");
+  PackSummary s;
+  ASSERT_TRUE(packMesh(harmonic(5), dir, {}, s));
+  ASSERT_TRUE(packMesh(harmonic(6), dir, {}, s));
+  int files = 0;
+  for (auto& e : std::filesystem::directory_iterator(dir + "/chunks")) files += e.path().extension() == ".tsc";
+  EXPECT_EQ(files, 1);
+}
+
+TEST(Format, PackRefusesUnusableMeshes) {
+  PackSummary s;
+  TetMesh noField = makeGridMesh(3);
+  EXPECT_EQ(packMesh(noField, tempDir("nofield"), {}, s).status, Status::MissingField);
+  TetMesh m = harmonic(3);
+  PackOptions o;
+  o.field = "nope";
+  Result r = packMesh(m, tempDir("badfield"), o, s);
+  EXPECT_EQ(r.status, Status::MissingField);
+  EXPECT_NE(r.message.find("harmonic"), std::string::npos) << "the message lists the fields";
+  TetMesh bad = harmonic(3);
+  bad.tets[5] = 1000;
+  EXPECT_EQ(packMesh(bad, tempDir("badidx"), {}, s).status, Status::OutOfRange);
+}
+
+TEST(Format, ManifestRoundTrip) {
+  PackSummary s;
+  std::string dir = packed("manifest", harmonic(4), &s);
+  Manifest m;
+  ASSERT_TRUE(parseManifest(writeManifest(s.manifest), m));
+  EXPECT_EQ(writeManifest(m), writeManifest(s.manifest));
+}
+
+TEST(Format, HashFormat) {
+  uint64_t h = 0;
+  EXPECT_TRUE(parseHash(formatHash(0x0123456789abcdefull), &h));
+  EXPECT_EQ(h, 0x0123456789abcdefull);
+  EXPECT_FALSE(parseHash("xxh3-64:0123", &h));
+  EXPECT_FALSE(parseHash("md5:0123456789abcdef", &h));
+  EXPECT_FALSE(parseHash("xxh3-64:0123456789abcdeg", &h));
+}
+
+// Each hostile manifest is refused with a message, never a crash.
+TEST(Format, HostileManifestsAreRefused) {
+  PackSummary s;
+  packed("hostile", harmonic(4), &s);
+  const std::string good = writeManifest(s.manifest);
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string t = good;
+    size_t at = t.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return t.replace(at, from.size(), to);
+  };
+  std::vector<std::string> cases = {
+      "",
+      "not json",
+      "[]",
+      "{}",
+      std::string(100000, '['),
+      with("\"formatVersion\": 1", "\"formatVersion\": 2"),
+      with("\"formatVersion\": 1", "\"formatVersion\": \"1\""),
+      with("\"format\": \"tetstream\"", "\"format\": \"other\""),
+      with("\"vertices\": 64", "\"vertices\": -1"),
+      with("\"vertices\": 64", "\"vertices\": 99999999999"),
+      with("\"tets\": 162", "\"tets\": 1.5"),
+      with("\"file\": \"chunks/", "\"file\": \"../../etc/"),
+      with("\"file\": \"chunks/", "\"file\": \"chunks/../"),
+      with("\"file\": \"chunks/", "\"file\": \"/chunks/"),
+      with("\"hash\": \"xxh3-64:", "\"hash\": \"xxh3-64:zz"),
+      with("\"kind\": \"base\"", "\"kind\": \"splits\""),
+      with("\"name\": \"harmonic\"", "\"name\": 7"),
+      with("\"chunks\": [", "\"chunks\": 5, \"x\": ["),
+      with("\"min\": [", "\"min\": [1e39, "),
+  };
+  for (const std::string& c : cases) {
+    Manifest m;
+    Result r = parseManifest(c, m);
+    EXPECT_FALSE(r.ok()) << "accepted: " << c.substr(0, 200);
+    EXPECT_FALSE(r.message.empty());
+  }
+}
+
+TEST(Format, CorruptTruncatedAndWrongChunksAreNeverApplied) {
+  std::string dir = packed("corrupt", harmonic(6));
+  Dataset ds;
+  ASSERT_TRUE(loadPackedDir(dir, ds, 0));
+  const ChunkInfo info = ds.manifest.chunks[0];
+  std::vector<uint8_t> good = test::loadBytes(dir + "/" + info.file);
+
+  std::vector<uint8_t> flipped = good;
+  flipped[flipped.size() / 2] ^= 0x10;
+  EXPECT_EQ(applyChunk(ds, 0, flipped).status, Status::HashMismatch);
+  for (size_t len : {size_t(0), size_t(1), good.size() / 2, good.size() - 1})
+    EXPECT_EQ(applyChunk(ds, 0, std::span(good.data(), len)).status, Status::SizeMismatch);
+  EXPECT_EQ(applyChunk(ds, 1, good).status, Status::BadArgument) << "out of order";
+  EXPECT_EQ(ds.chunksApplied, 0u);
+  EXPECT_EQ(ds.mesh.tetCount(), 0u) << "nothing applied";
+  Result ok = applyChunk(ds, 0, good);
+  EXPECT_TRUE(ok) << ok.message;
+}
+
+// A chunk whose hash matches (the attacker controls the manifest too) but whose content lies.
+TEST(Format, ConsistentlyHashedButInvalidPayloadsAreRefused) {
+  TetMesh m = harmonic(4);
+  std::string dir = packed("lying", m);
+  Dataset ds;
+  ASSERT_TRUE(loadPackedDir(dir, ds, 0));
+  auto tryMesh = [&](const TetMesh& bad, Status expect) {
+    std::vector<uint8_t> file;
+    ChunkInfo info;
+    ASSERT_TRUE(encodeBaseChunk(bad, 0, 3, file, info));
+    Dataset d;
+    ASSERT_TRUE(openDataset(d, test::loadFile(dir + "/manifest.json")));
+    d.manifest.chunks[0].bytes = info.bytes;
+    d.manifest.chunks[0].rawBytes = info.rawBytes;
+    d.manifest.chunks[0].hash = info.hash;
+    Result r = applyChunk(d, 0, file);
+    EXPECT_EQ(r.status, expect) << r.message;
+    EXPECT_EQ(d.mesh.tetCount(), 0u);
+  };
+  TetMesh outOfRange = m;
+  outOfRange.tets[7] = 5000;
+  tryMesh(outOfRange, Status::OutOfRange);
+  TetMesh repeated = m;
+  repeated.tets[1] = repeated.tets[0];
+  tryMesh(repeated, Status::Corrupt);
+  TetMesh nan = m;
+  nan.positions[5] = std::numeric_limits<float>::quiet_NaN();
+  tryMesh(nan, Status::NonFinite);
+  TetMesh fewer = m;
+  fewer.tets.resize(fewer.tets.size() - 4);
+  tryMesh(fewer, Status::Corrupt);
+  TetMesh moreFields = m;
+  moreFields.fields.push_back({"extra", std::vector<float>(m.vertexCount())});
+  tryMesh(moreFields, Status::Corrupt);
+}
+
+TEST(Format, SplitChunksAreRefusedByThisVersion) {
+  // Until vertex splits exist, a manifest that lists them must fail at that chunk, keeping the
+  // base mesh usable.
+  PackSummary s;
+  std::string dir = packed("splits", harmonic(4), &s);
+  Manifest m = s.manifest;
+  ChunkInfo extra = m.chunks[0];
+  extra.kind = ChunkKind::Splits;
+  extra.file = "chunks/00001-0000000000000000.tsc";
+  m.chunks.push_back(extra);
+  Dataset ds;
+  ASSERT_TRUE(openDataset(ds, writeManifest(m)));
+  std::vector<uint8_t> base = test::loadBytes(dir + "/" + m.chunks[0].file);
+  ASSERT_TRUE(applyChunk(ds, 0, base));
+  EXPECT_FALSE(applyChunk(ds, 1, base).ok());
+  EXPECT_EQ(ds.chunksApplied, 1u);
+  EXPECT_GT(ds.mesh.tetCount(), 0u);
+}
