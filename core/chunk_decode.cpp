@@ -47,8 +47,11 @@ Result openChunk(ChunkDecoder& dec, const ChunkInfo& info, uint32_t index, std::
   if (!dec.dctx) return fail(Status::TooLarge, name + ": out of memory for the zstd context");
   dec.raw.resize(info.rawBytes);
   size_t got = ZSTD_decompressDCtx(dec.dctx, dec.raw.data(), dec.raw.size(), file.data(), file.size());
-  if (ZSTD_isError(got)) return fail(Status::DecompressFailed, name + ": " + ZSTD_getErrorName(got));
-  if (got != info.rawBytes) return fail(Status::SizeMismatch, name + ": decompressed to a different size than declared");
+  if (ZSTD_isError(got) || got != info.rawBytes) {
+    std::vector<uint8_t>().swap(dec.raw);  // a refused chunk must not keep its memory
+    if (ZSTD_isError(got)) return fail(Status::DecompressFailed, name + ": " + ZSTD_getErrorName(got));
+    return fail(Status::SizeMismatch, name + ": decompressed to a different size than declared");
+  }
   if (got < kChunkHeaderBytes) return fail(Status::Truncated, name + ": shorter than its header");
   const uint8_t* h = dec.raw.data();
   if (std::memcmp(h, kChunkMagic, 4) != 0) return fail(Status::BadMagic, name + ": not a tetstream chunk (magic)");

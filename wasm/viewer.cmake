@@ -1,0 +1,62 @@
+# Browser viewer (Emscripten only; included from the root CMakeLists.txt).
+#   tetstream_imgui   Dear ImGui 1.86 + GLFW and OpenGL3 backends (sources in build/_deps/imgui)
+#   tetstream_viewer  tetstream.js + tetstream.wasm in ${TETSTREAM_WEB_DIR}, plus every file of web/
+# The viewer's model (viewer_state, camera) has no GL and no Emscripten and also compiles natively.
+
+set(TETSTREAM_IMGUI_DIR "${TETSTREAM_DEPS_DIR}/imgui")
+if(NOT EXISTS "${TETSTREAM_IMGUI_DIR}/imgui.cpp")
+  message(FATAL_ERROR "Dear ImGui sources not found in ${TETSTREAM_IMGUI_DIR}: run scripts/setup.sh")
+endif()
+
+add_library(tetstream_imgui STATIC
+  ${TETSTREAM_IMGUI_DIR}/imgui.cpp
+  ${TETSTREAM_IMGUI_DIR}/imgui_draw.cpp
+  ${TETSTREAM_IMGUI_DIR}/imgui_tables.cpp
+  ${TETSTREAM_IMGUI_DIR}/imgui_widgets.cpp
+  ${TETSTREAM_IMGUI_DIR}/backends/imgui_impl_glfw.cpp
+  ${TETSTREAM_IMGUI_DIR}/backends/imgui_impl_opengl3.cpp
+)
+target_include_directories(tetstream_imgui PUBLIC ${TETSTREAM_IMGUI_DIR} ${CMAKE_CURRENT_LIST_DIR})
+# One config header for every ImGui file, ours included: WebGL2 (GLES3) everywhere.
+target_compile_definitions(tetstream_imgui PUBLIC IMGUI_USER_CONFIG="imconfig_tetstream.h")
+
+add_executable(tetstream_viewer
+  ${CMAKE_CURRENT_LIST_DIR}/main.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/viewer_state.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/camera.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/renderer.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/panel.cpp
+)
+target_link_libraries(tetstream_viewer PRIVATE tetstream_core tetstream_imgui)
+tetstream_warnings(tetstream_viewer)
+# GLM 0.9.9.8 (type_half.inl) uses `volatile float f; f *= f;`, deprecated in C++20.
+target_compile_options(tetstream_viewer PRIVATE -Wno-deprecated-volatile)
+
+set(TETSTREAM_VIEWER_EXPORTS
+  _main _malloc _free
+  _ts_open_manifest _ts_chunk_file _ts_add_chunk _ts_set_isovalue _ts_set_field _ts_fail _ts_stats_json)
+list(JOIN TETSTREAM_VIEWER_EXPORTS "," TETSTREAM_VIEWER_EXPORTS)
+target_link_options(tetstream_viewer PRIVATE
+  -sUSE_GLFW=3
+  -sUSE_WEBGL2=1 -sMIN_WEBGL_VERSION=2 -sMAX_WEBGL_VERSION=2
+  -sALLOW_MEMORY_GROWTH=1 -sMAXIMUM_MEMORY=4GB
+  -sMODULARIZE=1 -sEXPORT_NAME=createTetstream -sINVOKE_RUN=0
+  -sENVIRONMENT=web -sFILESYSTEM=0
+  -sEXPORTED_FUNCTIONS=${TETSTREAM_VIEWER_EXPORTS}
+  -sEXPORTED_RUNTIME_METHODS=callMain,ccall,cwrap,UTF8ToString,HEAPU8
+  $<$<CONFIG:Release>:-O3>
+  $<$<CONFIG:Debug>:-sASSERTIONS=1>
+)
+set_target_properties(tetstream_viewer PROPERTIES
+  OUTPUT_NAME tetstream
+  SUFFIX ".js"
+  RUNTIME_OUTPUT_DIRECTORY ${TETSTREAM_WEB_DIR})
+
+# The static shell: copied on every build so edits to web/ show up after a rebuild.
+file(GLOB TETSTREAM_WEB_FILES CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/web/*)
+add_custom_target(tetstream_web_files
+  COMMAND ${CMAKE_COMMAND} -E make_directory ${TETSTREAM_WEB_DIR}
+  COMMAND ${CMAKE_COMMAND} -E copy_if_different ${TETSTREAM_WEB_FILES} ${TETSTREAM_WEB_DIR}
+  COMMENT "Copying web/ to ${TETSTREAM_WEB_DIR}"
+  VERBATIM)
+add_dependencies(tetstream_viewer tetstream_web_files)
