@@ -184,7 +184,7 @@ Result parseManifest(std::string_view text, Manifest& m) {
       m.lossless = true;
     } else {
       uint64_t pb = 0, fb = 0;
-      r.integer(*q, "positionBits", "quantization.", 8, 16, pb);
+      r.integer(*q, "positionBits", "quantization.", 8, 24, pb);
       r.integer(*q, "fieldBits", "quantization.", 8, 16, fb);
       m.positionBits = int(pb);
       m.fieldBits = int(fb);

@@ -69,9 +69,9 @@ PanelActions drawPanel(ViewerState& s, float uiScale, float pixelsPerCssPixel) {
 
   if (haveDataset) {
     ImGui::Separator();
-    row("vertices", grouped(s.dataset.mesh.vertexCount()) +
-                        (s.dataset.mesh.vertexCount() != m.vertices ? " of " + grouped(m.vertices) : ""));
-    row("tets", grouped(s.dataset.mesh.tetCount()));
+    row("vertices", grouped(s.dataset.pm.mesh.vertexCount()) +
+                        (s.dataset.pm.mesh.vertexCount() != m.vertices ? " of " + grouped(m.vertices) : ""));
+    row("tets", grouped(s.dataset.pm.mesh.tetCount()));
     row("triangles", grouped(s.surface.triangleCount()));
     char area[48];
     std::snprintf(area, sizeof area, "%.6g", s.surfaceArea);

@@ -43,7 +43,7 @@ Result openManifest(ViewerState& s, std::string_view manifestJson) {
   s.bytesLoaded = manifestJson.size();
   if (Result r = openDataset(s.dataset, manifestJson); !r) {
     s.dataset.manifest = {};
-    s.dataset.mesh = {};
+    s.dataset.pm = {};
     s.dataset.chunksApplied = 0;
     s.dataset.bytesApplied = 0;
     failLoad(s, "The dataset description (manifest.json) is not usable: " + r.message);
@@ -105,7 +105,7 @@ void failLoad(ViewerState& s, std::string_view message) {
 }
 
 void extract(ViewerState& s) {
-  const TetMesh& mesh = s.dataset.mesh;
+  const TetMesh& mesh = s.dataset.pm.mesh;
   s.surfaceDirty = true;
   int f = s.field >= 0 ? mesh.findField(s.dataset.manifest.fields[size_t(s.field)].name) : -1;
   if (mesh.tetCount() == 0 || f < 0 || mesh.fields[size_t(f)].values.size() != mesh.vertexCount()) {
@@ -123,7 +123,7 @@ void extract(ViewerState& s) {
 
 void updateBoundary(ViewerState& s) {
   if (!s.boundaryStale) return;
-  buildBoundary(s.dataset.mesh, s.boundary);
+  buildBoundary(s.dataset.pm.mesh, s.boundary);
   s.boundaryStale = false;
   s.boundaryDirty = true;
 }
@@ -200,8 +200,8 @@ std::string statsJson(const ViewerState& s) {
       {"state", loadStateName(s.state)},
       {"error", s.error},
       {"name", ds.manifest.name},
-      {"vertices", ds.mesh.vertexCount()},
-      {"tets", ds.mesh.tetCount()},
+      {"vertices", ds.pm.mesh.vertexCount()},
+      {"tets", ds.pm.mesh.tetCount()},
       {"triangles", s.surface.triangleCount()},
       {"surfaceVertices", s.surface.vertexCount()},
       {"isovalue", s.isovalue},

@@ -1,5 +1,6 @@
 #include "cli_common.h"
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
@@ -8,18 +9,36 @@
 
 namespace tetstream::cli {
 
-Result loadInput(const std::string& path, Input& in) {
+void addLevelOptions(CLI::App* sub, LevelOption& level) {
+  auto* c = sub->add_option("--chunks", level.chunks, "packed input: use the first K chunks (1 = the base mesh)")
+                ->check(CLI::Range(1, 1 << 20));
+  auto* f = sub->add_option("--fraction", level.fraction, "packed input: refine until this fraction of the vertices")
+                ->check(CLI::Range(0.0, 1.0));
+  c->excludes(f);
+}
+
+Result loadInput(const std::string& path, Input& in, const LevelOption& level) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) {
     if (!isPackedDir(path)) return fail(Status::IoError, path + ": a folder without manifest.json is not a packed dataset");
     Dataset ds;
-    if (Result r = loadPackedDir(path, ds); !r) return r;
+    uint32_t maxVertices = ~0u;
+    if (level.fraction >= 0) {
+      // The manifest is read twice (once here for the count): it is small.
+      Dataset probe;
+      if (Result r = loadPackedDir(path, probe, 0); !r) return r;
+      maxVertices = uint32_t(std::ceil(level.fraction * probe.manifest.vertices));
+    }
+    if (Result r = loadPackedDir(path, ds, level.chunks, maxVertices); !r) return r;
     in.packed = true;
     in.manifest = ds.manifest;
     in.chunksApplied = ds.chunksApplied;
-    in.mesh = std::move(ds.mesh);
+    in.splitsApplied = ds.pm.splitsApplied();
+    in.mesh = std::move(ds.pm.mesh);
     return Result::success();
   }
+  if (level.chunks >= 0 || level.fraction >= 0)
+    return fail(Status::BadArgument, "--chunks and --fraction apply to packed datasets, not to " + path);
   ReadReport report;
   Result r = readMesh(path, in.mesh, report);
   in.notes = report.notes;

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 #include "manifest.h"
@@ -15,16 +16,25 @@ namespace tetstream::cli {
 
 using json = nlohmann::ordered_json;
 
+// Which level of a packed dataset to use: the first `chunks` chunks (1 = the base mesh), or
+// the first level with at least `fraction` of the full vertex count. Default: everything.
+struct LevelOption {
+  int chunks = -1;
+  double fraction = -1;
+};
+void addLevelOptions(CLI::App* sub, LevelOption& level);
+
 struct Input {
   TetMesh mesh;
   bool packed = false;
   Manifest manifest;                // when packed
-  uint32_t chunksApplied = 0;       // when packed
+  uint32_t chunksApplied = 0;       // when packed: complete chunks
+  uint32_t splitsApplied = 0;       // when packed: vertex splits applied
   std::vector<std::string> notes;   // what the reader did (converted fields, skipped cells)
 };
 
 // A packed dataset folder (with manifest.json) or a mesh file (.vtu, .vtk).
-Result loadInput(const std::string& path, Input& in);
+Result loadInput(const std::string& path, Input& in, const LevelOption& level = {});
 
 // Picks the field by name, or the dataset's default (isoField for packed data, else the first).
 // Returns its index or sets `r` to a MissingField error listing the available names.

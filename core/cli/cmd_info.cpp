@@ -9,14 +9,15 @@
 namespace tetstream::cli {
 
 Runner addInfo(CLI::App& app) {
-  struct Opts { std::string input; bool json = false; };
+  struct Opts { std::string input; bool json = false; LevelOption level; };
   auto o = std::make_shared<Opts>();
   CLI::App* sub = app.add_subcommand("info", "Counts, fields and ranges, and validation findings");
   sub->add_option("input", o->input, "mesh file or packed dataset folder")->required();
   sub->add_flag("--json", o->json, "print the result as JSON on stdout");
+  addLevelOptions(sub, o->level);
   return [o] {
     Input in;
-    if (Result r = loadInput(o->input, in); !r) return reportError(r, o->json);
+    if (Result r = loadInput(o->input, in, o->level); !r) return reportError(r, o->json);
     const TetMesh& m = in.mesh;
     Bounds b = computeBounds(m.positions);
     ValidationReport v = validateMesh(m);
@@ -39,6 +40,8 @@ Runner addInfo(CLI::App& app) {
       if (in.packed) {
         j["format"] = {{"formatVersion", in.manifest.formatVersion}, {"generator", in.manifest.generator},
                        {"chunks", in.manifest.chunks.size()}, {"chunksApplied", in.chunksApplied},
+                       {"splitsApplied", in.splitsApplied}, {"fullVertices", in.manifest.vertices},
+                       {"fullTets", in.manifest.tets},
                        {"bytes", in.manifest.totalBytes()}, {"isoField", in.manifest.isoField}};
       }
       printJson(j);
@@ -52,10 +55,15 @@ Runner addInfo(CLI::App& app) {
       Range r = computeRange(f.values);
       std::printf("  field     %-24s [%g, %g]\n", f.name.c_str(), r.min, r.max);
     }
-    if (in.packed)
+    if (in.packed) {
       std::printf("  format    v%u, %zu chunk(s), %llu bytes, by %s\n", in.manifest.formatVersion,
                   in.manifest.chunks.size(), static_cast<unsigned long long>(in.manifest.totalBytes()),
                   in.manifest.generator.c_str());
+      std::printf("  level     %u of %zu chunks, %u splits: %.1f%% of %u vertices, %.1f%% of %u tets\n",
+                  in.chunksApplied, in.manifest.chunks.size(), in.splitsApplied,
+                  100.0 * m.vertexCount() / in.manifest.vertices, in.manifest.vertices,
+                  100.0 * m.tetCount() / in.manifest.tets, in.manifest.tets);
+    }
     std::printf("  boundary  %llu faces\n", static_cast<unsigned long long>(v.boundaryFaces));
     for (const std::string& n : in.notes) std::printf("  note      %s\n", n.c_str());
     if (v.findings.empty()) std::printf("  valid     no problems found\n");

@@ -11,7 +11,7 @@
 namespace tetstream::cli {
 
 Runner addIso(CLI::App& app) {
-  struct Opts { std::string input, field, out; double value = 0; bool json = false; };
+  struct Opts { std::string input, field, out; double value = 0; bool json = false; LevelOption level; };
   auto o = std::make_shared<Opts>();
   CLI::App* sub = app.add_subcommand("iso", "Extract an isosurface (marching tetrahedra)");
   sub->add_option("input", o->input, "mesh file or packed dataset folder")->required();
@@ -19,9 +19,10 @@ Runner addIso(CLI::App& app) {
   sub->add_option("--field", o->field, "scalar field (default: the dataset's first or iso field)");
   sub->add_option("-o,--output", o->out, "write the surface as binary PLY with normals");
   sub->add_flag("--json", o->json, "print the result as JSON on stdout");
+  addLevelOptions(sub, o->level);
   return [o] {
     Input in;
-    if (Result r = loadInput(o->input, in); !r) return reportError(r, o->json);
+    if (Result r = loadInput(o->input, in, o->level); !r) return reportError(r, o->json);
     Result r;
     int f = chooseField(in, o->field, r);
     if (f < 0) return reportError(r, o->json);

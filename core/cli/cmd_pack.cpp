@@ -1,4 +1,8 @@
-// tetstream pack INPUT -o OUTDIR [--field NAME]
+// tetstream pack INPUT -o OUTDIR [--field NAME] [--weights G,F,S] [--base-fraction F |
+//   --base-vertices N | --max-error E] [--lossless] [--chunk-kb K] [--json]
+#include <unistd.h>
+
+#include <chrono>
 #include <cstdio>
 #include <memory>
 
@@ -7,44 +11,141 @@
 #include "pack/packer.h"
 
 namespace tetstream::cli {
+namespace {
+
+// One-line progress on a terminal: phase, bar, percent, rate, time left. Silent otherwise.
+class ProgressLine {
+ public:
+  explicit ProgressLine(bool enabled) : enabled_(enabled) {}
+  void update(const char* phase, double fraction) {
+    if (!enabled_) return;
+    auto now = std::chrono::steady_clock::now();
+    if (phase != phase_) {
+      finishLine();
+      phase_ = phase;
+      phaseStart_ = now;
+    } else if (fraction < 1 && now - lastDraw_ < std::chrono::milliseconds(100)) {
+      return;
+    }
+    lastDraw_ = now;
+    double secs = std::chrono::duration<double>(now - phaseStart_).count();
+    char eta[32] = "";
+    if (fraction > 0.02 && fraction < 1) std::snprintf(eta, sizeof eta, ", %.0f s left", secs * (1 - fraction) / fraction);
+    int filled = int(fraction * 30 + 0.5);
+    std::fprintf(stderr, "\r  %-9s [%.*s%*s] %5.1f%%  %.1f s%s   ", phase, filled, "##############################",
+                 30 - filled, "", 100 * fraction, secs, eta);
+    drawn_ = true;
+  }
+  void finishLine() {
+    if (drawn_) std::fprintf(stderr, "\n");
+    drawn_ = false;
+  }
+
+ private:
+  bool enabled_, drawn_ = false;
+  std::string phase_;
+  std::chrono::steady_clock::time_point phaseStart_, lastDraw_;
+};
+
+}  // namespace
 
 Runner addPack(CLI::App& app) {
-  struct Opts { std::string input, out, field, name; int level = 9; bool json = false; };
+  struct Opts {
+    std::string input, out, field, name;
+    std::vector<double> weights;
+    double baseFraction = 0.01, maxError = -1;
+    uint32_t baseVertices = 0, chunkKb = 256;
+    int level = 19;
+    bool lossless = false, json = false;
+  };
   auto o = std::make_shared<Opts>();
-  CLI::App* sub = app.add_subcommand("pack", "Pack a mesh into a streamable dataset folder (manifest + chunks)");
+  CLI::App* sub = app.add_subcommand("pack", "Pack a mesh into a progressive dataset folder (manifest + chunks)");
   sub->add_option("input", o->input, "mesh file (.vtu, .vtk)")->required();
   sub->add_option("-o,--output", o->out, "output folder (created; an earlier pack there is replaced)")->required();
-  sub->add_option("--field", o->field, "field shown first and used to steer simplification (default: the first)");
+  sub->add_option("--field", o->field, "field that steers simplification and is shown first (default: the first)");
   sub->add_option("--name", o->name, "dataset name shown in the viewer (default: the file name)");
+  sub->add_option("--weights", o->weights, "cost weights G,F,S: boundary geometry, field, tet shape (default 10,1,0.002)")
+      ->delimiter(',')->expected(3);
+  auto* bf = sub->add_option("--base-fraction", o->baseFraction, "base mesh size as a fraction of the vertices")
+                 ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+  auto* bv = sub->add_option("--base-vertices", o->baseVertices, "base mesh size in vertices");
+  auto* me = sub->add_option("--max-error", o->maxError, "stop simplifying when the cheapest collapse costs more (relative error units)")
+                 ->check(CLI::PositiveNumber);
+  bv->excludes(bf);
+  me->excludes(bf);
+  me->excludes(bv);
+  sub->add_flag("--lossless", o->lossless, "keep exact float32 positions and fields (default: 16-bit grid)");
+  sub->add_option("--chunk-kb", o->chunkKb, "largest split chunk in KB; the first chunks are smaller")
+      ->check(CLI::Range(1u, 65536u))->capture_default_str();
   sub->add_option("--zstd-level", o->level, "zstd compression level")->check(CLI::Range(1, 22))->capture_default_str();
   sub->add_flag("--json", o->json, "print the result as JSON on stdout");
-  return [o] {
+  return [o, me, bv] {
     Stopwatch total;
+    ProgressLine bar(!o->json && isatty(2));
+    bar.update("read", 0);
     Input in;
-    if (Result r = loadInput(o->input, in); !r) return reportError(r, o->json);
+    if (Result r = loadInput(o->input, in); !r) {
+      bar.finishLine();
+      return reportError(r, o->json);
+    }
     if (in.packed) return reportError(fail(Status::BadArgument, o->input + " is already packed; give a mesh file"), o->json);
+    bar.update("read", 1);
     double readMs = total.ms();
-    PackOptions opt{o->field, o->name, o->level};
+    const uint32_t inputVertices = in.mesh.vertexCount();
+    PackOptions opt;
+    opt.field = o->field;
+    opt.name = o->name;
+    opt.zstdLevel = o->level;
+    if (!o->weights.empty())
+      for (int k = 0; k < 3; ++k) opt.weights[k] = o->weights[size_t(k)];
+    opt.baseFraction = o->baseFraction;
+    if (bv->count()) opt.baseVertices = std::max<uint32_t>(o->baseVertices, 4);
+    if (me->count()) {
+      opt.maxError = o->maxError;
+      opt.baseFraction = 0;  // as far as the error bound allows
+    }
+    opt.lossless = o->lossless;
+    opt.chunkKb = o->chunkKb;
+    opt.progress = [&bar](const char* phase, double f) { bar.update(phase, f); };
     PackSummary s;
-    Stopwatch packTime;
-    if (Result r = packMesh(std::move(in.mesh), o->out, opt, s); !r) return reportError(r, o->json);
+    Result r = packMesh(std::move(in.mesh), o->out, opt, s);
+    bar.finishLine();
+    if (!r) return reportError(r, o->json);
+
     const Manifest& m = s.manifest;
-    uint64_t bytes = m.totalBytes();
+    uint64_t bytes = m.totalBytes(), baseBytes = m.chunks[0].bytes;
     double bitsPerTet = 8.0 * double(bytes) / m.tets;
+    double bytesPerSplit = s.splits ? double(bytes - baseBytes) / s.splits : 0;
+    json notes = in.notes;
+    for (const std::string& n : s.notes) notes.push_back(n);
     if (o->json) {
-      json notes = in.notes;
-      for (const std::string& n : s.notes) notes.push_back(n);
       printJson({{"output", o->out}, {"name", m.name}, {"vertices", m.vertices}, {"tets", m.tets},
-                 {"field", m.isoField}, {"chunks", m.chunks.size()}, {"bytes", bytes}, {"bitsPerTet", bitsPerTet},
-                 {"readMs", readMs}, {"packMs", packTime.ms()}, {"ms", total.ms()}, {"notes", notes}});
+                 {"inputVertices", inputVertices}, {"field", m.isoField}, {"lossless", m.lossless},
+                 {"positionBits", m.positionBits}, {"baseVertices", s.baseVertices}, {"baseTets", s.baseTets},
+                 {"splits", s.splits}, {"chunks", m.chunks.size()}, {"bytes", bytes}, {"baseBytes", baseBytes},
+                 {"bitsPerTet", bitsPerTet}, {"bytesPerSplit", bytesPerSplit},
+                 {"baseFieldError", m.chunks[0].fieldError}, {"stopReason", s.stopReason},
+                 {"flatTetsRemoved", s.flatTetsRemoved}, {"flatTetsLeft", s.flatTetsLeft},
+                 {"readMs", readMs}, {"simplifyMs", s.simplifyMs}, {"encodeMs", s.encodeMs}, {"writeMs", s.writeMs},
+                 {"ms", total.ms()}, {"notes", notes}});
       return 0;
     }
-    for (const std::string& n : in.notes) std::printf("note: %s\n", n.c_str());
-    for (const std::string& n : s.notes) std::printf("note: %s\n", n.c_str());
+    for (const auto& n : notes) std::printf("note: %s\n", n.get<std::string>().c_str());
     std::printf("packed %s -> %s/\n", o->input.c_str(), o->out.c_str());
-    std::printf("  %u vertices, %u tets, field '%s', %zu chunk(s), %.2f MB (%.1f bits/tet)\n", m.vertices, m.tets,
-                m.isoField.c_str(), m.chunks.size(), bytes / 1e6, bitsPerTet);
-    std::printf("  read %.0f ms, pack %.0f ms\n", readMs, packTime.ms());
+    std::printf("  input     %u vertices, %u tets, field '%s'\n", m.vertices, m.tets, m.isoField.c_str());
+    std::printf("  base      %u vertices (%.2f%%), %u tets, %.1f KB, field error <= %.3g (est.)\n", s.baseVertices,
+                100.0 * s.baseVertices / std::max<uint32_t>(m.vertices, 1), s.baseTets, baseBytes / 1024.0,
+                m.chunks[0].fieldError);
+    std::printf("  stream    %u splits in %zu chunks, %.2f MB in all, %.1f bits/tet, %.1f bytes/split\n", s.splits,
+                m.chunks.size() - 1, bytes / 1e6, bitsPerTet, bytesPerSplit);
+    std::printf("  values    %s\n", m.lossless ? "lossless float32"
+                                                : ("quantized, " + std::to_string(m.positionBits) + "-bit positions, " +
+                                                   std::to_string(m.fieldBits) + "-bit fields").c_str());
+    std::printf("  stopped   %s", s.stopReason.c_str());
+    if (s.flatTetsRemoved || s.flatTetsLeft)
+      std::printf("; flat input tets: %u removed, %u left", s.flatTetsRemoved, s.flatTetsLeft);
+    std::printf("\n  time      read %.0f ms, simplify %.0f ms, encode %.0f ms, write %.0f ms\n", readMs, s.simplifyMs,
+                s.encodeMs, s.writeMs);
     return 0;
   };
 }

@@ -13,5 +13,6 @@ Runner addGen(CLI::App& app);
 Runner addPack(CLI::App& app);
 Runner addIso(CLI::App& app);
 Runner addInfo(CLI::App& app);
+Runner addUnpack(CLI::App& app);
 
 }  // namespace tetstream::cli

@@ -11,7 +11,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("tetstream ") + tetstream::kLibraryVersion);
   app.require_subcommand(1);
   std::map<CLI::App*, Runner> runners;
-  for (auto add : {addGen, addPack, addIso, addInfo}) {
+  for (auto add : {addGen, addPack, addUnpack, addIso, addInfo}) {
     size_t before = app.get_subcommands({}).size();
     Runner run = add(app);
     runners[app.get_subcommands({})[before]] = run;

@@ -21,23 +21,15 @@ void putArray(std::vector<uint8_t>& b, const std::vector<T>& a) {  // little-end
 
 }  // namespace
 
-Result encodeBaseChunk(const TetMesh& mesh, uint32_t index, int level, std::vector<uint8_t>& file, ChunkInfo& info) {
-  std::vector<uint8_t> raw;
-  raw.reserve(kChunkHeaderBytes + kBaseHeaderBytes + 12 * size_t(mesh.vertexCount()) +
-              4 * mesh.fields.size() * mesh.vertexCount() + 16 * size_t(mesh.tetCount()));
+void beginChunk(std::vector<uint8_t>& raw, ChunkKind kind, uint32_t index) {
   raw.insert(raw.end(), kChunkMagic, kChunkMagic + 4);
   putU16(raw, uint16_t(kFormatVersion));
-  putU16(raw, uint16_t(ChunkKind::Base));
+  putU16(raw, uint16_t(kind));
   putU32(raw, index);
   putU32(raw, 0);
-  putU32(raw, mesh.vertexCount());
-  putU32(raw, mesh.tetCount());
-  putU32(raw, uint32_t(mesh.fields.size()));
-  putU32(raw, 0);
-  putArray(raw, mesh.positions);
-  for (const ScalarField& f : mesh.fields) putArray(raw, f.values);
-  putArray(raw, mesh.tets);
+}
 
+Result finishChunk(const std::vector<uint8_t>& raw, int level, std::vector<uint8_t>& file, ChunkInfo& info) {
   file.resize(ZSTD_compressBound(raw.size()));
   ZSTD_CCtx* cctx = ZSTD_createCCtx();
   if (!cctx) return fail(Status::TooLarge, "out of memory for the zstd context");
@@ -48,15 +40,29 @@ Result encodeBaseChunk(const TetMesh& mesh, uint32_t index, int level, std::vect
   ZSTD_freeCCtx(cctx);
   if (ZSTD_isError(n)) return fail(Status::DecompressFailed, std::string("zstd: ") + ZSTD_getErrorName(n));
   file.resize(n);
-
-  info.kind = ChunkKind::Base;
   info.bytes = n;
   info.rawBytes = raw.size();
   info.hash = contentHash(file);
+  return Result::success();
+}
+
+Result encodeBaseChunk(const TetMesh& mesh, uint32_t index, int level, std::vector<uint8_t>& file, ChunkInfo& info) {
+  std::vector<uint8_t> raw;
+  raw.reserve(kChunkHeaderBytes + kBaseHeaderBytes + 12 * size_t(mesh.vertexCount()) +
+              4 * mesh.fields.size() * mesh.vertexCount() + 16 * size_t(mesh.tetCount()));
+  beginChunk(raw, ChunkKind::Base, index);
+  putU32(raw, mesh.vertexCount());
+  putU32(raw, mesh.tetCount());
+  putU32(raw, uint32_t(mesh.fields.size()));
+  putU32(raw, 0);
+  putArray(raw, mesh.positions);
+  for (const ScalarField& f : mesh.fields) putArray(raw, f.values);
+  putArray(raw, mesh.tets);
+  if (Result r = finishChunk(raw, level, file, info); !r) return r;
+  info.kind = ChunkKind::Base;
   info.vertices = mesh.vertexCount();
   info.tets = mesh.tetCount();
   info.splits = 0;
-  info.fieldError = 0;
   return Result::success();
 }
 

@@ -1,4 +1,4 @@
-// Chunk files, encode side (FORMAT.md §2-§3). Pack side only; the viewer never links this.
+// Chunk files, encode side (FORMAT.md §2-§4). Pack side only; the viewer never links this.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -9,8 +9,15 @@
 
 namespace tetstream {
 
-// Serialises `mesh` as base-mesh chunk `index` and compresses it with zstd at `level`.
-// Fills the size, hash and count fields of `info` (not `file`).
+// Starts a chunk's raw bytes with the 16-byte chunk header.
+void beginChunk(std::vector<uint8_t>& raw, ChunkKind kind, uint32_t index);
+
+// Compresses the raw chunk with zstd at `level` into `file` and fills the size and hash fields
+// of `info` (kind, counts and file name are the caller's).
+Result finishChunk(const std::vector<uint8_t>& raw, int level, std::vector<uint8_t>& file, ChunkInfo& info);
+
+// Serialises `mesh` as base-mesh chunk `index` (FORMAT.md §3) and compresses it. Fills the
+// size, hash and count fields of `info` (not `file`).
 Result encodeBaseChunk(const TetMesh& mesh, uint32_t index, int level, std::vector<uint8_t>& file, ChunkInfo& info);
 
 }  // namespace tetstream

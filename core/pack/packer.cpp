@@ -1,10 +1,17 @@
 #include "packer.h"
 
+#include <algorithm>
+#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <utility>
 
 #include "chunk_encode.h"
+#include "pack/file_writer.h"
+#include "pack/simplify.h"
+#include "pack/split_encode.h"
+#include "quantize.h"
 #include "validate.h"
 
 namespace tetstream {
@@ -12,12 +19,9 @@ namespace fs = std::filesystem;
 namespace {
 
 Result writeFile(const fs::path& path, const void* data, size_t size) {
-  std::FILE* f = std::fopen(path.c_str(), "wb");
-  if (!f) return fail(Status::IoError, path.string() + ": cannot create");
-  bool ok = std::fwrite(data, 1, size, f) == size;
-  ok = std::fclose(f) == 0 && ok;
-  if (!ok) return fail(Status::IoError, path.string() + ": write failed (disk full?)");
-  return Result::success();
+  FileWriter out(path.string());
+  out.write(data, size);
+  return out.commit();
 }
 
 std::string chunkFileName(uint32_t index, uint64_t hash) {
@@ -26,10 +30,34 @@ std::string chunkFileName(uint32_t index, uint64_t hash) {
   return buf;
 }
 
+double msSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Snaps positions and fields to the quantization grid of `m` (FORMAT.md §4). Returns the number
+// of tets that the snapping flattened or turned over (0 means this grid is safe).
+uint64_t snapToGrid(TetMesh& mesh, const Manifest& m) {
+  Quantizer q = makeQuantizer(m);
+  std::vector<double> before(mesh.tetCount());
+  for (uint32_t t = 0; t < mesh.tetCount(); ++t) before[t] = tetVolume(mesh, t);
+  for (uint32_t v = 0; v < mesh.vertexCount(); ++v)
+    for (int k = 0; k < 3; ++k) {
+      float& x = mesh.positions[3 * size_t(v) + k];
+      x = q.position[k].dequantize(q.position[k].quantize(x));
+    }
+  for (size_t f = 0; f < mesh.fields.size(); ++f)
+    for (float& x : mesh.fields[f].values) x = q.field[f].dequantize(q.field[f].quantize(x));
+  uint64_t broken = 0;
+  for (uint32_t t = 0; t < mesh.tetCount(); ++t) broken += before[t] > 0 && !(tetVolume(mesh, t) > 0);
+  return broken;
+}
+
 }  // namespace
 
 Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt, PackSummary& summary) {
   summary = PackSummary{};
+  auto progress = [&](const char* phase, double f) { if (opt.progress) opt.progress(phase, f); };
+  progress("validate", 0);
   ValidationReport report = validateMesh(mesh);
   if (report.fatal()) {
     std::string why;
@@ -66,16 +94,83 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   for (const ScalarField& f : mesh.fields) m.fields.push_back({f.name, computeRange(f.values)});
   m.isoField = mesh.fields[size_t(iso)].name;
 
+  // Quantization grid: 16 bits unless the mesh has elements too small for it.
+  m.lossless = opt.lossless || report.nonFiniteFieldValues > 0;
+  if (report.nonFiniteFieldValues && !opt.lossless)
+    summary.notes.push_back("fields contain NaN or infinite values: stored lossless (float32)");
+  if (!m.lossless) {
+    TetMesh snapped;
+    for (int bits : {16, 20, 24}) {
+      m.positionBits = bits;
+      snapped = mesh;
+      uint64_t broken = snapToGrid(snapped, m);
+      if (broken == 0) break;
+      summary.notes.push_back(std::to_string(broken) + " tetrahedra are too small for a " + std::to_string(bits) +
+                              "-bit position grid" + (bits < 24 ? ": trying more bits" : ": storing lossless"));
+      if (bits == 24) m.lossless = true;
+    }
+    if (!m.lossless) mesh = std::move(snapped);
+    m.positionBits = m.lossless ? 16 : m.positionBits;
+  }
+
+  // Simplify. Non-manifold or duplicated tets break the collapse's assumptions: keep them whole.
+  SimplifyResult simplified;
+  auto t0 = std::chrono::steady_clock::now();
+  SimplifyOptions so;
+  so.weightGeometry = opt.weights[0];
+  so.weightField = opt.weights[1];
+  so.weightShape = opt.weights[2];
+  so.field = iso;
+  so.maxError = opt.maxError;
+  so.targetVertices = opt.baseVertices ? opt.baseVertices
+                                       : uint32_t(std::llround(std::clamp(opt.baseFraction, 0.0, 1.0) * mesh.vertexCount()));
+  if (report.nonManifoldFaces || report.duplicateTets) {
+    summary.notes.push_back("non-manifold or duplicated tetrahedra: packed without simplification");
+    so.targetVertices = mesh.vertexCount();
+  }
+  so.progress = [&](uint32_t done, uint32_t planned) { progress("simplify", planned ? double(done) / planned : 1.0); };
+  if (Result r = simplifyMesh(mesh, so, simplified); !r) return r;
+  summary.simplifyMs = msSince(t0);
+  summary.stopReason = simplified.stopReason;
+  summary.flatTetsRemoved = simplified.flatTetsRemoved;
+  summary.flatTetsLeft = simplified.flatTetsLeft;
+
+  t0 = std::chrono::steady_clock::now();
+  progress("encode", 0);
+  StreamOptions stream;
+  stream.chunkBytes = std::max<uint32_t>(opt.chunkKb, 1) << 10;
+  stream.firstChunkBytes = std::min<uint32_t>(stream.chunkBytes, 16u << 10);
+  stream.zstdLevel = opt.zstdLevel;
+  EncodedStream enc;
+  if (Result r = encodeStream(mesh, simplified, m, stream, enc); !r) return r;
+  std::vector<uint8_t> baseFile;
+  ChunkInfo base;
+  base.fieldError = enc.baseFieldError;
+  if (Result r = encodeBaseChunk(enc.base, 0, opt.zstdLevel, baseFile, base); !r) return r;
+  summary.encodeMs = msSince(t0);
+  // Vertices no tet uses are not part of any level: the stream drops them.
+  m.vertices = enc.chunks.empty() ? enc.base.vertexCount() : enc.chunks.back().vertices;
+  m.tets = enc.chunks.empty() ? enc.base.tetCount() : enc.chunks.back().tets;
+  if (report.unusedVertices)
+    summary.notes.push_back("dropped " + std::to_string(report.unusedVertices) + " vertices that no tetrahedron uses");
+  summary.baseVertices = enc.base.vertexCount();
+  summary.baseTets = enc.base.tetCount();
+  summary.splits = simplified.log.size();
+
+  t0 = std::chrono::steady_clock::now();
+  progress("write", 0);
   std::error_code ec;
   fs::create_directories(fs::path(outDir) / "chunks", ec);
   if (ec) return fail(Status::IoError, outDir + ": cannot create folder: " + ec.message());
-
-  std::vector<uint8_t> file;
-  ChunkInfo base;
-  if (Result r = encodeBaseChunk(mesh, 0, opt.zstdLevel, file, base); !r) return r;
   base.file = chunkFileName(0, base.hash);
-  if (Result r = writeFile(fs::path(outDir) / base.file, file.data(), file.size()); !r) return r;
+  if (Result r = writeFile(fs::path(outDir) / base.file, baseFile.data(), baseFile.size()); !r) return r;
   m.chunks.push_back(base);
+  for (size_t c = 0; c < enc.files.size(); ++c) {
+    ChunkInfo info = enc.chunks[c];
+    info.file = chunkFileName(uint32_t(c + 1), info.hash);
+    if (Result r = writeFile(fs::path(outDir) / info.file, enc.files[c].data(), enc.files[c].size()); !r) return r;
+    m.chunks.push_back(info);
+  }
 
   // Remove chunk files an earlier pack left behind (only our own *.tsc names).
   for (const auto& entry : fs::directory_iterator(fs::path(outDir) / "chunks", ec)) {
@@ -85,13 +180,10 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
     for (const ChunkInfo& c : m.chunks) referenced |= c.file == rel;
     if (ours && !referenced) fs::remove(entry.path(), ec);
   }
-
   std::string json = writeManifest(m);
-  fs::path tmp = fs::path(outDir) / "manifest.json.tmp";
-  if (Result r = writeFile(tmp, json.data(), json.size()); !r) return r;
-  fs::rename(tmp, fs::path(outDir) / "manifest.json", ec);
-  if (ec) return fail(Status::IoError, outDir + "/manifest.json: " + ec.message());
-  return Result::success();
+  Result r = writeFile(fs::path(outDir) / "manifest.json", json.data(), json.size());
+  summary.writeMs = msSince(t0);
+  return r;
 }
 
 }  // namespace tetstream

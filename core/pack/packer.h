@@ -1,7 +1,10 @@
-// `tetstream pack`: turns a mesh into a packed dataset folder (FORMAT.md).
-// Version 0.1 writes the base chunk only (the whole mesh); the progressive packer of the next
-// version adds simplification and vertex-split chunks behind the same entry point.
+// `tetstream pack`: turns a mesh into a packed dataset folder (FORMAT.md): validate, orient,
+// quantize, simplify by half-edge collapses down to a small base mesh (simplify.h), encode the
+// reversed collapses as vertex-split chunks (split_encode.h), write chunks and manifest.
 #pragma once
+#include <cstdint>
+#include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -14,18 +17,30 @@ namespace tetstream {
 struct PackOptions {
   std::string field;     // field that steers simplification and is shown first; "" = first field
   std::string name;      // dataset name; "" = mesh.name
-  int zstdLevel = 9;
+  int zstdLevel = 19;
+  double weights[3] = {10.0, 1.0, 0.002};  // geometry, field, shape (simplify.h)
+  double baseFraction = 0.01;             // base mesh size as a fraction of the vertices...
+  uint32_t baseVertices = 0;              // ...or as a vertex count (wins when non-zero)
+  double maxError = std::numeric_limits<double>::infinity();  // stop simplifying at this cost
+  bool lossless = false;                  // keep float32 values in split records
+  uint32_t chunkKb = 256;                 // largest split chunk, compressed
+  // Phase name and fraction done, for progress displays.
+  std::function<void(const char* phase, double fraction)> progress;
 };
 
 struct PackSummary {
   Manifest manifest;
-  uint64_t flippedTets = 0;         // negatively oriented tets re-oriented (FORMAT.md §3)
-  std::vector<std::string> notes;   // what the packer changed or found, in plain words
+  uint64_t flippedTets = 0;          // negatively oriented tets re-oriented (FORMAT.md §3)
+  uint32_t baseVertices = 0, baseTets = 0, splits = 0;
+  uint32_t flatTetsRemoved = 0, flatTetsLeft = 0;
+  std::string stopReason;            // why simplification stopped
+  double simplifyMs = 0, encodeMs = 0, writeMs = 0;
+  std::vector<std::string> notes;    // what the packer changed or found, in plain words
 };
 
-// Validates, orients and writes `mesh` to `outDir` (created if missing). The manifest is
-// written last and atomically, so a reader never sees a manifest without its chunks; stale
-// chunk files of an earlier pack in the folder are removed.
+// Validates and packs `mesh` into `outDir` (created if missing). The manifest is written last
+// and atomically, so a reader never sees a manifest without its chunks; stale chunk files of an
+// earlier pack in the folder are removed.
 Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& options, PackSummary& summary);
 
 }  // namespace tetstream

@@ -2,6 +2,8 @@
 // buffer and faces in another, so the whole file is three fwrites.
 #include "pack/ply_writer.h"
 
+#include "pack/file_writer.h"
+
 #include <bit>
 #include <cerrno>
 #include <cstdio>
@@ -43,23 +45,11 @@ Result writePly(const std::string& path, std::span<const float> positions, std::
     std::memcpy(&faces[13 * t + 1], &triangles[3 * t], 12);
   }
 
-  const std::string tmp = path + ".tmp";
-  std::FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f) return fail(Status::IoError, path + ": cannot create " + tmp + " (" + std::strerror(errno) + ")");
-  bool ok = std::fwrite(header.data(), 1, header.size(), f) == header.size();
-  ok = ok && (verts.empty() || std::fwrite(verts.data(), sizeof(float), verts.size(), f) == verts.size());
-  ok = ok && (faces.empty() || std::fwrite(faces.data(), 1, faces.size(), f) == faces.size());
-  ok = std::fclose(f) == 0 && ok;
-  if (!ok) {
-    std::remove(tmp.c_str());
-    return fail(Status::IoError, path + ": write failed (disk full?)");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::string why = std::strerror(errno);
-    std::remove(tmp.c_str());
-    return fail(Status::IoError, path + ": cannot rename " + tmp + " (" + why + ")");
-  }
-  return Result::success();
+  FileWriter out(path);
+  out.write(header.data(), header.size());
+  out.write(verts.data(), verts.size() * sizeof(float));
+  out.write(faces.data(), faces.size());
+  return out.commit();
 }
 
 }  // namespace tetstream

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "pack/file_writer.h"
 #include "pack/readers.h"
 
 namespace tetstream {
@@ -94,27 +95,15 @@ Result writeVtu(const std::string& path, const TetMesh& mesh) {
   array("type=\"UInt8\" Name=\"types\"", types.data(), nt);
   xml += "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n  <AppendedData encoding=\"raw\">\n   _";
 
-  const std::string tmp = path + ".tmp";
-  std::FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f) return fail(Status::IoError, path + ": cannot create " + tmp + " (" + std::strerror(errno) + ")");
-  bool ok = std::fwrite(xml.data(), 1, xml.size(), f) == xml.size();
+  FileWriter out(path);
+  out.write(xml.data(), xml.size());
   for (const Block& b : blocks) {
-    ok = ok && std::fwrite(&b.bytes, 8, 1, f) == 1;
-    ok = ok && (b.bytes == 0 || std::fwrite(b.data, 1, size_t(b.bytes), f) == b.bytes);
+    out.write(&b.bytes, 8);
+    out.write(b.data, size_t(b.bytes));
   }
   const char tail[] = "\n  </AppendedData>\n</VTKFile>\n";
-  ok = ok && std::fwrite(tail, 1, sizeof tail - 1, f) == sizeof tail - 1;
-  ok = std::fclose(f) == 0 && ok;
-  if (!ok) {
-    std::remove(tmp.c_str());
-    return fail(Status::IoError, path + ": write failed (disk full?)");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::string why = std::strerror(errno);
-    std::remove(tmp.c_str());
-    return fail(Status::IoError, path + ": cannot rename " + tmp + " (" + why + ")");
-  }
-  return Result::success();
+  out.write(tail, sizeof tail - 1);
+  return out.commit();
 }
 
 }  // namespace tetstream

@@ -26,7 +26,7 @@ int main(int argc, char** argv) {
   }
   double loadMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   const std::string field = argc > 3 ? argv[3] : ds.manifest.isoField;
-  int f = ds.mesh.findField(field);
+  int f = ds.pm.mesh.findField(field);
   if (f < 0) {
     std::fprintf(stderr, "error: no field '%s'\n", field.c_str());
     return 1;
@@ -37,7 +37,7 @@ int main(int argc, char** argv) {
   double best = 1e300;
   for (int i = 0; i < repeats; ++i) {
     auto t = std::chrono::steady_clock::now();
-    extractIsosurface(ds.mesh, ds.mesh.fields[size_t(f)].values, std::strtof(argv[2], nullptr), x, s);
+    extractIsosurface(ds.pm.mesh, ds.pm.mesh.fields[size_t(f)].values, std::strtof(argv[2], nullptr), x, s);
     best = std::min(best, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count());
   }
   auto bytes = [](const auto& v) {
@@ -46,7 +46,7 @@ int main(int argc, char** argv) {
   std::printf(
       "{\"tets\": %u, \"triangles\": %u, \"vertices\": %u, \"area\": %.17g, \"positionsHash\": \"%s\", "
       "\"indicesHash\": \"%s\", \"normalsHash\": \"%s\", \"loadMs\": %.3f, \"ms\": %.3f}\n",
-      ds.mesh.tetCount(), s.triangleCount(), s.vertexCount(), surfaceArea(s), formatHash(contentHash(bytes(s.positions))).c_str(),
+      ds.pm.mesh.tetCount(), s.triangleCount(), s.vertexCount(), surfaceArea(s), formatHash(contentHash(bytes(s.positions))).c_str(),
       formatHash(contentHash(bytes(s.indices))).c_str(), formatHash(contentHash(bytes(s.normals))).c_str(), loadMs, best);
   return 0;
 }

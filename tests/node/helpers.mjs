@@ -21,13 +21,13 @@ export function cli(...args) {
 }
 
 // Generates and packs a Harmonic dataset of n³ vertices; returns the pack folder.
-export function packedHarmonic(n, name = `harmonic${n}`) {
+export function packedHarmonic(n, name = `harmonic${n}`, packArgs = []) {
   const dir = tempDir(name);
   const vtu = path.join(dir, 'h.vtu');
   const pack = path.join(dir, 'pack');
   let r = cli('gen', 'harmonic', '--n', String(n), '-o', vtu);
   if (r.status !== 0) throw new Error(`gen failed: ${r.stderr}`);
-  r = cli('pack', vtu, '-o', pack);
+  r = cli('pack', vtu, '-o', pack, ...packArgs);
   if (r.status !== 0) throw new Error(`pack failed: ${r.stderr}`);
   return { dir, vtu, pack };
 }

@@ -35,10 +35,20 @@ TetMesh harmonic(uint32_t n) {
   return m;
 }
 
+// The whole mesh as one exact base chunk (no simplification, no quantization): the tests here
+// are about the container; test_progressive.cpp covers the split stream.
+PackOptions wholeMesh() {
+  PackOptions o;
+  o.baseFraction = 1.0;
+  o.lossless = true;
+  o.zstdLevel = 3;
+  return o;
+}
+
 std::string packed(const std::string& name, const TetMesh& m, PackSummary* summary = nullptr) {
   std::string dir = tempDir(name);
   PackSummary s;
-  Result r = packMesh(m, dir, PackOptions{}, s);
+  Result r = packMesh(m, dir, wholeMesh(), s);
   EXPECT_TRUE(r) << r.message;
   if (summary) *summary = s;
   return dir;
@@ -52,12 +62,12 @@ TEST(Format, PackThenLoadIsExact) {
   Dataset ds;
   Result r = loadPackedDir(dir, ds);
   ASSERT_TRUE(r) << r.message;
-  EXPECT_EQ(ds.mesh.positions, m.positions);
-  EXPECT_EQ(ds.mesh.tets, m.tets);
-  ASSERT_EQ(ds.mesh.fields.size(), 2u);
-  EXPECT_EQ(ds.mesh.fields[0].name, "harmonic");
-  EXPECT_EQ(ds.mesh.fields[0].values, m.fields[0].values);
-  EXPECT_EQ(ds.mesh.fields[1].values, m.fields[1].values);
+  EXPECT_EQ(ds.pm.mesh.positions, m.positions);
+  EXPECT_EQ(ds.pm.mesh.tets, m.tets);
+  ASSERT_EQ(ds.pm.mesh.fields.size(), 2u);
+  EXPECT_EQ(ds.pm.mesh.fields[0].name, "harmonic");
+  EXPECT_EQ(ds.pm.mesh.fields[0].values, m.fields[0].values);
+  EXPECT_EQ(ds.pm.mesh.fields[1].values, m.fields[1].values);
   EXPECT_EQ(ds.manifest.isoField, "harmonic");
   EXPECT_EQ(ds.chunksApplied, 1u);
 }
@@ -70,7 +80,7 @@ TEST(Format, PackOrientsTetsPositively) {
   EXPECT_EQ(s.flippedTets, (m.tetCount() + 1) / 2);
   Dataset ds;
   ASSERT_TRUE(loadPackedDir(dir, ds));
-  for (uint32_t t = 0; t < ds.mesh.tetCount(); ++t) EXPECT_GT(tetVolume(ds.mesh, t), 0);
+  for (uint32_t t = 0; t < ds.pm.mesh.tetCount(); ++t) EXPECT_GT(tetVolume(ds.pm.mesh, t), 0);
 }
 
 TEST(Format, PackIsDeterministic) {
@@ -86,8 +96,8 @@ TEST(Format, PackIsDeterministic) {
 TEST(Format, RepackReplacesStaleChunks) {
   std::string dir = tempDir("repack");
   PackSummary s;
-  ASSERT_TRUE(packMesh(harmonic(5), dir, {}, s));
-  ASSERT_TRUE(packMesh(harmonic(6), dir, {}, s));
+  ASSERT_TRUE(packMesh(harmonic(5), dir, wholeMesh(), s));
+  ASSERT_TRUE(packMesh(harmonic(6), dir, wholeMesh(), s));
   int files = 0;
   for (auto& e : std::filesystem::directory_iterator(dir + "/chunks")) files += e.path().extension() == ".tsc";
   EXPECT_EQ(files, 1);
@@ -179,7 +189,7 @@ TEST(Format, CorruptTruncatedAndWrongChunksAreNeverApplied) {
     EXPECT_EQ(applyChunk(ds, 0, std::span(good.data(), len)).status, Status::SizeMismatch);
   EXPECT_EQ(applyChunk(ds, 1, good).status, Status::BadArgument) << "out of order";
   EXPECT_EQ(ds.chunksApplied, 0u);
-  EXPECT_EQ(ds.mesh.tetCount(), 0u) << "nothing applied";
+  EXPECT_EQ(ds.pm.mesh.tetCount(), 0u) << "nothing applied";
   Result ok = applyChunk(ds, 0, good);
   EXPECT_TRUE(ok) << ok.message;
 }
@@ -201,7 +211,7 @@ TEST(Format, ConsistentlyHashedButInvalidPayloadsAreRefused) {
     d.manifest.chunks[0].hash = info.hash;
     Result r = applyChunk(d, 0, file);
     EXPECT_EQ(r.status, expect) << r.message;
-    EXPECT_EQ(d.mesh.tetCount(), 0u);
+    EXPECT_EQ(d.pm.mesh.tetCount(), 0u);
   };
   TetMesh outOfRange = m;
   outOfRange.tets[7] = 5000;
@@ -236,5 +246,5 @@ TEST(Format, SplitChunksAreRefusedByThisVersion) {
   ASSERT_TRUE(applyChunk(ds, 0, base));
   EXPECT_FALSE(applyChunk(ds, 1, base).ok());
   EXPECT_EQ(ds.chunksApplied, 1u);
-  EXPECT_GT(ds.mesh.tetCount(), 0u);
+  EXPECT_GT(ds.pm.mesh.tetCount(), 0u);
 }

@@ -2,9 +2,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <set>
 
 #include "isosurface.h"
+#include "tet_quality.h"
 #include "tet_tables.h"
 #include "test_helpers.h"
 
@@ -93,4 +96,52 @@ TEST(TetTables, SingleTetEveryCaseThroughExtraction) {
       EXPECT_GT(surfaceArea(s), 0.0);
     }
   }
+}
+
+// The closed form of κ(S) (tet_quality.h) against the paper's definition: S = A·W⁻¹,
+// κ = ‖S‖_F ‖S⁻¹‖_F, with W mapping the right-angled reference tet onto the equilateral one.
+TEST(TetQuality, ConditionNumberMatchesTheMatrixDefinition) {
+  auto inverse = [](const double m[3][3], double out[3][3]) {
+    double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                 m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) {
+        int r1 = (c + 1) % 3, r2 = (c + 2) % 3, c1 = (r + 1) % 3, c2 = (r + 2) % 3;
+        out[r][c] = (m[r1][c1] * m[r2][c2] - m[r1][c2] * m[r2][c1]) / det;
+      }
+  };
+  auto frob = [](const double m[3][3]) {
+    double s = 0;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) s += m[r][c] * m[r][c];
+    return std::sqrt(s);
+  };
+  const double W[3][3] = {{1, 0.5, 0.5}, {0, std::sqrt(3.0) / 2, std::sqrt(3.0) / 6}, {0, 0, std::sqrt(2.0 / 3.0)}};
+  double Winv[3][3];
+  inverse(W, Winv);
+  uint64_t seed = 12345;
+  auto rnd = [&] { seed = seed * 6364136223846793005ull + 1442695040888963407ull; return double(seed >> 11) / double(1ull << 53) - 0.5; };
+  for (int trial = 0; trial < 200; ++trial) {
+    double p[4][3];
+    for (auto& v : p)
+      for (double& x : v) x = rnd();
+    double A[3][3], S[3][3] = {}, Sinv[3][3];
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) A[r][c] = p[c + 1][r] - p[0][r];
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c)
+        for (int k = 0; k < 3; ++k) S[r][c] += A[r][k] * Winv[k][c];
+    inverse(S, Sinv);
+    double expected = frob(S) * frob(Sinv);
+    EXPECT_NEAR(tetConditionNumber(p[0], p[1], p[2], p[3]), expected, 1e-9 * expected);
+    TetShape shape = tetShape(p[0], p[1], p[2], p[3]);
+    EXPECT_NEAR(shape.kappa(), expected, 1e-9 * expected);
+    EXPECT_NEAR(shape.det / 6, tetVolume(std::array<float, 3>{float(p[0][0]), float(p[0][1]), float(p[0][2])}.data(),
+                                         std::array<float, 3>{float(p[1][0]), float(p[1][1]), float(p[1][2])}.data(),
+                                         std::array<float, 3>{float(p[2][0]), float(p[2][1]), float(p[2][2])}.data(),
+                                         std::array<float, 3>{float(p[3][0]), float(p[3][1]), float(p[3][2])}.data()),
+                1e-6);
+  }
+  const double regular[4][3] = {{0, 0, 0}, {1, 0, 0}, {0.5, std::sqrt(3.0) / 2, 0}, {0.5, std::sqrt(3.0) / 6, std::sqrt(2.0 / 3.0)}};
+  EXPECT_NEAR(tetConditionNumber(regular[0], regular[1], regular[2], regular[3]), 3.0, 1e-12) << "equilateral: κ = 3";
 }

@@ -1,0 +1,599 @@
+// Half-edge-collapse simplification; see simplify.h for the cost and legality rules.
+//
+// State is flat per-vertex and per-tet arrays. The priority queue holds one entry per vertex
+// version: the cost of the vertex's cheapest outgoing half-edge. Every half-edge is evaluated
+// (both directions), but a vertex whose neighbourhood changed is only re-evaluated when its
+// entry reaches the top (lazy update): stale entries are recognised by a version stamp and
+// dropped, never searched for, so the queue is never rebuilt.
+#include "simplify.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <queue>
+
+#include "adjacency.h"
+#include "tet_quality.h"
+
+namespace tetstream {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr uint32_t kOmega = 0xfffffffeu;   // the virtual vertex the boundary is coned to
+constexpr double kFlat = 1e-7;            // |6V| <= kFlat * (longest edge)^3 counts as flat
+constexpr float kKappaCap = 1e4f;         // κ of flat tets, capped so averages stay finite
+
+struct Quadric {
+  double q[10] = {};  // xx xy xz xw yy yz yw zz zw ww
+  double area = 0;
+  void addPlane(double a, double b, double c, double d, double w) {
+    double p[4] = {a, b, c, d};
+    int n = 0;
+    for (int r = 0; r < 4; ++r)
+      for (int s = r; s < 4; ++s) q[n++] += w * p[r] * p[s];
+    area += w;
+  }
+  void add(const Quadric& o) {
+    for (int k = 0; k < 10; ++k) q[k] += o.q[k];
+    area += o.area;
+  }
+  double eval(const double* p) const {
+    double x = p[0], y = p[1], z = p[2];
+    return q[0] * x * x + 2 * q[1] * x * y + 2 * q[2] * x * z + 2 * q[3] * x + q[4] * y * y + 2 * q[5] * y * z +
+           2 * q[6] * y + q[7] * z * z + 2 * q[8] * z + q[9];
+  }
+};
+
+struct Entry {
+  float cost;
+  uint32_t vertex, version;
+};
+struct EntryAfter {  // min-heap by cost, ties by vertex id: deterministic
+  bool operator()(const Entry& a, const Entry& b) const {
+    return a.cost > b.cost || (a.cost == b.cost && a.vertex > b.vertex);
+  }
+};
+
+
+template <typename T>
+void sortUnique(std::vector<T>& v) {
+  std::sort(v.begin(), v.end());
+  v.erase(std::unique(v.begin(), v.end()), v.end());
+}
+
+template <typename T>
+size_t intersectionSize(const std::vector<T>& a, const std::vector<T>& b) {
+  size_t n = 0;
+  for (size_t x = 0, y = 0; x < a.size() && y < b.size();) {
+    if (a[x] < b[y]) ++x;
+    else if (b[y] < a[x]) ++y;
+    else { ++n; ++x; ++y; }
+  }
+  return n;
+}
+
+struct Tri {
+  uint32_t v[3];
+  bool operator<(const Tri& o) const { return std::lexicographical_compare(v, v + 3, o.v, o.v + 3); }
+  bool operator==(const Tri& o) const { return v[0] == o.v[0] && v[1] == o.v[1] && v[2] == o.v[2]; }
+};
+Tri makeTri(uint32_t a, uint32_t b, uint32_t c) {
+  if (a > b) std::swap(a, b);
+  if (b > c) std::swap(b, c);
+  if (a > b) std::swap(a, b);
+  return {{a, b, c}};
+}
+uint64_t makeEdge(uint32_t a, uint32_t b) { return a < b ? uint64_t(a) << 32 | b : uint64_t(b) << 32 | a; }
+
+class Simplifier {
+ public:
+  Simplifier(const TetMesh& m, const SimplifyOptions& o, SimplifyResult& r) : mesh_(m), opt_(o), out_(r) {}
+
+  CollapseVerdict check(uint32_t i, uint32_t j) {
+    init();
+    neighbours(i, nbr_);
+    if (!std::binary_search(nbr_.begin(), nbr_.end(), j)) return CollapseVerdict::NotAnEdge;
+    float ef;
+    CollapseVerdict v = CollapseVerdict::Legal;
+    prepareStar(i);
+    evaluate(i, j, &ef, &v);
+    if (v == CollapseVerdict::Legal && !linkCondition(i, j)) v = CollapseVerdict::LinkCondition;
+    return v;
+  }
+
+  Result run() {
+    init();
+    const uint32_t target = std::max<uint32_t>(opt_.targetVertices, 4);
+    const uint32_t planned = alive_ > target ? alive_ - target : 0;
+    out_.stopReason = "target reached";
+    while (alive_ > target) {
+      if (heap_.empty()) { out_.stopReason = "no legal collapse left"; break; }
+      Entry e = heap_.top();
+      heap_.pop();
+      if (!out_.vertexAlive[e.vertex] || version_[e.vertex] != e.version) continue;
+      if (e.cost > opt_.maxError) { out_.stopReason = "error bound reached"; break; }
+      tryCollapse(e.vertex);
+      if (opt_.progress && (out_.log.size() & 4095) == 0) opt_.progress(out_.log.size(), planned);
+    }
+    if (opt_.progress) opt_.progress(out_.log.size(), planned);
+    out_.vertices = alive_;
+    out_.tetCount = 0;
+    for (uint32_t t = 0; t < T_; ++t) {
+      out_.tetCount += out_.tetAlive[t];
+      if (out_.tetAlive[t] && kappa_[t] >= kKappaCap) ++out_.flatTetsLeft;
+    }
+    out_.log.movedBegin.push_back(uint32_t(out_.log.moved.size()));
+    out_.log.removedBegin.push_back(uint32_t(out_.log.removed.size()));
+    return Result::success();
+  }
+
+ private:
+  // ------------------------------------------------------------------ setup
+  void init() {
+    V_ = mesh_.vertexCount();
+    T_ = mesh_.tetCount();
+    pos_.resize(3 * size_t(V_));
+    for (size_t k = 0; k < pos_.size(); ++k) pos_[k] = mesh_.positions[k];
+    field_ = mesh_.fields[size_t(opt_.field)].values.data();
+    Range r = computeRange(mesh_.fields[size_t(opt_.field)].values);
+    range_ = r.max > r.min ? double(r.max) - r.min : 1.0;
+    diag_ = computeBounds(mesh_.positions).diagonal();
+    if (!(diag_ > 0)) diag_ = 1;
+
+    out_.tets = mesh_.tets;
+    out_.tetAlive.assign(T_, 1);
+    out_.vertexAlive.assign(V_, 0);
+    star_.assign(V_, {});
+    for (uint32_t t = 0; t < T_; ++t)
+      for (int k = 0; k < 4; ++k) star_[out_.tets[4 * size_t(t) + k]].push_back(t);
+    alive_ = 0;
+    for (uint32_t v = 0; v < V_; ++v)
+      if (!star_[v].empty()) { out_.vertexAlive[v] = 1; ++alive_; }
+
+    FaceAdjacency adj;
+    buildFaceAdjacency(out_.tets, V_, adj);
+    opp_ = std::move(adj.opposite);
+    boundary_.assign(V_, 0);
+    quadric_.assign(V_, {});
+    for (uint32_t h = 0; h < 4 * T_; ++h) {
+      if (opp_[h] != kNoNeighbor) continue;
+      const uint32_t* v = &out_.tets[h & ~3u];
+      uint32_t a = v[kFaces[h & 3][0]], b = v[kFaces[h & 3][1]], c = v[kFaces[h & 3][2]];
+      const double *pa = p(a), *pb = p(b), *pc = p(c);
+      double u[3] = {pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]}, w[3] = {pc[0] - pa[0], pc[1] - pa[1], pc[2] - pa[2]};
+      double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+      double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      for (uint32_t x : {a, b, c}) boundary_[x] = 1;
+      if (len == 0) continue;
+      for (double& x : n) x /= len;
+      double d = -(n[0] * pa[0] + n[1] * pa[1] + n[2] * pa[2]);
+      for (uint32_t x : {a, b, c}) quadric_[x].addPlane(n[0], n[1], n[2], d, 0.5 * len);
+    }
+    kappa_.resize(T_);
+    kappaSum_.assign(V_, 0.0);
+    for (uint32_t t = 0; t < T_; ++t) {
+      kappa_[t] = tetKappa(t);
+      if (kappa_[t] >= kKappaCap) ++flatInput_;
+      for (int k = 0; k < 4; ++k) kappaSum_[out_.tets[4 * size_t(t) + k]] += kappa_[t];
+    }
+    acc_.assign(V_, 0.0f);
+    version_.assign(V_, 0);
+    lastCost_.assign(V_, float(kInf));
+    for (uint32_t v = 0; v < V_; ++v)
+      if (out_.vertexAlive[v]) pushVertex(v);
+  }
+
+  static constexpr uint8_t kFaces[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+
+  const double* p(uint32_t v) const { return &pos_[3 * size_t(v)]; }
+
+  float tetKappa(uint32_t t) const {
+    const uint32_t* v = &out_.tets[4 * size_t(t)];
+    const TetShape shape = tetShape(p(v[0]), p(v[1]), p(v[2]), p(v[3]));
+    if (shape.det <= kFlat * shape.longestEdge * std::sqrt(shape.longestEdge)) return kKappaCap;
+    return float(std::min<double>(kKappaCap, shape.kappa()));
+  }
+
+  bool tetHas(uint32_t t, uint32_t v) const {
+    const uint32_t* x = &out_.tets[4 * size_t(t)];
+    return x[0] == v || x[1] == v || x[2] == v || x[3] == v;
+  }
+
+  // ------------------------------------------------------------------ costs
+  bool isBoundaryEdge(uint32_t i, uint32_t j) const {
+    for (uint32_t t : star_[i]) {
+      const uint32_t* v = &out_.tets[4 * size_t(t)];
+      if (!tetHas(t, j)) continue;
+      for (int f = 0; f < 4; ++f)
+        if (opp_[4 * t + f] == kNoNeighbor && v[f] != i && v[f] != j) return true;
+    }
+    return false;
+  }
+
+  // Per-tet data of star(i) shared by every candidate target j. With p_j at slot si, the
+  // determinant and the barycentric numerators of p_i are affine in p_j (g·p_j + h), and the
+  // edge and face terms of κ need only a few products per candidate (tet_quality.h).
+  struct StarTet {
+    uint32_t t;
+    uint32_t other[3];        // the vertices besides i, in slot order
+    double g[4][3], h[4];     // [0]: det of the new tet; [1..3]: numerators with p_i at other[k-1]
+    double detOld;            // det with p_i (numerator for the slot of i)
+    double fixedEdges, longestFixed, sumSq, sum[3], fixedFace;
+    double C[3][3], D[3][3];  // faces (P, x, y): cross = C - P × D
+    double x[3][3];           // positions of the other vertices
+    float f[3];               // field at the other vertices
+    float kappa;              // κ of the tet now
+  };
+
+  static void affineDet(const double* a, const double* b, const double* c, double sign, double* g, double* h) {
+    // (a - P)·((b - P) × (c - P)) = a·(b×c) - P·(b×c + c×a + a×b)
+    double bc[3] = {b[1] * c[2] - b[2] * c[1], b[2] * c[0] - b[0] * c[2], b[0] * c[1] - b[1] * c[0]};
+    double ca[3] = {c[1] * a[2] - c[2] * a[1], c[2] * a[0] - c[0] * a[2], c[0] * a[1] - c[1] * a[0]};
+    double ab[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+    for (int k = 0; k < 3; ++k) g[k] = -sign * (bc[k] + ca[k] + ab[k]);
+    *h = sign * (a[0] * bc[0] + a[1] * bc[1] + a[2] * bc[2]);
+  }
+
+  void prepareStar(uint32_t i) {
+    starData_.clear();
+    const double* pi = p(i);
+    for (uint32_t t : star_[i]) {
+      const uint32_t* v = &out_.tets[4 * size_t(t)];
+      StarTet st;
+      st.t = t;
+      st.kappa = kappa_[t];
+      int si = 0, n = 0;
+      const double* x[3];
+      for (int k = 0; k < 4; ++k) {
+        if (v[k] == i) si = k;
+        else { st.other[n] = v[k]; x[n] = p(v[k]); st.f[n] = field_[v[k]]; ++n; }
+      }
+      for (int k = 0; k < 3; ++k) std::copy_n(x[k], 3, st.x[k]);
+      // Moving the vertex at slot si to the front takes si adjacent swaps.
+      const double sign = (si & 1) ? -1.0 : 1.0;
+      affineDet(x[0], x[1], x[2], sign, st.g[0], &st.h[0]);
+      for (int k = 0; k < 3; ++k) {
+        const double* y[3] = {x[0], x[1], x[2]};
+        y[k] = pi;
+        affineDet(y[0], y[1], y[2], sign, st.g[k + 1], &st.h[k + 1]);
+      }
+      st.detOld = st.g[0][0] * pi[0] + st.g[0][1] * pi[1] + st.g[0][2] * pi[2] + st.h[0];
+      double e01 = dist2(x[0], x[1]), e02 = dist2(x[0], x[2]), e12 = dist2(x[1], x[2]);
+      st.fixedEdges = e01 + e02 + e12;
+      st.longestFixed = std::max({e01, e02, e12});
+      st.sumSq = 0;
+      for (int k = 0; k < 3; ++k) {
+        st.sum[k] = x[0][k] + x[1][k] + x[2][k];
+        st.sumSq += x[0][k] * x[0][k] + x[1][k] * x[1][k] + x[2][k] * x[2][k];
+      }
+      const int pairs[3][2] = {{0, 1}, {1, 2}, {0, 2}};
+      for (int q = 0; q < 3; ++q) {
+        const double *a = x[pairs[q][0]], *b = x[pairs[q][1]];
+        cross(a, b, st.C[q]);
+        for (int k = 0; k < 3; ++k) st.D[q][k] = b[k] - a[k];
+      }
+      double u[3] = {x[1][0] - x[0][0], x[1][1] - x[0][1], x[1][2] - x[0][2]};
+      double w[3] = {x[2][0] - x[0][0], x[2][1] - x[0][1], x[2][2] - x[0][2]};
+      double n3[3];
+      cross(u, w, n3);
+      st.fixedFace = n3[0] * n3[0] + n3[1] * n3[1] + n3[2] * n3[2];
+      starData_.push_back(st);
+    }
+  }
+
+  static double dist2(const double* a, const double* b) {
+    double d0 = a[0] - b[0], d1 = a[1] - b[1], d2 = a[2] - b[2];
+    return d0 * d0 + d1 * d1 + d2 * d2;
+  }
+  static void cross(const double* u, const double* v, double* n) {
+    n[0] = u[1] * v[2] - u[2] * v[1];
+    n[1] = u[2] * v[0] - u[0] * v[2];
+    n[2] = u[0] * v[1] - u[1] * v[0];
+  }
+
+  // Cost of hec(i → j) given prepareStar(i), or infinity when a tet would invert, flatten or
+  // fall below the minimum quality, or a boundary vertex would leave the boundary.
+  double evaluate(uint32_t i, uint32_t j, float* fieldErr, CollapseVerdict* verdict = nullptr) {
+    ++out_.costEvaluations;
+    auto reject = [&](CollapseVerdict v) {
+      if (verdict) *verdict = v;
+      return kInf;
+    };
+    if (boundary_[i] && !isBoundaryEdge(i, j)) return reject(CollapseVerdict::BoundaryRule);
+    const double* P = p(j);
+    const double PP = P[0] * P[0] + P[1] * P[1] + P[2] * P[2];
+    double kappaSum = kappaSum_[j];
+    int64_t count = int64_t(star_[j].size());
+    double bestInside = -kInf, interp = field_[j];
+    for (const StarTet& st : starData_) {
+      if (st.other[0] == j || st.other[1] == j || st.other[2] == j) {  // removed by the collapse
+        kappaSum -= st.kappa;
+        --count;
+        continue;
+      }
+      const double det = st.g[0][0] * P[0] + st.g[0][1] * P[1] + st.g[0][2] * P[2] + st.h[0];
+      double longest = st.longestFixed;
+      for (int k = 0; k < 3; ++k) longest = std::max(longest, dist2(P, st.x[k]));
+      if (det <= 0) return reject(CollapseVerdict::Inverted);
+      if (det <= kFlat * longest * std::sqrt(longest)) return reject(CollapseVerdict::Flat);
+      const double edges = st.fixedEdges + 3 * PP - 2 * (P[0] * st.sum[0] + P[1] * st.sum[1] + P[2] * st.sum[2]) + st.sumSq;
+      double faces = st.fixedFace;
+      for (int q = 0; q < 3; ++q) {
+        double pd[3];
+        cross(P, st.D[q], pd);
+        double c0 = st.C[q][0] - pd[0], c1 = st.C[q][1] - pd[1], c2 = st.C[q][2] - pd[2];
+        faces += c0 * c0 + c1 * c1 + c2 * c2;
+      }
+      const double kappa = std::sqrt(edges * 0.25 * faces) / det;
+      if (3.0 / kappa < opt_.minQuality) return reject(CollapseVerdict::LowQuality);
+      kappaSum += std::min<double>(kappa, kKappaCap);
+      ++count;
+      // Barycentric coordinates of p_i in the new tet, to interpolate the coarse field there;
+      // the first tet that contains p_i wins.
+      if (bestInside >= 0) continue;
+      double lambda[4] = {st.detOld / det, 0, 0, 0}, lo = lambda[0];
+      for (int k = 1; k < 4; ++k) {
+        lambda[k] = (st.g[k][0] * P[0] + st.g[k][1] * P[1] + st.g[k][2] * P[2] + st.h[k]) / det;
+        lo = std::min(lo, lambda[k]);
+      }
+      if (lo > bestInside) {
+        bestInside = lo;
+        interp = lambda[0] * field_[j] + lambda[1] * st.f[0] + lambda[2] * st.f[1] + lambda[3] * st.f[2];
+      }
+    }
+    double es = count > 0 ? (kappaSum / double(count) - 3.0) / 3.0 : 0.0;
+    double ef = std::abs(double(field_[i]) - interp) / range_ + acc_[i];
+    double eg = 0;
+    if (boundary_[i]) {
+      Quadric q = quadric_[i];
+      q.add(quadric_[j]);
+      if (q.area > 0) eg = std::sqrt(std::max(0.0, q.eval(P)) / q.area) / diag_;
+    }
+    *fieldErr = float(ef);
+    if (verdict) *verdict = CollapseVerdict::Legal;
+    return opt_.weightGeometry * eg + opt_.weightField * ef + opt_.weightShape * es;
+  }
+
+  void neighbours(uint32_t v, std::vector<uint32_t>& out) const {
+    out.clear();
+    for (uint32_t t : star_[v])
+      for (int k = 0; k < 4; ++k) {
+        uint32_t w = out_.tets[4 * size_t(t) + k];
+        if (w != v) out.push_back(w);
+      }
+    sortUnique(out);
+  }
+
+  // Evaluates every half-edge out of v and queues v with the cheapest legal one.
+  void pushVertex(uint32_t v) {
+    neighbours(v, nbr_);
+    prepareStar(v);
+    double best = kInf;
+    float ef;
+    for (uint32_t w : nbr_) best = std::min(best, evaluate(v, w, &ef));
+    lastCost_[v] = float(best);
+    if (best < kInf) heap_.push({float(best), v, version_[v]});
+  }
+
+  // Pops are re-evaluated: the neighbourhood of the target may have changed since the push.
+  void tryCollapse(uint32_t i) {
+    neighbours(i, nbr_);
+    prepareStar(i);
+    candidates_.clear();
+    for (uint32_t w : nbr_) {
+      float ef;
+      double c = evaluate(i, w, &ef);
+      if (c < kInf) candidates_.push_back({c, w, ef});
+    }
+    std::sort(candidates_.begin(), candidates_.end(), [](const Candidate& a, const Candidate& b) {
+      return a.cost < b.cost || (a.cost == b.cost && a.j < b.j);
+    });
+    lastCost_[i] = candidates_.empty() ? float(kInf) : float(candidates_[0].cost);
+    for (const Candidate& c : candidates_) {
+      if (!heap_.empty() && float(c.cost) > heap_.top().cost) {
+        heap_.push({float(c.cost), i, version_[i]});  // something else is cheaper now
+        return;
+      }
+      if (c.cost > opt_.maxError) return;
+      if (!linkCondition(i, c.j)) { ++out_.rejectedByLink; continue; }
+      collapse(i, c.j, c.fieldErr);
+      return;
+    }
+    // No legal collapse from i until its neighbourhood changes (then it is queued again).
+  }
+
+  // ------------------------------------------------------------------ link condition
+  // Lk(i) ∩ Lk(j) = Lk(ij) with the boundary coned to kOmega: vertices and edges of the two
+  // links meet exactly in the link of the edge, and no triangle is in both.
+  void gatherLink(uint32_t v, std::vector<uint32_t>& verts, std::vector<uint64_t>& edges, std::vector<Tri>& tris) {
+    verts.clear();
+    edges.clear();
+    tris.clear();
+    for (uint32_t t : star_[v]) {
+      const uint32_t* x = &out_.tets[4 * size_t(t)];
+      uint32_t o[3];
+      int n = 0, sv = 0;
+      for (int k = 0; k < 4; ++k) {
+        if (x[k] == v) sv = k;
+        else o[n++] = x[k];
+      }
+      verts.insert(verts.end(), o, o + 3);
+      edges.push_back(makeEdge(o[0], o[1]));
+      edges.push_back(makeEdge(o[0], o[2]));
+      edges.push_back(makeEdge(o[1], o[2]));
+      tris.push_back(makeTri(o[0], o[1], o[2]));
+      for (int f = 0; f < 4; ++f) {
+        if (f == sv || opp_[4 * t + f] != kNoNeighbor) continue;
+        uint32_t a = 0, b = 0;  // the boundary face f contains v and two others
+        int m = 0;
+        for (int k = 0; k < 4; ++k)
+          if (k != f && x[k] != v) (m++ == 0 ? a : b) = x[k];
+        verts.push_back(kOmega);
+        edges.push_back(makeEdge(a, kOmega));
+        edges.push_back(makeEdge(b, kOmega));
+        tris.push_back(makeTri(a, b, kOmega));
+      }
+    }
+    sortUnique(verts);
+    sortUnique(edges);
+    sortUnique(tris);
+  }
+
+  bool linkCondition(uint32_t i, uint32_t j) {
+    gatherLink(i, lvI_, leI_, ltI_);
+    gatherLink(j, lvJ_, leJ_, ltJ_);
+    if (intersectionSize(ltI_, ltJ_) != 0) return false;
+    // Link of the edge: the opposite edges of the tets around it, and the boundary faces at it.
+    lvE_.clear();
+    leE_.clear();
+    for (uint32_t t : star_[i]) {
+      if (!tetHas(t, j)) continue;
+      const uint32_t* x = &out_.tets[4 * size_t(t)];
+      uint32_t o[2];
+      int n = 0;
+      for (int k = 0; k < 4; ++k)
+        if (x[k] != i && x[k] != j) o[n++] = x[k];
+      lvE_.insert(lvE_.end(), o, o + 2);
+      leE_.push_back(makeEdge(o[0], o[1]));
+      for (int f = 0; f < 4; ++f)
+        if (opp_[4 * t + f] == kNoNeighbor && x[f] != i && x[f] != j) {
+          uint32_t k = o[0] == x[f] ? o[1] : o[0];  // the face is (i, j, k)
+          lvE_.push_back(kOmega);
+          leE_.push_back(makeEdge(k, kOmega));
+        }
+    }
+    sortUnique(lvE_);
+    sortUnique(leE_);
+    return intersectionSize(lvI_, lvJ_) == lvE_.size() && intersectionSize(leI_, leJ_) == leE_.size();
+  }
+
+  // ------------------------------------------------------------------ the collapse
+  static void eraseFrom(std::vector<uint32_t>& v, uint32_t x) {
+    auto it = std::find(v.begin(), v.end(), x);
+    assert(it != v.end());
+    *it = v.back();
+    v.pop_back();
+  }
+
+  void collapse(uint32_t i, uint32_t j, float fieldErr) {
+    CollapseLog& log = out_.log;
+    log.i.push_back(i);
+    log.j.push_back(j);
+    log.fieldError.push_back(float(fieldErr * range_));
+    log.movedBegin.push_back(uint32_t(log.moved.size()));
+    log.removedBegin.push_back(uint32_t(log.removed.size()));
+
+    const std::vector<uint32_t> around = star_[i];  // copy: star_ lists change below
+    for (uint32_t t : around) {
+      uint32_t* v = &out_.tets[4 * size_t(t)];
+      if (!tetHas(t, j)) continue;
+      // Removed tet (i, j, k, l): glue its neighbours across (j, k, l) and (i, k, l).
+      log.removed.push_back(t);
+      log.removedVertices.insert(log.removedVertices.end(), v, v + 4);
+      int si = 0, sj = 0;
+      for (int k = 0; k < 4; ++k) {
+        if (v[k] == i) si = k;
+        if (v[k] == j) sj = k;
+      }
+      uint32_t hA = opp_[4 * t + si], hB = opp_[4 * t + sj];
+      if (hA != kNoNeighbor) opp_[hA] = hB;
+      if (hB != kNoNeighbor) opp_[hB] = hA;
+      for (int f = 0; f < 4; ++f) opp_[4 * t + f] = kNoNeighbor;
+      if (kappa_[t] >= kKappaCap) ++out_.flatTetsRemoved;
+      out_.tetAlive[t] = 0;
+      for (int k = 0; k < 4; ++k) kappaSum_[v[k]] -= kappa_[t];
+      for (int k = 0; k < 4; ++k)
+        if (v[k] != i) eraseFrom(star_[v[k]], t);
+    }
+    for (uint32_t t : around) {
+      if (!out_.tetAlive[t]) continue;
+      uint32_t* v = &out_.tets[4 * size_t(t)];
+      for (int k = 0; k < 4; ++k)
+        if (v[k] == i) v[k] = j;
+      log.moved.push_back(t);
+      star_[j].push_back(t);
+      float before = kappa_[t];
+      kappa_[t] = tetKappa(t);
+      for (int k = 0; k < 4; ++k) kappaSum_[v[k]] += double(kappa_[t]) - (v[k] == j ? 0.0 : before);
+    }
+    star_[i].clear();
+    star_[i].shrink_to_fit();
+    out_.vertexAlive[i] = 0;
+    --alive_;
+    boundary_[j] |= boundary_[i];
+    quadric_[j].add(quadric_[i]);
+    acc_[j] = std::max(acc_[j], float(fieldErr / 1.0));
+
+    // Everything around j changed. Requeue j and its neighbours lazily: under their last known
+    // cost (the neighbourhood of a blocked vertex changed, so it gets another chance), to be
+    // re-evaluated only when they reach the top.
+    touched_.clear();
+    for (uint32_t t : around)
+      for (int k = 0; k < 4; ++k) touched_.push_back(out_.tets[4 * size_t(t)+ k]);
+    sortUnique(touched_);
+    touched_.erase(std::remove(touched_.begin(), touched_.end(), i), touched_.end());
+    for (uint32_t v : touched_) {
+      ++version_[v];
+      float key = std::isfinite(lastCost_[v]) ? lastCost_[v] : 0.0f;
+      heap_.push({key, v, version_[v]});
+    }
+  }
+
+  struct Candidate {
+    double cost;
+    uint32_t j;
+    float fieldErr;
+  };
+
+  const TetMesh& mesh_;
+  const SimplifyOptions& opt_;
+  SimplifyResult& out_;
+  uint32_t V_ = 0, T_ = 0, alive_ = 0, flatInput_ = 0;
+  std::vector<double> pos_;
+  const float* field_ = nullptr;
+  double range_ = 1, diag_ = 1;
+  std::vector<std::vector<uint32_t>> star_;
+  std::vector<uint32_t> opp_;
+  std::vector<uint8_t> boundary_;
+  std::vector<Quadric> quadric_;
+  std::vector<float> kappa_, acc_, lastCost_;
+  std::vector<double> kappaSum_;  // per vertex: Σ κ over its star
+  std::vector<StarTet> starData_;
+  std::vector<uint32_t> version_;
+  std::priority_queue<Entry, std::vector<Entry>, EntryAfter> heap_;
+  // scratch, reused
+  std::vector<uint32_t> nbr_, touched_, lvI_, lvJ_, lvE_;
+  std::vector<uint64_t> leI_, leJ_, leE_;
+  std::vector<Tri> ltI_, ltJ_;
+  std::vector<Candidate> candidates_;
+};
+
+}  // namespace
+
+const char* collapseVerdictName(CollapseVerdict v) {
+  switch (v) {
+    case CollapseVerdict::Legal: return "legal";
+    case CollapseVerdict::BoundaryRule: return "boundary vertex leaves the boundary";
+    case CollapseVerdict::Inverted: return "a tet would invert";
+    case CollapseVerdict::Flat: return "a tet would become flat";
+    case CollapseVerdict::LowQuality: return "a tet would fall below the minimum quality";
+    case CollapseVerdict::LinkCondition: return "link condition violated";
+    case CollapseVerdict::NotAnEdge: return "not an edge";
+  }
+  return "?";
+}
+
+CollapseVerdict checkCollapse(const TetMesh& mesh, uint32_t i, uint32_t j, const SimplifyOptions& options) {
+  SimplifyResult scratch;
+  Simplifier s(mesh, options, scratch);
+  return s.check(i, j);
+}
+
+Result simplifyMesh(const TetMesh& mesh, const SimplifyOptions& options, SimplifyResult& out) {
+  assert(options.field >= 0 && size_t(options.field) < mesh.fields.size());
+  out = SimplifyResult{};
+  Simplifier s(mesh, options, out);
+  return s.run();
+}
+
+}  // namespace tetstream

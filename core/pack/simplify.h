@@ -1,0 +1,85 @@
+// Tetrahedral mesh simplification by half-edge collapses hec(p_i → p_j) (paper §3).
+//
+// Every half-edge sits in a priority queue keyed by its cost (both directions; they differ):
+//   cost = w_g·E_g + w_f·E_f + w_s·E_s, each term dimensionless:
+//   E_g  geometric error, paper eq. (3)-(4): boundary plane quadrics (area weighted, summed on
+//        collapse) evaluated at p_j, as an RMS distance divided by the bounding-box diagonal.
+//        Zero for interior vertices, whose collapse does not move the boundary.
+//   E_f  field error, paper eq. (6) plus accumulation: |S(p_i) − S'(p_i)| / field range, where
+//        S' interpolates the coarse field at p_i inside the tets around p_j after the collapse,
+//        plus the error p_i had already absorbed from earlier collapses (so the estimate grows
+//        where the mesh has been coarsened, and collapses spread evenly).
+//   E_s  shape error, paper §3.3: mean of κ(S) − 3 over the tets around p_j after the collapse,
+//        divided by 3 (0 for equilateral tets).
+// Defaults (10, 1, 0.002) keep the boundary first, then the field; tet shape is a
+// tie-breaker; all terms are scale free, so they work for any mesh size and field range.
+//
+// Legality, checked for every collapse (paper §3.2 and Staadt & Gross / Dey et al.):
+//   - a boundary vertex may only move along a boundary edge;
+//   - the link condition Lk(i) ∩ Lk(j) = Lk(ij), with the boundary coned to a virtual vertex,
+//     so the mesh and its boundary keep their topology and stay manifold;
+//   - no tet that moves from p_i to p_j may become inverted or flat (eq. 1, relative tolerance)
+//     or fall below the minimum quality 3/κ ≥ minQuality.
+// Consequences: no collapse creates an inverted or flat tet; flat tets of the input only ever
+// disappear (when they contain the collapsed edge) or become proper.
+//
+// The result is a log of collapses for the encoder (split_encode.h); the simplifier knows
+// nothing of the file format. Deterministic: same input and options, same log.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "mesh.h"
+#include "status.h"
+
+namespace tetstream {
+
+struct SimplifyOptions {
+  double weightGeometry = 10.0, weightField = 1.0, weightShape = 0.002;
+  uint32_t targetVertices = 0;  // stop at this many vertices (0: as far as legal collapses go)
+  double maxError = std::numeric_limits<double>::infinity();  // stop when the cheapest cost exceeds it
+  int field = 0;                // index of the field that steers the field error
+  double minQuality = 0.02;     // 3/κ of every tet a collapse changes must stay at or above this
+  std::function<void(uint32_t done, uint32_t planned)> progress;  // called now and then
+};
+
+// One collapse as it happened, in original vertex and tet ids.
+struct CollapseLog {
+  std::vector<uint32_t> i, j;            // removed vertex, kept vertex
+  std::vector<float> fieldError;         // E_f of the collapse (field units), for the manifest
+  std::vector<uint32_t> movedBegin;      // collapse c moved tets moved[movedBegin[c] .. movedBegin[c+1])
+  std::vector<uint32_t> moved;           // tets whose i slot became j
+  std::vector<uint32_t> removedBegin;    // likewise for removed tets
+  std::vector<uint32_t> removed;         // tet ids removed by the collapse
+  std::vector<uint32_t> removedVertices; // 4 per removed tet: its vertices just before the collapse
+
+  uint32_t size() const { return uint32_t(i.size()); }
+};
+
+struct SimplifyResult {
+  CollapseLog log;
+  std::vector<uint32_t> tets;      // 4 per original tet, current vertices (valid where tetAlive)
+  std::vector<uint8_t> tetAlive;   // 1 per original tet
+  std::vector<uint8_t> vertexAlive;
+  uint32_t vertices = 0, tetCount = 0;  // counts of the base mesh
+  uint32_t flatTetsRemoved = 0;    // input tets with zero volume that the collapses removed
+  uint32_t flatTetsLeft = 0;
+  uint64_t costEvaluations = 0, rejectedByLink = 0;
+  std::string stopReason;          // "target reached", "no legal collapse left", "error bound"
+};
+
+// Why a single collapse is or is not allowed (for tests and diagnostics).
+enum class CollapseVerdict { Legal, BoundaryRule, Inverted, Flat, LowQuality, LinkCondition, NotAnEdge };
+const char* collapseVerdictName(CollapseVerdict v);
+
+// Checks hec(i → j) on `mesh` as the simplifier would before collapsing it.
+CollapseVerdict checkCollapse(const TetMesh& mesh, uint32_t i, uint32_t j, const SimplifyOptions& options = {});
+
+// Simplifies `mesh` (positions already on the packer's quantization grid; tets positively
+// oriented or flat). Fails only on a mesh the caller should have validated (asserted).
+Result simplifyMesh(const TetMesh& mesh, const SimplifyOptions& options, SimplifyResult& out);
+
+}  // namespace tetstream

@@ -1,0 +1,197 @@
+#include "pack/split_encode.h"
+
+#include <algorithm>
+#include <cassert>
+
+#include "pack/chunk_encode.h"
+#include "progressive.h"
+#include "quantize.h"
+#include "split_stream.h"
+#include "varint.h"
+
+namespace tetstream {
+namespace {
+
+constexpr uint32_t kNone = ~uint32_t(0);
+
+// Parity of the permutation that takes slots (0, 1, 2, 3) to `p`.
+bool oddPermutation(const int p[4]) {
+  int inversions = 0;
+  for (int a = 0; a < 4; ++a)
+    for (int b = a + 1; b < 4; ++b) inversions += p[a] > p[b];
+  return inversions & 1;
+}
+
+void putU32(std::vector<uint8_t>& b, uint32_t x) { for (int i = 0; i < 4; ++i) b.push_back(uint8_t(x >> (8 * i))); }
+
+class Encoder {
+ public:
+  Encoder(const TetMesh& mesh, const SimplifyResult& s, const Manifest& m, const StreamOptions& o, EncodedStream& out)
+      : mesh_(mesh), s_(s), m_(m), opt_(o), out_(out), q_(makeQuantizer(m)) {}
+
+  Result run() {
+    buildBase();
+    const CollapseLog& log = s_.log;
+    const uint32_t C = log.size();
+    // Estimated field error with a splits applied: the largest of the collapses still in place.
+    prefixMax_.resize(C);
+    for (uint32_t c = 0; c < C; ++c) prefixMax_[c] = std::max(c ? prefixMax_[c - 1] : 0.0f, log.fieldError[c]);
+    out_.baseFieldError = C ? prefixMax_[C - 1] : 0;
+
+    target_ = opt_.firstChunkBytes;
+    startChunk();
+    for (uint32_t c = C; c-- > 0;) {
+      encodeSplit(c);
+      ++inChunk_;
+      if (records_.size() >= target_ * ratio_ || c == 0)
+        if (Result r = flushChunk(C - c); !r) return r;
+    }
+    return Result::success();
+  }
+
+ private:
+  void buildBase() {
+    const uint32_t V = mesh_.vertexCount(), T = mesh_.tetCount();
+    out_.streamVertexOf.assign(V, kNone);
+    out_.streamTetOf.assign(T, kNone);
+    TetMesh& b = out_.base;
+    b = TetMesh{};
+    b.name = mesh_.name;
+    b.fields.resize(mesh_.fields.size());
+    for (size_t f = 0; f < mesh_.fields.size(); ++f) b.fields[f].name = mesh_.fields[f].name;
+    for (uint32_t v = 0; v < V; ++v) {
+      if (!s_.vertexAlive[v]) continue;
+      out_.streamVertexOf[v] = b.vertexCount();
+      b.positions.insert(b.positions.end(), &mesh_.positions[3 * size_t(v)], &mesh_.positions[3 * size_t(v)] + 3);
+      for (size_t f = 0; f < mesh_.fields.size(); ++f) b.fields[f].values.push_back(mesh_.fields[f].values[v]);
+    }
+    for (uint32_t t = 0; t < T; ++t) {
+      if (!s_.tetAlive[t]) continue;
+      out_.streamTetOf[t] = b.tetCount();
+      for (int k = 0; k < 4; ++k) b.tets.push_back(out_.streamVertexOf[s_.tets[4 * size_t(t) + k]]);
+    }
+    initProgressive(pm_, b);
+  }
+
+  void startChunk() {
+    raw_.clear();
+    records_.clear();
+    inChunk_ = 0;
+    prevJ_ = 0;  // each chunk decodes on its own (FORMAT.md §4)
+  }
+
+  uint32_t candidateIndex(uint32_t v) const {
+    auto it = std::lower_bound(candidates_.begin(), candidates_.end(), v);
+    if (it != candidates_.end() && *it == v) return uint32_t(it - candidates_.begin());
+    return uint32_t(candidates_.size()) + v;  // explicit id (FORMAT.md §4)
+  }
+
+  void putValue(float value, float predictor, const QuantAxis& axis) {
+    if (q_.lossless) putF32(records_, value);
+    else putVarint(records_, zigzag(int32_t(axis.quantize(value)) - int32_t(axis.quantize(predictor))));
+  }
+
+  void encodeSplit(uint32_t c) {
+    const CollapseLog& log = s_.log;
+    const uint32_t i = log.i[c], j = log.j[c];
+    const uint32_t js = out_.streamVertexOf[j], is = pm_.vertexCount();
+    assert(js != kNone && out_.streamVertexOf[i] == kNone);
+    out_.streamVertexOf[i] = is;
+    putVarint(records_, zigzag(int32_t(js) - int32_t(prevJ_)));
+    prevJ_ = js;
+
+    // Moved tets as a bit mask over star(j), ascending.
+    moved_.clear();
+    for (uint32_t k = log.movedBegin[c]; k < log.movedBegin[c + 1]; ++k) moved_.push_back(out_.streamTetOf[log.moved[k]]);
+    std::sort(moved_.begin(), moved_.end());
+    starOf(pm_, js, star_);
+    size_t maskAt = records_.size();
+    records_.resize(maskAt + (star_.size() + 7) / 8, 0);
+    for (size_t k = 0, x = 0; k < star_.size() && x < moved_.size(); ++k)
+      if (star_[k] == moved_[x]) {
+        records_[maskAt + (k >> 3)] |= uint8_t(1u << (k & 7));
+        ++x;
+      }
+
+    // New tets (i, j, a, b), ordered as an even permutation of the original tet.
+    neighboursOf(pm_, js, candidates_);
+    const uint32_t first = log.removedBegin[c], count = log.removedBegin[c + 1] - first;
+    putVarint(records_, count);
+    newTets_.clear();
+    for (uint32_t n = 0; n < count; ++n) {
+      const uint32_t* v = &log.removedVertices[4 * size_t(first + n)];
+      int slot[4], others = 2;
+      for (int k = 0; k < 4; ++k) {
+        if (v[k] == i) slot[0] = k;
+        else if (v[k] == j) slot[1] = k;
+        else slot[others++] = k;
+      }
+      if (oddPermutation(slot)) std::swap(slot[2], slot[3]);
+      uint32_t a = out_.streamVertexOf[v[slot[2]]], b = out_.streamVertexOf[v[slot[3]]];
+      putVarint(records_, candidateIndex(a));
+      putVarint(records_, candidateIndex(b));
+      newTets_.insert(newTets_.end(), {is, js, a, b});
+      out_.streamTetOf[log.removed[first + n]] = pm_.tetCount() + n;
+    }
+
+    const float* pi = &mesh_.positions[3 * size_t(i)];
+    const float* pj = &pm_.mesh.positions[3 * size_t(js)];
+    for (int k = 0; k < 3; ++k) putValue(pi[k], pj[k], q_.position[k]);
+    fields_.resize(mesh_.fields.size());
+    for (size_t f = 0; f < mesh_.fields.size(); ++f) {
+      fields_[f] = mesh_.fields[f].values[i];
+      putValue(fields_[f], pm_.mesh.fields[f].values[js], q_.field[f]);
+    }
+    changed_.clear();
+    applySplit(pm_, SplitOp{js, moved_, newTets_, pi, fields_.data()}, changed_);
+  }
+
+  Result flushChunk(uint32_t splitsApplied) {
+    const uint32_t index = uint32_t(out_.chunks.size()) + 1;
+    beginChunk(raw_, ChunkKind::Splits, index);
+    putU32(raw_, inChunk_);
+    putU32(raw_, q_.lossless ? kSplitFlagLossless : 0);
+    raw_.insert(raw_.end(), records_.begin(), records_.end());
+    std::vector<uint8_t> file;
+    ChunkInfo info;
+    if (Result r = finishChunk(raw_, opt_.zstdLevel, file, info); !r) return r;
+    info.kind = ChunkKind::Splits;
+    info.vertices = pm_.vertexCount();
+    info.tets = pm_.tetCount();
+    info.splits = inChunk_;
+    const uint32_t C = s_.log.size();
+    info.fieldError = splitsApplied < C ? prefixMax_[C - splitsApplied - 1] : 0.0;
+    // Aim the next chunk: observed compression ratio, target doubling up to chunkBytes.
+    if (info.bytes > 0) ratio_ = std::max(1.0, double(raw_.size()) / double(info.bytes));
+    target_ = std::min<uint64_t>(2 * target_, opt_.chunkBytes);
+    out_.files.push_back(std::move(file));
+    out_.chunks.push_back(info);
+    startChunk();
+    return Result::success();
+  }
+
+  const TetMesh& mesh_;
+  const SimplifyResult& s_;
+  const Manifest& m_;
+  const StreamOptions& opt_;
+  EncodedStream& out_;
+  Quantizer q_;
+  ProgressiveMesh pm_;
+  std::vector<float> prefixMax_, fields_;
+  std::vector<uint8_t> raw_, records_;
+  std::vector<uint32_t> star_, moved_, candidates_, newTets_, changed_;
+  uint32_t prevJ_ = 0, inChunk_ = 0;
+  uint64_t target_ = 0;
+  double ratio_ = 2.5;
+};
+
+}  // namespace
+
+Result encodeStream(const TetMesh& mesh, const SimplifyResult& s, const Manifest& m, const StreamOptions& opt,
+                    EncodedStream& out) {
+  out = EncodedStream{};
+  Encoder e(mesh, s, m, opt, out);
+  return e.run();
+}
+
+}  // namespace tetstream

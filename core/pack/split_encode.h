@@ -1,0 +1,36 @@
+// Turns the simplifier's collapse log into the progressive stream (FORMAT.md §3-§4): the base
+// mesh and vertex-split chunks, newest collapse first. The encoder replays every split on the
+// same ProgressiveMesh code the viewer runs, so the neighbourhoods it encodes against are
+// exactly the ones a decoder will see.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "manifest.h"
+#include "mesh.h"
+#include "pack/simplify.h"
+#include "status.h"
+
+namespace tetstream {
+
+struct StreamOptions {
+  uint32_t firstChunkBytes = 16u << 10;  // compressed size aimed at by the first split chunk
+  uint32_t chunkBytes = 256u << 10;      // later chunks double up to this size
+  int zstdLevel = 19;
+};
+
+struct EncodedStream {
+  TetMesh base;                              // vertices and tets in stream order
+  std::vector<std::vector<uint8_t>> files;   // split chunk files, chunk 1 onwards
+  std::vector<ChunkInfo> chunks;             // their manifest entries (file names left empty)
+  std::vector<uint32_t> streamVertexOf;      // original vertex id -> id in the stream
+  std::vector<uint32_t> streamTetOf;         // original tet id -> id in the stream
+  double baseFieldError = 0;                 // estimated field error of the base mesh
+};
+
+// `mesh` is the simplifier's input (values on the quantization grid of `m` unless lossless);
+// `m` supplies bounds, fields, quantization and the chunk indices start at 1.
+Result encodeStream(const TetMesh& mesh, const SimplifyResult& s, const Manifest& m, const StreamOptions& opt,
+                    EncodedStream& out);
+
+}  // namespace tetstream

@@ -1,0 +1,106 @@
+#include "split_stream.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace tetstream {
+namespace {
+
+Result corrupt(const std::string& what) { return fail(Status::Corrupt, "split chunk: " + what); }
+
+}  // namespace
+
+Result beginSplits(SplitReader& r, std::span<const uint8_t> payload, const ChunkInfo& info, const Manifest& m) {
+  r.in = ByteReader{payload, 0};
+  uint32_t count = 0, flags = 0;
+  if (!r.in.u32(count) || !r.in.u32(flags)) return fail(Status::Truncated, "split chunk: payload shorter than its header");
+  if (count != info.splits)
+    return corrupt(std::to_string(count) + " splits where the manifest says " + std::to_string(info.splits));
+  if (flags & ~kSplitFlagLossless) return fail(Status::Unsupported, "split chunk: unknown flags");
+  r.lossless = flags & kSplitFlagLossless;
+  if (r.lossless != m.lossless) return corrupt("lossless flag differs from the manifest");
+  r.remaining = count;
+  r.prevJ = 0;
+  return Result::success();
+}
+
+Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, std::vector<uint32_t>& changed) {
+  if (r.remaining == 0) return corrupt("no split left in the chunk");
+  const uint32_t V = pm.vertexCount(), i = V;
+  uint32_t u;
+  if (!r.in.varint(u)) return fail(Status::Truncated, "split chunk: record ends early");
+  const int64_t j64 = int64_t(r.prevJ) + unzigzag(u);
+  if (j64 < 0 || j64 >= V) return fail(Status::OutOfRange, "split chunk: kept vertex " + std::to_string(j64) + " does not exist");
+  const uint32_t j = uint32_t(j64);
+
+  // T_moved: a bit per tet around j, in ascending tet order.
+  starOf(pm, j, r.star);
+  const uint8_t* mask;
+  if (!r.in.bytes((r.star.size() + 7) / 8, mask)) return fail(Status::Truncated, "split chunk: record ends early");
+  r.moved.clear();
+  for (size_t k = 0; k < r.star.size(); ++k)
+    if (mask[k >> 3] >> (k & 7) & 1) r.moved.push_back(r.star[k]);
+  if (r.star.size() % 8 && mask[r.star.size() / 8] >> (r.star.size() % 8)) return corrupt("mask bits beyond the star");
+
+  // T_new: (i, j, a, b), vertices a and b named by index into j's sorted neighbours, or past
+  // the end for an explicit vertex id; the order makes the tet positively oriented.
+  neighboursOf(pm, j, r.candidates);
+  uint32_t m;
+  if (!r.in.varint(m)) return fail(Status::Truncated, "split chunk: record ends early");
+  if (m > kMaxNewTetsPerSplit) return corrupt(std::to_string(m) + " new tets in one split");
+  r.newTets.clear();
+  const uint32_t nc = uint32_t(r.candidates.size());
+  auto resolve = [&](uint32_t x, uint32_t& v) {
+    v = x < nc ? r.candidates[x] : x - nc;
+    return v < V && v != j;
+  };
+  for (uint32_t n = 0; n < m; ++n) {
+    uint32_t x, y, a, b;
+    if (!r.in.varint(x) || !r.in.varint(y)) return fail(Status::Truncated, "split chunk: record ends early");
+    if (!resolve(x, a) || !resolve(y, b) || a == b) return fail(Status::OutOfRange, "split chunk: a new tet has an invalid vertex");
+    r.newTets.insert(r.newTets.end(), {i, j, a, b});
+  }
+
+  // Position and field values of p_i: raw floats, or grid steps relative to p_j.
+  float position[3];
+  const size_t F = pm.mesh.fields.size();
+  r.fields.resize(F);
+  if (r.lossless) {
+    for (float& x : position)
+      if (!r.in.f32(x)) return fail(Status::Truncated, "split chunk: record ends early");
+    for (float& x : r.fields)
+      if (!r.in.f32(x)) return fail(Status::Truncated, "split chunk: record ends early");
+    for (float x : position)
+      if (!std::isfinite(x)) return fail(Status::NonFinite, "split chunk: a vertex position is not finite");
+  } else {
+    auto predicted = [&](const QuantAxis& axis, float base, float& out) {
+      uint32_t d;
+      if (!r.in.varint(d)) return false;
+      int64_t qv = int64_t(axis.quantize(base)) + unzigzag(d);
+      if (qv < 0 || qv > int64_t(axis.maxQ)) return false;
+      out = axis.dequantize(uint32_t(qv));
+      return true;
+    };
+    const float* pj = &pm.mesh.positions[3 * size_t(j)];
+    for (int k = 0; k < 3; ++k)
+      if (!predicted(q.position[k], pj[k], position[k])) return corrupt("a position leaves the grid or the record ends early");
+    for (size_t f = 0; f < F; ++f)
+      if (!predicted(q.field[f], pm.mesh.fields[f].values[j], r.fields[f])) return corrupt("a field value leaves its range or the record ends early");
+  }
+  if (r.remaining == 1 && !r.in.atEnd()) return corrupt("bytes after the last split");
+
+  SplitOp op{j, r.moved, r.newTets, position, r.fields.data()};
+  applySplit(pm, op, changed);
+  r.prevJ = j;
+  --r.remaining;
+  return Result::success();
+}
+
+Result endSplits(const SplitReader& r) {
+  if (r.remaining != 0) return corrupt(std::to_string(r.remaining) + " splits not applied");
+  if (!r.in.atEnd()) return corrupt("bytes after the last split");
+  return Result::success();
+}
+
+}  // namespace tetstream

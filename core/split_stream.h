@@ -1,0 +1,41 @@
+// Vertex-split chunks (FORMAT.md §4), decode side: reads one record at a time from a chunk's
+// payload and applies it to a ProgressiveMesh, so a viewer can spread a chunk over frames.
+// Every field of a record is checked against the current mesh before anything changes.
+#pragma once
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "manifest.h"
+#include "progressive.h"
+#include "quantize.h"
+#include "status.h"
+#include "varint.h"
+
+namespace tetstream {
+
+inline constexpr uint32_t kSplitFlagLossless = 1;
+inline constexpr uint32_t kMaxNewTetsPerSplit = 4096;
+
+struct SplitReader {
+  ByteReader in;
+  uint32_t remaining = 0;  // records left in the chunk
+  uint32_t prevJ = 0;
+  bool lossless = false;
+  // scratch, reused across records
+  std::vector<uint32_t> star, candidates, moved, newTets;
+  std::vector<float> fields;
+};
+
+// Starts reading a split chunk's payload (after the chunk header). The payload must outlive
+// the reader's use.
+Result beginSplits(SplitReader& r, std::span<const uint8_t> payload, const ChunkInfo& info, const Manifest& m);
+
+// Decodes the next record and applies it; appends changed tet ids (moved, then new) to
+// `changed`. On failure nothing of that record is applied.
+Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, std::vector<uint32_t>& changed);
+
+// After the last record: the payload must be fully consumed.
+Result endSplits(const SplitReader& r);
+
+}  // namespace tetstream

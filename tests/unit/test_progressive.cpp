@@ -1,0 +1,310 @@
+// The progressive stream end to end: pack (simplify + encode) then decode every prefix.
+// Properties: every prefix is a valid conforming mesh with no inverted or flat tets; all chunks
+// give back the input (bit-exact lossless, within half a grid step otherwise); packing is
+// deterministic; the boundary survives simplification.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <unordered_map>
+
+#include "adjacency.h"
+#include "dataset.h"
+#include "pack/generators.h"
+#include "pack/packer.h"
+#include "pack/simplify.h"
+#include "quantize.h"
+#include "test_helpers.h"
+#include "validate.h"
+
+using namespace tetstream;
+
+namespace {
+
+std::string tempDir(const std::string& name) {
+  static test::ScratchDir root("progressive");
+  std::string dir = root.path + "/" + name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+TetMesh harmonic(uint32_t n) {
+  TetMesh m = makeGridMesh(n);
+  addHarmonicField(m);
+  addDistanceField(m);
+  m.name = "harmonic";
+  return m;
+}
+
+// Drops the tets in the octant x, y, z > 0 (a non-convex domain with concave creases) and the
+// vertices no tet uses any more.
+TetMesh lShape(uint32_t n) {
+  TetMesh g = harmonic(n);
+  TetMesh m;
+  m.fields.resize(g.fields.size());
+  for (size_t f = 0; f < g.fields.size(); ++f) m.fields[f].name = g.fields[f].name;
+  std::vector<uint32_t> remap(g.vertexCount(), ~0u);
+  for (uint32_t t = 0; t < g.tetCount(); ++t) {
+    const uint32_t* v = &g.tets[4 * t];
+    float c[3] = {0, 0, 0};
+    for (int k = 0; k < 4; ++k)
+      for (int a = 0; a < 3; ++a) c[a] += g.positions[3 * v[k] + a] / 4;
+    if (c[0] > 0 && c[1] > 0 && c[2] > 0) continue;
+    for (int k = 0; k < 4; ++k) {
+      if (remap[v[k]] == ~0u) {
+        remap[v[k]] = m.vertexCount();
+        m.positions.insert(m.positions.end(), &g.positions[3 * v[k]], &g.positions[3 * v[k]] + 3);
+        for (size_t f = 0; f < g.fields.size(); ++f) m.fields[f].values.push_back(g.fields[f].values[v[k]]);
+      }
+      m.tets.push_back(remap[v[k]]);
+    }
+  }
+  m.name = "lshape";
+  return m;
+}
+
+std::string pack(const std::string& name, const TetMesh& m, PackOptions o, PackSummary* summary = nullptr) {
+  std::string dir = tempDir(name);
+  PackSummary s;
+  o.zstdLevel = 3;
+  Result r = packMesh(m, dir, o, s);
+  EXPECT_TRUE(r) << r.message;
+  if (summary) *summary = s;
+  return dir;
+}
+
+double meshVolume(const TetMesh& m) {
+  double v = 0;
+  for (uint32_t t = 0; t < m.tetCount(); ++t) v += tetVolume(m, t);
+  return v;
+}
+
+// Asserts what FORMAT.md promises for every level.
+void expectValidLevel(const TetMesh& m, const std::string& what) {
+  ValidationReport r = validateMesh(m);
+  EXPECT_EQ(r.negativeTets, 0u) << what;
+  EXPECT_EQ(r.zeroVolumeTets, 0u) << what;
+  EXPECT_EQ(r.repeatedVertexTets, 0u) << what;
+  EXPECT_EQ(r.duplicateTets, 0u) << what;
+  EXPECT_EQ(r.nonManifoldFaces, 0u) << what;
+  EXPECT_EQ(r.nonManifoldBoundaryEdges, 0u) << what;
+  EXPECT_EQ(r.unusedVertices, 0u) << what;
+  // The boundary of a ball-shaped domain stays a sphere: V - E + F = 2.
+  FaceAdjacency adj;
+  buildFaceAdjacency(m.tets, m.vertexCount(), adj);
+  std::vector<uint32_t> b;
+  extractBoundary(m.tets, adj, b);
+  std::vector<uint32_t> verts(b);
+  std::sort(verts.begin(), verts.end());
+  verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+  const long F = long(b.size() / 3), E = 3 * F / 2, V = long(verts.size());
+  EXPECT_EQ(V - E + F, 2) << what;
+}
+
+// Compares the fully refined mesh with the input: same vertex set (positions to within `tol`
+// per coordinate, fields to within `ftol`) and the same tets with the same orientation.
+void expectSameMesh(const TetMesh& in, const TetMesh& out, const Quantizer& q, bool exact) {
+  ASSERT_EQ(in.vertexCount(), out.vertexCount());
+  ASSERT_EQ(in.tetCount(), out.tetCount());
+  // Key vertices by grid cell: unique for these meshes, identical for both sides.
+  auto key = [&](const float* p) {
+    return std::array<uint32_t, 3>{q.position[0].quantize(p[0]), q.position[1].quantize(p[1]), q.position[2].quantize(p[2])};
+  };
+  std::map<std::array<uint32_t, 3>, uint32_t> original;
+  for (uint32_t v = 0; v < in.vertexCount(); ++v) original[key(&in.positions[3 * v])] = v;
+  ASSERT_EQ(original.size(), in.vertexCount());
+  std::vector<uint32_t> toIn(out.vertexCount());
+  for (uint32_t v = 0; v < out.vertexCount(); ++v) {
+    auto it = original.find(key(&out.positions[3 * v]));
+    ASSERT_NE(it, original.end());
+    toIn[v] = it->second;
+    for (int k = 0; k < 3; ++k) {
+      float a = in.positions[3 * it->second + k], b = out.positions[3 * v + k];
+      if (exact) EXPECT_EQ(std::memcmp(&a, &b, 4), 0);
+      else EXPECT_LE(std::abs(a - b), 0.5f * q.position[k].step * 1.0001f);
+    }
+    for (size_t f = 0; f < in.fields.size(); ++f) {
+      float a = in.fields[f].values[it->second], b = out.fields[f].values[v];
+      if (exact) EXPECT_EQ(std::memcmp(&a, &b, 4), 0);
+      else EXPECT_LE(std::abs(a - b), 0.5f * q.field[f].step * 1.0001f);
+    }
+  }
+  // Tets: the same vertex sets, and each an even permutation of the input's (same orientation).
+  std::map<std::array<uint32_t, 4>, std::array<uint32_t, 4>> inTets;
+  for (uint32_t t = 0; t < in.tetCount(); ++t) {
+    std::array<uint32_t, 4> v, s;
+    std::copy_n(&in.tets[4 * t], 4, v.begin());
+    s = v;
+    std::sort(s.begin(), s.end());
+    inTets[s] = v;
+  }
+  for (uint32_t t = 0; t < out.tetCount(); ++t) {
+    std::array<uint32_t, 4> v, s;
+    for (int k = 0; k < 4; ++k) v[k] = toIn[out.tets[4 * t + k]];
+    s = v;
+    std::sort(s.begin(), s.end());
+    auto it = inTets.find(s);
+    ASSERT_NE(it, inTets.end()) << "tet " << t << " is not in the input";
+    int inversions = 0;  // parity of the permutation from the input's order to ours
+    std::array<int, 4> pos;
+    for (int k = 0; k < 4; ++k) pos[k] = int(std::find(it->second.begin(), it->second.end(), v[k]) - it->second.begin());
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) inversions += pos[a] > pos[b];
+    EXPECT_EQ(inversions % 2, 0) << "tet " << t << " changed orientation";
+  }
+}
+
+void roundTrip(const std::string& name, const TetMesh& m, PackOptions o) {
+  o.chunkKb = 2;  // many small chunks: many prefixes to check
+  PackSummary s;
+  std::string dir = pack(name, m, o, &s);
+  Dataset ds;
+  Result r = loadPackedDir(dir, ds, 0);
+  ASSERT_TRUE(r) << r.message;
+  const size_t chunks = ds.manifest.chunks.size();
+  ASSERT_GE(chunks, 3u) << "expected a base and several split chunks";
+  EXPECT_LE(s.baseVertices, m.vertexCount() / 20) << s.stopReason;
+  for (size_t k = 1; k <= chunks; ++k) {
+    Dataset level;
+    r = loadPackedDir(dir, level, int(k));
+    ASSERT_TRUE(r) << r.message;
+    EXPECT_EQ(level.pm.vertexCount(), level.manifest.chunks[k - 1].vertices);
+    EXPECT_EQ(level.pm.tetCount(), level.manifest.chunks[k - 1].tets);
+    expectValidLevel(level.pm.mesh, name + " after " + std::to_string(k) + " chunks");
+    if (k > 1) {
+      EXPECT_LE(level.manifest.chunks[k - 1].fieldError, level.manifest.chunks[k - 2].fieldError);
+    }
+  }
+  Dataset full;
+  ASSERT_TRUE(loadPackedDir(dir, full));
+  EXPECT_EQ(full.manifest.chunks.back().fieldError, 0.0);
+  expectSameMesh(m, full.pm.mesh, full.quant, o.lossless);
+}
+
+}  // namespace
+
+TEST(Progressive, HarmonicLosslessRoundTripIsBitExact) {
+  PackOptions o;
+  o.lossless = true;
+  roundTrip("harmonic-lossless", harmonic(12), o);
+}
+
+TEST(Progressive, HarmonicQuantizedRoundTripWithinHalfAStep) {
+  roundTrip("harmonic-16bit", harmonic(12), PackOptions{});
+}
+
+TEST(Progressive, NonConvexDomainWithCreases) {
+  PackOptions o;
+  o.lossless = true;
+  roundTrip("lshape", lShape(11), o);
+}
+
+TEST(Progressive, PackingIsDeterministic) {
+  TetMesh m = harmonic(10);
+  PackOptions o;
+  o.chunkKb = 2;
+  std::string a = pack("det-a", m, o), b = pack("det-b", m, o);
+  EXPECT_EQ(test::loadFile(a + "/manifest.json"), test::loadFile(b + "/manifest.json"));
+  for (auto& e : std::filesystem::directory_iterator(a + "/chunks"))
+    EXPECT_EQ(test::loadFile(e.path().string()), test::loadFile(b + "/chunks/" + e.path().filename().string()));
+}
+
+// Planar boundary faces and creases carry zero quadric error, so with the default weights the
+// cube keeps its exact shape and volume at a 5% base; the L-shape keeps its volume (8 - 1).
+TEST(Progressive, BoundaryIsPreserved) {
+  for (auto [name, mesh, volume] : {std::tuple{"cube", harmonic(11), 8.0}, std::tuple{"l", lShape(11), 7.0}}) {
+    PackOptions o;
+    o.lossless = true;
+    o.baseFraction = 0.05;
+    std::string dir = pack(std::string("boundary-") + name, mesh, o);
+    Dataset base;
+    ASSERT_TRUE(loadPackedDir(dir, base, 1));
+    EXPECT_NEAR(meshVolume(base.pm.mesh), volume, 1e-4) << name;
+    Bounds b = computeBounds(base.pm.mesh.positions);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(b.min[k], -1.0f);
+      EXPECT_EQ(b.max[k], 1.0f);
+    }
+  }
+}
+
+TEST(Progressive, CorruptSplitChunkKeepsTheLastCompleteLevel) {
+  PackOptions o;
+  o.chunkKb = 2;
+  std::string dir = pack("corrupt-splits", harmonic(10), o);
+  Dataset ds;
+  ASSERT_TRUE(loadPackedDir(dir, ds, 2));
+  const uint32_t v = ds.pm.vertexCount(), t = ds.pm.tetCount();
+  const ChunkInfo info = ds.manifest.chunks[2];
+  std::vector<uint8_t> bytes = test::loadBytes(dir + "/" + info.file);
+  bytes[bytes.size() / 3] ^= 4;
+  EXPECT_EQ(applyChunk(ds, 2, bytes).status, Status::HashMismatch);
+  EXPECT_EQ(ds.pm.vertexCount(), v);
+  EXPECT_EQ(ds.pm.tetCount(), t);
+}
+
+// ------------------------------------------------------------------ legality on tiny meshes
+
+namespace {
+uint32_t gridVertex(uint32_t n, uint32_t i, uint32_t j, uint32_t k) { return i + n * (j + n * k); }
+}  // namespace
+
+TEST(Legality, BoundaryVertexMayNotBePulledInward) {
+  TetMesh m = harmonic(3);
+  const uint32_t centre = gridVertex(3, 1, 1, 1);
+  int neighbours = 0;
+  for (uint32_t v = 0; v < m.vertexCount(); ++v) {
+    CollapseVerdict verdict = checkCollapse(m, v, centre);
+    if (verdict == CollapseVerdict::NotAnEdge) continue;
+    ++neighbours;
+    EXPECT_EQ(verdict, CollapseVerdict::BoundaryRule) << v;
+  }
+  EXPECT_EQ(neighbours, 14) << "the Kuhn split gives the centre 14 neighbours";
+  // Along the boundary it may move (the corner into its edge neighbour is a boundary edge).
+  EXPECT_NE(checkCollapse(m, gridVertex(3, 1, 0, 0), gridVertex(3, 0, 0, 0)), CollapseVerdict::BoundaryRule);
+}
+
+TEST(Legality, CollapseThatInvertsATetIsRefused) {
+  // In the Kuhn split, moving the centre onto the edge midpoint (1, 0, 0) pushes it through
+  // the far side of a tet of its star.
+  TetMesh m = harmonic(3);
+  EXPECT_EQ(checkCollapse(m, gridVertex(3, 1, 1, 1), gridVertex(3, 1, 0, 0)), CollapseVerdict::Inverted);
+  EXPECT_EQ(checkCollapse(m, gridVertex(3, 1, 1, 1), gridVertex(3, 2, 1, 1)), CollapseVerdict::Legal);
+}
+
+TEST(Legality, LinkConditionProtectsTopology) {
+  // Tets (i, j, a, b), (i, k, c, d), (j, k, e, f): i and j share the neighbour k, but (i, j, k)
+  // is no triangle of the mesh; collapsing i into j would glue two parts of the boundary.
+  TetMesh m;
+  m.positions = {0, 0, 0,  1, 0, 0,  0, 1, 0,  0, 0, 1,         // i j a b
+                 -1, -2, 0,  -1, -2, 1,  -1, -3, 0,             // k c d
+                 1.5f, -3, 0,  1.5f, -3, 1};                    // e f
+  m.tets = {0, 1, 2, 3, 0, 4, 5, 6, 1, 4, 7, 8};
+  for (uint32_t t = 0; t < m.tetCount(); ++t)
+    if (tetVolume(m, t) < 0) std::swap(m.tets[4 * t + 2], m.tets[4 * t + 3]);
+  m.fields.push_back({"f", std::vector<float>(m.vertexCount(), 0.0f)});
+  SimplifyOptions o;
+  o.minQuality = 0;
+  EXPECT_EQ(checkCollapse(m, 0, 1, o), CollapseVerdict::LinkCondition);
+}
+
+TEST(Legality, FlatInputTetsAreRemovedNotCreated) {
+  // A grid whose middle layer is squashed flat in one cube: the packer must not fail, must not
+  // create new flat tets, and removes the flat ones where it can.
+  TetMesh m = harmonic(7);
+  uint32_t v = gridVertex(7, 3, 3, 3);
+  m.positions[3 * v + 2] = m.positions[3 * gridVertex(7, 3, 3, 2) + 2];  // onto the layer below
+  ValidationReport before = validateMesh(m);
+  ASSERT_GT(before.zeroVolumeTets + before.negativeTets, 0u);
+  SimplifyOptions o;
+  o.targetVertices = 20;
+  SimplifyResult r;
+  ASSERT_TRUE(simplifyMesh(m, o, r));
+  EXPECT_GT(r.flatTetsRemoved, 0u);
+  EXPECT_LE(r.flatTetsLeft, before.zeroVolumeTets);
+}
