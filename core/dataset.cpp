@@ -28,22 +28,39 @@ Result readFile(const std::string& path, uint64_t limit, std::vector<uint8_t>& o
 
 }  // namespace
 
+uint32_t Dataset::chunksApplied() const {
+  if (chunksReceived == 0) return 0;
+  uint32_t n = 1;
+  while (n < chunksReceived && chunkFirstSplit[n + 1] <= pm.splitsApplied()) ++n;
+  return n;
+}
+
+uint32_t Dataset::splitsThroughChunk(uint32_t index) const {
+  if (index + 1 < chunkFirstSplit.size()) return chunkFirstSplit[index + 1];
+  uint32_t n = 0;  // not received yet: from the manifest
+  for (uint32_t c = 1; c <= index && c < manifest.chunks.size(); ++c) n += manifest.chunks[c].splits;
+  return n;
+}
+
 Result openDataset(Dataset& ds, std::string_view manifestJson) {
   Manifest m;
   if (Result r = parseManifest(manifestJson, m); !r) return r;
   ds.manifest = std::move(m);
   ds.quant = makeQuantizer(ds.manifest);
   ds.pm = ProgressiveMesh{};
-  ds.chunksApplied = 0;
-  ds.bytesApplied = 0;
-  ds.chunkOpen = false;
+  ds.chunksReceived = 0;
+  ds.bytesReceived = 0;
+  ds.payloads.clear();
+  ds.chunkFirstSplit.clear();
+  ds.recordStart.assign(1, 0);
+  ds.splitsDecoded = 0;
   return Result::success();
 }
 
-Result beginChunk(Dataset& ds, uint32_t index, std::span<const uint8_t> file) {
-  if (ds.chunkOpen || index != ds.chunksApplied || index >= ds.manifest.chunks.size())
-    return fail(Status::BadArgument, "chunk " + std::to_string(index) + " applied out of order (next is " +
-                                         std::to_string(ds.chunksApplied) + ")");
+Result receiveChunk(Dataset& ds, uint32_t index, std::span<const uint8_t> file) {
+  if (index != ds.chunksReceived || index >= ds.manifest.chunks.size())
+    return fail(Status::BadArgument, "chunk " + std::to_string(index) + " received out of order (next is " +
+                                         std::to_string(ds.chunksReceived) + ")");
   const ChunkInfo& info = ds.manifest.chunks[index];
   std::span<const uint8_t> payload;
   if (Result r = openChunk(ds.decoder, info, index, file, payload); !r) return r;
@@ -51,51 +68,90 @@ Result beginChunk(Dataset& ds, uint32_t index, std::span<const uint8_t> file) {
     TetMesh mesh;
     if (Result r = decodeBaseMesh(payload, ds.manifest, mesh); !r) return r;
     initProgressive(ds.pm, std::move(mesh));
-    ds.chunksApplied = 1;
-    ds.bytesApplied = info.bytes;
-    return Result::success();
+    ds.payloads.assign(1, {});
+    ds.chunkFirstSplit.assign({0, 0});
+  } else {
+    if (Result r = beginSplits(ds.reader, payload, info, ds.manifest); !r) return r;
+    ds.payloads.emplace_back(payload.begin(), payload.end());
+    ds.chunkFirstSplit.push_back(ds.chunkFirstSplit.back() + info.splits);
   }
-  if (Result r = beginSplits(ds.splits, payload, info, ds.manifest); !r) return r;
-  ds.chunkOpen = true;
-  ds.openSplitsApplied = 0;
+  ds.chunksReceived = index + 1;
+  ds.bytesReceived += info.bytes;
   return Result::success();
 }
 
-Result stepChunk(Dataset& ds, uint32_t maxSplits, std::vector<uint32_t>& changed, bool* done) {
-  *done = !ds.chunkOpen;
-  if (!ds.chunkOpen) return Result::success();
-  const ChunkInfo& info = ds.manifest.chunks[ds.chunksApplied];
-  for (uint32_t n = 0; n < maxSplits && ds.splits.remaining > 0; ++n) {
-    Result r = applyNextSplit(ds.splits, ds.pm, ds.quant, changed);
-    if (!r) {
-      // Back to the last complete chunk: a half-applied chunk is no level of the format.
-      for (; ds.openSplitsApplied > 0; --ds.openSplitsApplied) undoSplit(ds.pm, changed);
-      ds.chunkOpen = false;
-      r.message = "chunk " + std::to_string(ds.chunksApplied) + ": " + r.message;
+namespace {
+
+// Drops received chunks from `chunk` on (after a decode failure inside it).
+void dropChunksFrom(Dataset& ds, uint32_t chunk) {
+  ds.payloads.resize(chunk);
+  ds.chunkFirstSplit.resize(chunk + 1);
+  ds.chunksReceived = chunk;
+  ds.bytesReceived = 0;
+  for (uint32_t c = 0; c < chunk; ++c) ds.bytesReceived += ds.manifest.chunks[c].bytes;
+  ds.splitsDecoded = std::min(ds.splitsDecoded, ds.chunkFirstSplit.back());
+  ds.recordStart.resize(ds.splitsDecoded + 1);
+}
+
+// Applies split g = ds.splitsApplied() from its chunk's payload.
+Result redoNext(Dataset& ds, std::vector<uint32_t>& changed) {
+  const uint32_t g = ds.splitsApplied();
+  uint32_t c = 1;
+  while (ds.chunkFirstSplit[c + 1] <= g) ++c;
+  const uint32_t first = ds.chunkFirstSplit[c], end = ds.chunkFirstSplit[c + 1];
+  SplitReader& r = ds.reader;
+  r.in = ByteReader{ds.payloads[c], g == first ? 8 : ds.recordStart[g]};
+  r.remaining = end - g;
+  r.prevJ = g == first ? 0 : ds.pm.splitJ[g - 1];
+  r.lossless = ds.manifest.lossless;
+  Result res = applyNextSplit(r, ds.pm, ds.quant, changed);
+  if (res && g + 1 == end) {
+    const ChunkInfo& info = ds.manifest.chunks[c];
+    if (ds.pm.vertexCount() != info.vertices || ds.pm.tetCount() != info.tets)
+      res = fail(Status::Corrupt, "split chunk: counts after the chunk differ from the manifest");
+    else if (!r.in.atEnd())
+      res = fail(Status::Corrupt, "split chunk: bytes after the last split");
+    if (!res) undoSplit(ds.pm, changed);
+  }
+  if (!res) {
+    while (ds.splitsApplied() > first) undoSplit(ds.pm, changed);
+    dropChunksFrom(ds, c);
+    res.message = "chunk " + std::to_string(c) + ": " + res.message;
+    return res;
+  }
+  if (g == ds.splitsDecoded) {
+    ds.recordStart.push_back(uint32_t(r.in.pos));
+    ds.recordStart[g] = g == first ? 8 : ds.recordStart[g];
+    ++ds.splitsDecoded;
+  }
+  return res;
+}
+
+}  // namespace
+
+Result stepTowards(Dataset& ds, uint32_t targetSplits, uint32_t maxSteps, std::vector<uint32_t>& changed,
+                   bool* reached) {
+  const uint32_t target = std::min(targetSplits, ds.splitsReceived());
+  for (uint32_t n = 0; n < maxSteps && ds.splitsApplied() != target; ++n) {
+    if (ds.splitsApplied() > target) {
+      undoSplit(ds.pm, changed);
+    } else if (Result r = redoNext(ds, changed); !r) {
+      *reached = false;
       return r;
     }
-    ++ds.openSplitsApplied;
   }
-  if (ds.splits.remaining == 0) {
-    ds.chunkOpen = false;
-    if (ds.pm.vertexCount() != info.vertices || ds.pm.tetCount() != info.tets) {
-      for (; ds.openSplitsApplied > 0; --ds.openSplitsApplied) undoSplit(ds.pm, changed);
-      return fail(Status::Corrupt, "chunk " + std::to_string(ds.chunksApplied) + ": counts after the chunk differ from the manifest");
-    }
-    ++ds.chunksApplied;
-    ds.bytesApplied += info.bytes;
-    *done = true;
-  }
+  *reached = ds.splitsApplied() == target;
   return Result::success();
 }
 
 Result applyChunk(Dataset& ds, uint32_t index, std::span<const uint8_t> file) {
-  if (Result r = beginChunk(ds, index, file); !r) return r;
+  if (ds.splitsApplied() != ds.splitsReceived())
+    return fail(Status::BadArgument, "applyChunk needs every received split applied first");
+  if (Result r = receiveChunk(ds, index, file); !r) return r;
   std::vector<uint32_t> changed;
-  bool done = false;
-  while (!done) {
+  for (bool reached = false; !reached;) {
     changed.clear();
-    if (Result r = stepChunk(ds, 1u << 16, changed, &done); !r) return r;
+    if (Result r = stepTowards(ds, ds.splitsReceived(), 1u << 16, changed, &reached); !r) return r;
   }
   return Result::success();
 }
@@ -122,12 +178,14 @@ Result loadPackedDir(const std::string& dir, Dataset& ds, int maxChunks, uint32_
       if (r.status == Status::TooLarge) r.status = Status::SizeMismatch;
       return r;
     }
-    if (Result r = beginChunk(ds, i, bytes); !r) return r;
-    for (bool done = false; !done;) {
-      uint32_t room = ds.pm.vertexCount() < maxVertices ? maxVertices - ds.pm.vertexCount() : 0;
-      if (room == 0 && ds.chunkOpen) return Result::success();  // stop inside this chunk
+    if (Result r = receiveChunk(ds, i, bytes); !r) return r;
+    // Each split adds one vertex: stop inside the chunk at the vertex budget.
+    uint32_t target = ds.splitsReceived();
+    if (maxVertices != ~0u && ds.pm.baseVertices + uint64_t(target) > maxVertices)
+      target = maxVertices > ds.pm.baseVertices ? maxVertices - ds.pm.baseVertices : 0;
+    for (bool reached = false; !reached;) {
       changed.clear();
-      if (Result r = stepChunk(ds, std::min<uint32_t>(room, 1u << 16), changed, &done); !r) return r;
+      if (Result r = stepTowards(ds, target, 1u << 16, changed, &reached); !r) return r;
     }
   }
   return Result::success();

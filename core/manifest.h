@@ -12,7 +12,7 @@
 namespace tetstream {
 
 inline constexpr uint32_t kFormatVersion = 1;
-inline constexpr const char* kLibraryVersion = "0.1.0";
+inline constexpr const char* kLibraryVersion = "0.2.0";
 
 enum class ChunkKind : uint8_t { Base = 1, Splits = 2 };
 

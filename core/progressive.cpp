@@ -22,6 +22,25 @@ void unlinkCorners(ProgressiveMesh& pm, uint32_t v, Pred drop) {
   }
 }
 
+// Small arrays (a vertex's star: tens of entries): insertion sort beats introsort's overhead.
+void sortSmall(std::vector<uint32_t>& v) {
+  for (size_t i = 1; i < v.size(); ++i) {
+    uint32_t x = v[i];
+    size_t k = i;
+    for (; k > 0 && v[k - 1] > x; --k) v[k] = v[k - 1];
+    v[k] = x;
+  }
+}
+
+uint32_t nextStamp(const ProgressiveMesh& pm) {
+  pm.seen.resize(pm.vertexHead.size(), 0);
+  if (++pm.stamp == 0) {  // wrapped: clear once every 4 billion calls
+    std::fill(pm.seen.begin(), pm.seen.end(), 0);
+    pm.stamp = 1;
+  }
+  return pm.stamp;
+}
+
 }  // namespace
 
 void initProgressive(ProgressiveMesh& pm, TetMesh base) {
@@ -39,18 +58,22 @@ void initProgressive(ProgressiveMesh& pm, TetMesh base) {
 void starOf(const ProgressiveMesh& pm, uint32_t v, std::vector<uint32_t>& tets) {
   tets.clear();
   for (uint32_t c = pm.vertexHead[v]; c != kNoCorner; c = pm.cornerNext[c]) tets.push_back(c >> 2);
-  std::sort(tets.begin(), tets.end());
+  sortSmall(tets);
 }
 
 void neighboursOf(const ProgressiveMesh& pm, uint32_t v, std::vector<uint32_t>& vertices) {
   vertices.clear();
+  const uint32_t stamp = nextStamp(pm);
+  pm.seen[v] = stamp;
   for (uint32_t c = pm.vertexHead[v]; c != kNoCorner; c = pm.cornerNext[c]) {
     const uint32_t* t = &pm.mesh.tets[c & ~3u];
     for (int k = 0; k < 4; ++k)
-      if (t[k] != v) vertices.push_back(t[k]);
+      if (pm.seen[t[k]] != stamp) {
+        pm.seen[t[k]] = stamp;
+        vertices.push_back(t[k]);
+      }
   }
-  std::sort(vertices.begin(), vertices.end());
-  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  sortSmall(vertices);
 }
 
 void applySplit(ProgressiveMesh& pm, const SplitOp& op, std::vector<uint32_t>& changed) {
@@ -97,11 +120,14 @@ void undoSplit(ProgressiveMesh& pm, std::vector<uint32_t>& changed) {
   pm.splitJ.pop_back();
   pm.splitTetsBefore.pop_back();
 
-  // Unlink the new tets' corners from their vertices, then drop the tets.
+  // Unlink the new tets' corners from their vertices (one walk per vertex), drop the tets.
   const uint32_t firstDead = 4 * tetsBefore;
+  const uint32_t stamp = nextStamp(pm);
   for (uint32_t c = firstDead; c < m.tets.size(); ++c) {
     uint32_t v = m.tets[c];
-    if (v != i) unlinkCorners(pm, v, [&](uint32_t x) { return x >= firstDead; });
+    if (v == i || pm.seen[v] == stamp) continue;
+    pm.seen[v] = stamp;
+    unlinkCorners(pm, v, [&](uint32_t x) { return x >= firstDead; });
   }
   m.tets.resize(firstDead);
   pm.cornerNext.resize(firstDead);

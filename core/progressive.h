@@ -34,6 +34,9 @@ struct ProgressiveMesh {
   // Undo log, one entry per applied split: the kept vertex and the tet count before the split.
   std::vector<uint32_t> splitJ, splitTetsBefore;
   uint32_t baseVertices = 0, baseTets = 0;
+  // Scratch for de-duplicating vertices without sorting: a stamp per vertex.
+  mutable std::vector<uint32_t> seen;
+  mutable uint32_t stamp = 0;
 
   uint32_t vertexCount() const { return mesh.vertexCount(); }
   uint32_t tetCount() const { return mesh.tetCount(); }

@@ -4,7 +4,7 @@
 // ---------------------------------------------------------------------------------------------
 // JS surface (the module is built with -sMODULARIZE -sEXPORT_NAME=createTetstream):
 //
-//   const Module = await createTetstream({ canvas: document.getElementById('canvas') });
+//   const Module = await createTetstream({ canvas, onPauseChange(paused) { ... } });
 //   Module.callMain([]);   // once: creates the WebGL2 context, ImGui and the frame loop
 //   Built with -sINVOKE_RUN=0 so the shell can validate the manifest and start the chunk
 //   downloads first; the functions below work before main() has run. Setting up WebGL on a
@@ -17,24 +17,42 @@
 //       The validated "file" of chunk i (relative to the manifest's URL), "" when out of range.
 //       Valid until the next manifest. Chunk count: stats().chunksTotal.
 //   _ts_add_chunk(i, ptr, len) -> 1 | 0
-//       The complete bytes of chunk i, which must be the next one. JS copies each file into
-//       wasm memory once (_malloc + HEAPU8.set) and frees it after the call; the viewer keeps
-//       nothing pointing into it. Verifies (size, hash, zstd, payload), applies, re-extracts.
-//       0 = rejected: the previous level stays on screen and the state becomes "error".
+//       The complete bytes of chunk i, which must be the next one: hand each over as soon as it
+//       (and every chunk before it) has arrived. JS copies each file into wasm memory once
+//       (_malloc + HEAPU8.set) and frees it after the call; the viewer keeps nothing pointing
+//       into it. Verifies (size, hash, zstd, header) and keeps the chunk: cheap, ~1 ms for
+//       256 KB. The base chunk is shown at once; split chunks are applied by the frame loop
+//       within its per-frame budget. 0 = rejected (or the viewer is in "error"): stop sending.
+//   _ts_download_progress(networkBytes, datasetBytes)   (doubles, cumulative)
+//       Bytes off the wire (aborted requests included) and bytes of the dataset in hand
+//       (verified chunks plus partial downloads): the panel's rate, progress and time left.
+//   _ts_set_paused(0 | 1)              pause or resume downloading (the panel's button does the
+//                                      same); the viewer calls Module.onPauseChange(paused) for
+//                                      either, and the shell stops or restarts its fetches there
+//   _ts_set_level(fraction)            (double) level target as a fraction of the full mesh's
+//                                      vertices, clamped to what has been received; 1 = newest,
+//                                      following new data
 //   _ts_set_isovalue(value)            (float) re-extracts at once
 //   _ts_set_field(name) -> 1 | 0       (C string) selects a field; isovalue -> middle of its range
 //   _ts_fail(message)                  (C string) a failure JS saw (HTTP status, network) in
-//                                      plain words; state "error"
+//                                      plain words; state "error", the shown level stays
 //   _ts_stats_json() -> const char*    JSON described in viewer_state.h (statsJson); the buffer
 //                                      stays valid until the next call
 //   _malloc, _free                     for the byte buffers above
 //
 // Runtime methods exported for the shell: callMain, ccall, cwrap, UTF8ToString, HEAPU8 (memory
 // view; re-read it after every call, memory can grow).
+//
+// Frame loop: every animation frame first spends up to kRefineBudgetMs applying or undoing
+// splits toward the level target (measured with emscripten_get_now, checked every kStepBatch
+// splits), with the isosurface and hull updated from the changed tets only, then uploads the
+// changed buffer ranges and draws. A frame with nothing to apply and nothing changed draws
+// nothing.
 // ---------------------------------------------------------------------------------------------
 #include <emscripten.h>
 #include <emscripten/html5.h>
 
+#include <GLES3/gl3.h>
 #include <GLFW/glfw3.h>
 
 #include <algorithm>
@@ -64,6 +82,7 @@ struct App {
   Renderer renderer;
   GLFWwindow* window = nullptr;
   std::string platformError;  // set when WebGL 2 / GLFW could not start; sticky
+  bool softwareGl = false;    // SwiftShader & co: drawn without multisampling
 
   int width = 0, height = 0;  // canvas size in device pixels (= GLFW window and framebuffer size)
   double pixelRatio = 1;      // device pixels per CSS pixel
@@ -74,9 +93,15 @@ struct App {
   double lastX = 0, lastY = 0;
 
   int redrawFrames = 2;        // frames still to draw; 0 = idle, nothing changed
-  double lastFrameStart = -1;  // emscripten_get_now() of the previous drawn frame
+  GLsync gpuFence = nullptr;   // after the last drawn frame: signalled once the GPU has done it
+  double fenceSince = 0;
+  double lastFrameStart = -1;  // emscripten_get_now() of the previous frame callback
   std::string statsBuffer;
 };
+
+// Refinement work per frame: at 60 Hz that leaves half of a 16.7 ms frame to drawing and the
+// browser, so refinement alone never makes a frame long.
+constexpr double kRefineBudgetMs = 8.0;
 
 App g_app;
 
@@ -156,29 +181,18 @@ void ignoreScroll(GLFWwindow*, double, double) {}
 
 void onKey(GLFWwindow*, int, int, int, int) { requestRedraw(); }
 
-// ---------------------------------------------------------------- frame
-void frame() {
+// Tells the shell that downloading was paused or resumed (it owns the fetches).
+void notifyPause() {
+  ViewerState& s = g_app.state;
+  if (!s.pausedChanged) return;
+  s.pausedChanged = false;
+  EM_ASM({ if (Module.onPauseChange) Module.onPauseChange(!!$0); }, s.paused);
+}
+
+// ---------------------------------------------------------------- drawing
+void drawFrame() {
   App& a = g_app;
-  syncCanvasSize();
   ViewerState& s = a.state;
-  // The hull waits until the first surface has been shown, and while it is hidden.
-  if (s.boundaryStale && s.showBoundary && s.firstSurfaceMs >= 0) updateBoundary(s);
-  // Draw only when something changed: on a software GL (SwiftShader) or a slow GPU a frame can
-  // take tens of milliseconds of main-thread time that downloading and decoding need more.
-  if (s.surfaceDirty || s.boundaryDirty || s.frameRequested || a.dragButton >= 0) requestRedraw();
-  if (a.redrawFrames <= 0) {
-    a.lastFrameStart = -1;  // an idle gap is not a frame time
-    return;
-  }
-  --a.redrawFrames;
-
-  double start = emscripten_get_now();
-  if (a.lastFrameStart >= 0) {
-    double dt = start - a.lastFrameStart;
-    s.frameMs = s.frameMs > 0 ? 0.9 * s.frameMs + 0.1 * dt : dt;
-  }
-  a.lastFrameStart = start;
-
   if (s.frameRequested) {
     a.camera.setBounds(s.dataset.manifest.bounds.min, s.dataset.manifest.bounds.max, aspect());
     a.cameraMoved = false;
@@ -198,12 +212,17 @@ void frame() {
 
   if (s.surfaceDirty) {
     uploadSurface(a.renderer, s.surface);
+    s.surface.clearChanges();
     s.surfaceDirty = false;
   }
-  if (s.boundaryDirty) {
-    uploadBoundary(a.renderer, s.boundary);
-    s.boundaryDirty = false;
+  if (s.hullDirty) {
+    uploadHull(a.renderer, s.hull);
+    s.hull.clearChanges();
+    s.hullDirty = false;
   }
+  s.uploadBytes = a.renderer.uploads.bytes;
+  s.fullUploads = a.renderer.uploads.full;
+  s.partialUploads = a.renderer.uploads.partial;
   FrameParams p;
   p.view = a.camera.view();
   p.projection = a.camera.projection(aspect());
@@ -214,10 +233,59 @@ void frame() {
   ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 
   // The surface's draw calls are submitted; the browser presents them when this callback returns.
+  const double now = emscripten_get_now();
   if (s.surfaceReady && s.firstSurfaceMs < 0) {
-    s.firstSurfaceMs = emscripten_get_now();
+    s.firstSurfaceMs = now;
     requestRedraw();  // the panel shows the time
   }
+}
+
+// True while the GPU is still working on the last drawn frame. Drawing then would only queue
+// more work behind it, and once the command queue is full the next GL call blocks the main
+// thread until the GPU catches up (~40-150 ms a frame on SwiftShader): refinement and input
+// would stall with it. So a frame is drawn only when the previous one is done; on a real GPU
+// that is every frame. The fence is polled, never waited on (WebGL updates its status between
+// frames); after 250 ms without an answer the frame is drawn anyway.
+bool gpuBusy(double now) {
+  App& a = g_app;
+  if (!a.gpuFence) return false;
+  GLint status = GL_UNSIGNALED;
+  glGetSynciv(a.gpuFence, GL_SYNC_STATUS, 1, nullptr, &status);
+  if (status != GL_SIGNALED && now - a.fenceSince < 250) return true;
+  glDeleteSync(a.gpuFence);
+  a.gpuFence = nullptr;
+  return false;
+}
+
+// ---------------------------------------------------------------- frame
+void frame() {
+  App& a = g_app;
+  ViewerState& s = a.state;
+  const double start = emscripten_get_now();
+  const bool measuring = s.firstSurfaceMs >= 0;  // frame times count once the first surface is up
+  if (a.lastFrameStart >= 0) {
+    double dt = start - a.lastFrameStart;
+    s.frameMs = s.frameMs > 0 ? 0.9 * s.frameMs + 0.1 * dt : dt;
+    if (measuring) s.maxFrameGapMs = std::max(s.maxFrameGapMs, dt);
+  }
+  a.lastFrameStart = start;
+  syncCanvasSize();
+  tick(s, start);
+  if (advance(s, start + kRefineBudgetMs, emscripten_get_now)) requestRedraw();
+  if (s.state == LoadState::Complete && s.completeMs < 0) s.completeMs = emscripten_get_now();
+  if (downloading(s)) requestRedraw(1);  // progress and rate move
+  // Draw only when something changed: on a software GL (SwiftShader) or a slow GPU a frame can
+  // take tens of milliseconds of main-thread time that downloading and decoding need more.
+  if (s.surfaceDirty || s.hullDirty || s.frameRequested || a.dragButton >= 0) requestRedraw();
+  if (a.redrawFrames > 0 && !gpuBusy(start)) {
+    --a.redrawFrames;
+    drawFrame();
+    a.gpuFence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+    a.fenceSince = start;
+  }
+  notifyPause();
+  const double end = emscripten_get_now();
+  if (measuring) s.maxFrameMs = std::max(s.maxFrameMs, end - start);
 }
 
 bool initPlatform(std::string& error) {
@@ -228,7 +296,23 @@ bool initPlatform(std::string& error) {
   glfwWindowHint(GLFW_CLIENT_API, GLFW_OPENGL_ES_API);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 0);
-  glfwWindowHint(GLFW_SAMPLES, 4);
+  // A software rasterizer (SwiftShader or llvmpipe: also Chrome's fallback when the GPU is
+  // unusable) pays for 4x multisampling with 2-3x the frame time, hardware hardly notices it.
+  // The renderer's name is only visible through a context, so a throwaway one is asked first.
+  g_app.softwareGl = EM_ASM_INT({
+    try {
+      const gl = document.createElement('canvas').getContext('webgl2');
+      if (!gl) return 0;
+      const info = gl.getExtension('WEBGL_debug_renderer_info');
+      const name = String(info ? gl.getParameter(info.UNMASKED_RENDERER_WEBGL) : 0);
+      const lose = gl.getExtension('WEBGL_lose_context');
+      if (lose) lose.loseContext();
+      return /swiftshader|llvmpipe|softpipe|software/i.test(name) ? 1 : 0;
+    } catch (e) {
+      return 0;
+    }
+  }) != 0;
+  glfwWindowHint(GLFW_SAMPLES, g_app.softwareGl ? 0 : 4);
   double cssW = 0, cssH = 0;
   emscripten_get_element_css_size("#canvas", &cssW, &cssH);
   g_app.pixelRatio = std::max(1.0, emscripten_get_device_pixel_ratio());
@@ -251,7 +335,8 @@ bool initPlatform(std::string& error) {
     error = "The viewer's WebGL 2 shaders could not be set up: " + error;
     return false;
   }
-  std::printf("tetstream viewer: %s\n", info.c_str());
+  std::printf("tetstream viewer: %s%s\n", info.c_str(), g_app.softwareGl ? " | software rasterizer: no MSAA" : "");
+  warmUpRenderer(g_app.renderer);
 
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
@@ -303,6 +388,22 @@ EMSCRIPTEN_KEEPALIVE int ts_add_chunk(int index, const uint8_t* bytes, int len) 
   return addChunk(g_app.state, uint32_t(index), std::span<const uint8_t>(bytes, size_t(len))).ok() ? 1 : 0;
 }
 
+EMSCRIPTEN_KEEPALIVE void ts_download_progress(double networkBytes, double datasetBytes) {
+  if (!(networkBytes >= 0) || !(datasetBytes >= 0)) return;
+  noteDownload(g_app.state, uint64_t(networkBytes), uint64_t(datasetBytes), emscripten_get_now());
+}
+
+EMSCRIPTEN_KEEPALIVE void ts_set_paused(int paused) {
+  requestRedraw();
+  setPaused(g_app.state, paused != 0);
+  notifyPause();
+}
+
+EMSCRIPTEN_KEEPALIVE void ts_set_level(double fraction) {
+  requestRedraw();
+  setLevelFraction(g_app.state, fraction);
+}
+
 EMSCRIPTEN_KEEPALIVE void ts_set_isovalue(float value) {
   requestRedraw();
   setIsovalue(g_app.state, value);
@@ -319,6 +420,7 @@ EMSCRIPTEN_KEEPALIVE void ts_fail(const char* message) {
 }
 
 EMSCRIPTEN_KEEPALIVE const char* ts_stats_json() {
+  tick(g_app.state, emscripten_get_now());
   g_app.statsBuffer = statsJson(g_app.state);
   return g_app.statsBuffer.c_str();
 }

@@ -2,6 +2,9 @@
 
 #include <GLES3/gl3.h>
 
+#include <algorithm>
+#include <span>
+
 #include <glm/gtc/type_ptr.hpp>
 
 namespace tetstream::viewer {
@@ -149,9 +152,57 @@ void bindFloat3(GLuint location, GLuint buffer) {
   glVertexAttribPointer(location, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
 }
 
-void upload(GLenum target, GLuint buffer, const void* data, size_t bytes) {
-  glBindBuffer(target, buffer);
-  glBufferData(target, GLsizeiptr(bytes), bytes ? data : nullptr, GL_STATIC_DRAW);
+// Changed slots closer than this are sent in one bufferSubData (re-sending a few unchanged
+// elements is cheaper than another call); past kMaxRuns calls the bounding range goes at once.
+constexpr uint32_t kRunGap = 32;
+constexpr size_t kMaxRuns = 256;
+
+// Brings `buf` (bound to `target` by the caller's VAO state) up to date with `count` elements
+// of `elemBytes` bytes at `data`: everything when `full` or when the buffer has to grow,
+// otherwise the runs covering `changed` (slots >= count are ignored).
+void sync(Renderer& r, GLenum target, GpuBuffer& buf, const void* data, uint32_t count, uint32_t elemBytes,
+          std::span<const uint32_t> changed, bool full) {
+  const auto* bytes = static_cast<const uint8_t*>(data);
+  glBindBuffer(target, buf.id);
+  if (count > buf.capacity) {
+    buf.capacity = std::max(2 * count, 4096u);  // doubling: a whole upload is rare
+    glBufferData(target, GLsizeiptr(size_t(buf.capacity) * elemBytes), nullptr, GL_DYNAMIC_DRAW);
+    full = true;
+  }
+  if (full) {
+    if (count) glBufferSubData(target, 0, GLsizeiptr(size_t(count) * elemBytes), bytes);
+    r.uploads.bytes += uint64_t(count) * elemBytes;
+    ++r.uploads.full;
+    return;
+  }
+  std::vector<uint32_t>& slots = r.scratch;
+  slots.clear();
+  for (uint32_t v : changed)
+    if (v < count) slots.push_back(v);
+  if (slots.empty()) return;
+  std::sort(slots.begin(), slots.end());
+  slots.erase(std::unique(slots.begin(), slots.end()), slots.end());
+  size_t runs = 1;
+  for (size_t i = 1; i < slots.size(); ++i) runs += slots[i] - slots[i - 1] > kRunGap;
+  auto send = [&](uint32_t begin, uint32_t end) {
+    const size_t offset = size_t(begin) * elemBytes, size = size_t(end - begin) * elemBytes;
+    glBufferSubData(target, GLintptr(offset), GLsizeiptr(size), bytes + offset);
+    r.uploads.bytes += size;
+  };
+  if (runs > kMaxRuns) {
+    send(slots.front(), slots.back() + 1);
+  } else {
+    uint32_t begin = slots[0], end = slots[0] + 1;
+    for (size_t i = 1; i < slots.size(); ++i) {
+      if (slots[i] - (end - 1) > kRunGap) {
+        send(begin, end);
+        begin = slots[i];
+      }
+      end = slots[i] + 1;
+    }
+    send(begin, end);
+  }
+  ++r.uploads.partial;
 }
 
 }  // namespace
@@ -170,23 +221,22 @@ bool initRenderer(Renderer& r, std::string& info, std::string& error) {
   r.hullProj = glGetUniformLocation(r.hullProgram, "uProj");
   r.lineViewProj = glGetUniformLocation(r.lineProgram, "uViewProj");
 
-  glGenBuffers(3, r.isoBuffers);
+  for (GpuBuffer* b : {&r.isoPositions, &r.isoNormals, &r.isoIndices, &r.hullPositions, &r.hullNormals, &r.lines})
+    glGenBuffers(1, &b->id);
   glGenVertexArrays(1, &r.isoVao);
   glBindVertexArray(r.isoVao);
-  bindFloat3(0, r.isoBuffers[0]);
-  bindFloat3(1, r.isoBuffers[1]);
-  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, r.isoBuffers[2]);  // recorded in the VAO
+  bindFloat3(0, r.isoPositions.id);
+  bindFloat3(1, r.isoNormals.id);
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, r.isoIndices.id);  // recorded in the VAO
 
-  glGenBuffers(2, r.hullBuffers);
   glGenVertexArrays(1, &r.hullVao);
   glBindVertexArray(r.hullVao);
-  bindFloat3(0, r.hullBuffers[0]);
-  bindFloat3(1, r.hullBuffers[1]);
+  bindFloat3(0, r.hullPositions.id);
+  bindFloat3(1, r.hullNormals.id);
 
-  glGenBuffers(1, &r.lineBuffer);
   glGenVertexArrays(1, &r.lineVao);
   glBindVertexArray(r.lineVao);
-  bindFloat3(0, r.lineBuffer);
+  bindFloat3(0, r.lines.id);
 
   glGenVertexArrays(1, &r.emptyVao);
   glBindVertexArray(0);
@@ -202,31 +252,52 @@ void destroyRenderer(Renderer& r) {
   glDeleteProgram(r.hullProgram);
   glDeleteProgram(r.lineProgram);
   glDeleteProgram(r.backgroundProgram);
-  glDeleteBuffers(3, r.isoBuffers);
-  glDeleteBuffers(2, r.hullBuffers);
-  glDeleteBuffers(1, &r.lineBuffer);
+  for (GpuBuffer* b : {&r.isoPositions, &r.isoNormals, &r.isoIndices, &r.hullPositions, &r.hullNormals, &r.lines})
+    glDeleteBuffers(1, &b->id);
   GLuint vaos[4] = {r.isoVao, r.hullVao, r.lineVao, r.emptyVao};
   glDeleteVertexArrays(4, vaos);
   r = Renderer{};
 }
 
-void uploadSurface(Renderer& r, const IsoSurface& s) {
-  glBindVertexArray(0);  // keep the VAO's element binding untouched by the upload below
-  upload(GL_ARRAY_BUFFER, r.isoBuffers[0], s.positions.data(), s.positions.size() * sizeof(float));
-  upload(GL_ARRAY_BUFFER, r.isoBuffers[1], s.normals.data(), s.normals.size() * sizeof(float));
-  glBindVertexArray(r.isoVao);
-  upload(GL_ELEMENT_ARRAY_BUFFER, r.isoBuffers[2], s.indices.data(), s.indices.size() * sizeof(uint32_t));
+void warmUpRenderer(Renderer& r) {
+  const float tri[9] = {0, 0, 2, 1, 0, 2, 0, 1, 2};  // z = 2: outside the clip volume
+  const uint32_t indices[3] = {0, 1, 2};
   glBindVertexArray(0);
-  r.isoIndexCount = int32_t(s.indices.size());
+  for (GpuBuffer* b : {&r.isoPositions, &r.isoNormals, &r.hullPositions, &r.hullNormals, &r.lines}) {
+    glBindBuffer(GL_ARRAY_BUFFER, b->id);
+    glBufferData(GL_ARRAY_BUFFER, sizeof tri, tri, GL_DYNAMIC_DRAW);
+    b->capacity = 0;  // the first real upload allocates again
+  }
+  glBindVertexArray(r.isoVao);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, sizeof indices, indices, GL_DYNAMIC_DRAW);
+  r.isoIndices.capacity = 0;
+  glBindVertexArray(0);
+  r.isoIndexCount = 3;
+  r.hullVertexCount = 3;
+  r.lineVertexCount = 2;
+  drawScene(r, FrameParams{});
+  r.isoIndexCount = r.hullVertexCount = r.lineVertexCount = 0;
 }
 
-void uploadBoundary(Renderer& r, const BoundaryMesh& b) {
+void uploadSurface(Renderer& r, const IncrementalIsosurface& s) {
+  const bool full = s.fullUploadNeeded();
+  glBindVertexArray(0);  // keep the VAO's element binding untouched by the array uploads
+  sync(r, GL_ARRAY_BUFFER, r.isoPositions, s.positions().data(), s.vertexSlotCount(), 12, s.changedVertices(), full);
+  sync(r, GL_ARRAY_BUFFER, r.isoNormals, s.normals().data(), s.vertexSlotCount(), 12, s.changedVertices(), full);
+  glBindVertexArray(r.isoVao);  // the element buffer is bound through the VAO
+  sync(r, GL_ELEMENT_ARRAY_BUFFER, r.isoIndices, s.indices().data(), s.triangleCount(), 12, s.changedTriangles(), full);
   glBindVertexArray(0);
-  upload(GL_ARRAY_BUFFER, r.hullBuffers[0], b.positions.data(), b.positions.size() * sizeof(float));
-  upload(GL_ARRAY_BUFFER, r.hullBuffers[1], b.normals.data(), b.normals.size() * sizeof(float));
-  upload(GL_ARRAY_BUFFER, r.lineBuffer, b.featureLines.data(), b.featureLines.size() * sizeof(float));
-  r.hullVertexCount = int32_t(b.positions.size() / 3);
-  r.lineVertexCount = int32_t(b.featureLines.size() / 3);
+  r.isoIndexCount = int32_t(3 * s.triangleCount());
+}
+
+void uploadHull(Renderer& r, const HullTracker& h) {
+  const bool full = h.fullUploadNeeded();
+  glBindVertexArray(0);
+  sync(r, GL_ARRAY_BUFFER, r.hullPositions, h.trianglePositions().data(), h.triangleCount(), 36, h.changedTriangles(), full);
+  sync(r, GL_ARRAY_BUFFER, r.hullNormals, h.triangleNormals().data(), h.triangleCount(), 36, h.changedTriangles(), full);
+  sync(r, GL_ARRAY_BUFFER, r.lines, h.lineVertices().data(), h.lineCount(), 24, h.changedLines(), full);
+  r.hullVertexCount = int32_t(3 * h.triangleCount());
+  r.lineVertexCount = int32_t(2 * h.lineCount());
 }
 
 void drawScene(const Renderer& r, const FrameParams& p) {

@@ -1,27 +1,44 @@
 // WebGL2 renderer (OpenGL ES 3.0, "#version 300 es" shaders): the isosurface lit and shaded
 // from a headlight, two-sided (the low-field side has a cool tint, the high-field side a warm
 // one), and the domain boundary as a faint translucent hull with its crease edges drawn as lines.
-// Buffers are uploaded only when the viewer state says the surface or the level changed.
+//
+// Uploads follow the model's change lists: while splits stream in, only the slots written since
+// the last frame go to the GPU (bufferSubData over runs of nearby slots); a whole buffer is sent
+// only after a full extraction (isovalue, field) or when it has to grow (doubling, so rarely).
 // Needs a current GL context; everything else about the viewer lives in GL-free files.
 #pragma once
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 
-#include "isosurface.h"
+#include "isosurface_incremental.h"
 #include "viewer_state.h"
 
 namespace tetstream::viewer {
 
+// A GL buffer and how many elements (of the caller's element size) it can hold.
+struct GpuBuffer {
+  uint32_t id = 0;
+  uint32_t capacity = 0;
+};
+
+// What went to the GPU, for the stats (tests check that streaming uploads stay partial).
+struct UploadStats {
+  uint64_t bytes = 0;
+  uint32_t full = 0, partial = 0;  // buffer uploads of each kind
+};
+
 struct Renderer {
   uint32_t isoProgram = 0, hullProgram = 0, lineProgram = 0, backgroundProgram = 0;
-  uint32_t isoVao = 0, isoBuffers[3] = {};  // positions, normals, indices
-  uint32_t hullVao = 0, hullBuffers[2] = {};
-  uint32_t lineVao = 0, lineBuffer = 0;
-  uint32_t emptyVao = 0;
+  uint32_t isoVao = 0, hullVao = 0, lineVao = 0, emptyVao = 0;
+  GpuBuffer isoPositions, isoNormals, isoIndices;  // elements: vertex slots, vertex slots, triangles
+  GpuBuffer hullPositions, hullNormals, lines;     // elements: triangles, triangles, segments
   int32_t isoView = -1, isoProj = -1, hullView = -1, hullProj = -1, lineViewProj = -1;
   int32_t isoIndexCount = 0, hullVertexCount = 0, lineVertexCount = 0;
+  UploadStats uploads;
+  std::vector<uint32_t> scratch;  // sorted change lists
 };
 
 // Compiles shaders and creates buffers. On failure returns false with the GL log in `error`.
@@ -29,8 +46,14 @@ struct Renderer {
 bool initRenderer(Renderer& r, std::string& info, std::string& error);
 void destroyRenderer(Renderer& r);
 
-void uploadSurface(Renderer& r, const IsoSurface& surface);
-void uploadBoundary(Renderer& r, const BoundaryMesh& boundary);
+// Draws one clipped-away triangle through every program and state drawScene uses, so that the
+// GL implementation compiles its pipelines now (while the dataset downloads) and not at the
+// first surface (~0.3 s on SwiftShader).
+void warmUpRenderer(Renderer& r);
+
+// Sends what changed since the model's last clearChanges(); the caller clears them afterwards.
+void uploadSurface(Renderer& r, const IncrementalIsosurface& surface);
+void uploadHull(Renderer& r, const HullTracker& hull);
 
 struct FrameParams {
   glm::mat4 view{1.f}, projection{1.f};

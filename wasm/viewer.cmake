@@ -34,7 +34,8 @@ target_compile_options(tetstream_viewer PRIVATE -Wno-deprecated-volatile)
 
 set(TETSTREAM_VIEWER_EXPORTS
   _main _malloc _free
-  _ts_open_manifest _ts_chunk_file _ts_add_chunk _ts_set_isovalue _ts_set_field _ts_fail _ts_stats_json)
+  _ts_open_manifest _ts_chunk_file _ts_add_chunk _ts_download_progress _ts_set_paused _ts_set_level
+  _ts_set_isovalue _ts_set_field _ts_fail _ts_stats_json)
 list(JOIN TETSTREAM_VIEWER_EXPORTS "," TETSTREAM_VIEWER_EXPORTS)
 target_link_options(tetstream_viewer PRIVATE
   -sUSE_GLFW=3

@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 
 #include <nlohmann/json.hpp>
 
 #include "adjacency.h"
+#include "tet_tables.h"
 
 namespace tetstream::viewer {
 namespace {
@@ -17,6 +19,85 @@ double nowMs() {
 }
 
 float middleOf(const Range& r) { return r.min + 0.5f * (r.max - r.min); }
+
+// Boundary edges whose two triangles' normals differ by more than ~30 degrees are creases.
+constexpr float kCreaseCos = 0.866f;
+
+uint64_t edgeKey(uint32_t a, uint32_t b) { return a < b ? uint64_t(a) << 32 | b : uint64_t(b) << 32 | a; }
+
+uint64_t mix(uint64_t x) {  // splitmix64 finaliser
+  x ^= x >> 30;
+  x *= 0xbf58476d1ce4e5b9ull;
+  x ^= x >> 27;
+  x *= 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+// Outward unit normal of triangle (a, b, c), 0 when degenerate.
+void faceNormal(const float* p, const uint32_t tri[3], float n[3]) {
+  const float* a = p + 3 * size_t(tri[0]);
+  const float* b = p + 3 * size_t(tri[1]);
+  const float* c = p + 3 * size_t(tri[2]);
+  float u[3], v[3];
+  for (int k = 0; k < 3; ++k) u[k] = b[k] - a[k], v[k] = c[k] - a[k];
+  n[0] = u[1] * v[2] - u[2] * v[1];
+  n[1] = u[2] * v[0] - u[0] * v[2];
+  n[2] = u[0] * v[1] - u[1] * v[0];
+  float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  for (int k = 0; k < 3; ++k) n[k] = len > 0 ? n[k] / len : 0.f;
+}
+
+// The values of the chosen field on the current level, empty when there is none.
+std::span<const float> fieldValues(const ViewerState& s) {
+  const TetMesh& mesh = s.dataset.pm.mesh;
+  if (s.field < 0 || mesh.tetCount() == 0) return {};
+  int f = mesh.findField(s.dataset.manifest.fields[size_t(s.field)].name);
+  if (f < 0 || mesh.fields[size_t(f)].values.size() != mesh.vertexCount()) return {};
+  return mesh.fields[size_t(f)].values;
+}
+
+// The whole surface of the current level (isovalue or field changed, or the base arrived).
+void extract(ViewerState& s) {
+  s.surfaceDirty = true;
+  std::span<const float> values = fieldValues(s);
+  if (values.empty()) {
+    s.surface.reset();
+    s.extractMs = 0;
+    return;
+  }
+  double t0 = nowMs();
+  s.surface.rebuild(s.dataset.pm.mesh, values, s.isovalue);
+  s.extractMs = nowMs() - t0;
+  s.surfaceReady = true;
+}
+
+// Growing the mesh arrays by doubling while streaming would copy tens of MB inside one frame
+// (~20 ms natively at 1 M tets): size them for the full mesh once, as the manifest announces
+// it. The manifest is untrusted, so only up to 4 M tets (~100 MB); bigger meshes grow as usual.
+void reserveFullLevel(Dataset& ds) {
+  constexpr uint32_t kMaxReservedTets = 4u << 20;
+  const Manifest& m = ds.manifest;
+  if (m.tets > kMaxReservedTets || m.vertices > kMaxReservedTets) return;
+  ProgressiveMesh& pm = ds.pm;
+  pm.mesh.positions.reserve(3 * size_t(m.vertices));
+  pm.mesh.tets.reserve(4 * size_t(m.tets));
+  for (ScalarField& f : pm.mesh.fields) f.values.reserve(m.vertices);
+  pm.cornerNext.reserve(4 * size_t(m.tets));
+  pm.vertexHead.reserve(m.vertices);
+  pm.splitJ.reserve(m.vertices);
+  pm.splitTetsBefore.reserve(m.vertices);
+}
+
+void updateState(ViewerState& s) {
+  if (s.state == LoadState::Idle || s.state == LoadState::Error) return;
+  const Dataset& ds = s.dataset;
+  if (ds.chunksReceived == 0)
+    s.state = LoadState::Loading;
+  else if (ds.chunksReceived == s.chunksTotal && ds.splitsApplied() == ds.splitsReceived())
+    s.state = LoadState::Complete;
+  else
+    s.state = LoadState::Streaming;
+}
 
 }  // namespace
 
@@ -31,21 +112,26 @@ const char* loadStateName(LoadState s) {
   return "error";
 }
 
+// ------------------------------------------------------------------ loading and level
+
 Result openManifest(ViewerState& s, std::string_view manifestJson) {
-  s.surface.clear();
-  s.boundary = {};
-  s.surfaceDirty = s.boundaryDirty = true;
-  s.boundaryStale = false;
+  s.surface.reset();
+  s.hull.clear();
+  s.surfaceDirty = s.hullDirty = true;
   s.surfaceReady = false;
-  s.surfaceArea = 0;
-  s.chunksLoaded = s.chunksTotal = 0;
+  s.chunksTotal = 0;
   s.field = -1;
-  s.bytesLoaded = manifestJson.size();
+  s.targetSplits = 0;
+  s.live = true;
+  s.paused = false;
+  s.networkBytes = s.datasetBytes = 0;
+  s.rate.reset();
+  s.rateBytesPerSec = 0;
+  s.completeMs = -1;
   if (Result r = openDataset(s.dataset, manifestJson); !r) {
     s.dataset.manifest = {};
     s.dataset.pm = {};
-    s.dataset.chunksApplied = 0;
-    s.dataset.bytesApplied = 0;
+    s.dataset.chunksReceived = 0;
     failLoad(s, "The dataset description (manifest.json) is not usable: " + r.message);
     return r;
   }
@@ -68,18 +154,89 @@ Result addChunk(ViewerState& s, uint32_t index, std::span<const uint8_t> bytes) 
     if (s.state != LoadState::Error) failLoad(s, r.message);
     return r;
   }
-  if (Result r = applyChunk(s.dataset, index, bytes); !r) {
+  Dataset& ds = s.dataset;
+  if (Result r = receiveChunk(ds, index, bytes); !r) {
     failLoad(s, "Part " + std::to_string(index + 1) + " of " + std::to_string(s.chunksTotal) +
                     " of the dataset could not be used: " + r.message +
-                    (s.chunksLoaded ? ". Showing the last complete level." : "."));
+                    (ds.chunksReceived ? ". Showing the last complete level." : "."));
     return r;
   }
-  s.chunksLoaded = s.dataset.chunksApplied;
-  s.bytesLoaded += bytes.size();
-  s.state = s.chunksLoaded == s.chunksTotal ? LoadState::Complete : LoadState::Streaming;
-  s.boundaryStale = true;
-  extract(s);
+  if (ds.chunksReceived == 1) {  // the base: shown at once
+    reserveFullLevel(ds);
+    extract(s);
+    s.hull.rebuild(ds.pm);
+    s.hullDirty = true;
+  }
+  if (s.live) s.targetSplits = ds.splitsReceived();
+  updateState(s);
   return Result::success();
+}
+
+bool advance(ViewerState& s, double deadlineMs, Clock now) {
+  Dataset& ds = s.dataset;
+  if (ds.chunksReceived == 0 || std::min(s.targetSplits, ds.splitsReceived()) == ds.splitsApplied()) {
+    updateState(s);
+    return false;
+  }
+  const double t0 = now();
+  const uint32_t base = ds.pm.baseVertices;
+  uint32_t steps = 0;
+  do {
+    const uint32_t target = std::min(s.targetSplits, ds.splitsReceived());
+    const uint32_t a0 = ds.splitsApplied();
+    if (a0 == target) break;
+    const uint32_t n = std::min(kStepBatch, a0 > target ? a0 - target : target - a0);
+    s.changed.clear();
+    s.splitVertices.clear();
+    // The hull needs every split's i and j; an undo forgets j, so read it first.
+    if (a0 > target)
+      for (uint32_t g = a0 - n; g < a0; ++g) s.splitVertices.insert(s.splitVertices.end(), {base + g, ds.pm.splitJ[g]});
+    bool reached = false;
+    Result r = stepTowards(ds, target, n, s.changed, &reached);
+    const uint32_t a1 = ds.splitsApplied();
+    for (uint32_t g = a0; g < a1; ++g) s.splitVertices.insert(s.splitVertices.end(), {base + g, ds.pm.splitJ[g]});
+    steps += a1 > a0 ? a1 - a0 : a0 - a1;
+    // Paper §4.3: only the changed tets (T_new, T_moved, and the removed ones) are looked at.
+    if (std::span<const float> values = fieldValues(s); !values.empty())
+      s.surface.updateTets(ds.pm.mesh, values, s.changed);
+    if (!r) {
+      // The bad chunk and everything after it are gone (undone further than this batch): the
+      // surface followed through `changed`, the hull is rebuilt once.
+      s.hull.rebuild(ds.pm);
+      s.targetSplits = std::min(s.targetSplits, ds.splitsReceived());
+      failLoad(s, "Part " + std::to_string(ds.chunksReceived + 1) + " of " + std::to_string(s.chunksTotal) +
+                      " of the dataset is damaged (" + r.message + "). Showing the last complete level.");
+      break;
+    }
+    s.hull.update(ds.pm, s.splitVertices);
+  } while (now() < deadlineMs);
+  s.surfaceDirty = s.hullDirty = true;
+  s.refineMs = now() - t0;
+  s.maxRefineMs = std::max(s.maxRefineMs, s.refineMs);
+  s.refineSteps = steps;
+  updateState(s);
+  return true;
+}
+
+void setLevel(ViewerState& s, uint32_t splits) {
+  const uint32_t received = s.dataset.splitsReceived();
+  s.targetSplits = std::min(splits, received);
+  s.live = splits >= received;
+  updateState(s);
+}
+
+void setLevelFraction(ViewerState& s, double fraction) {
+  if (!std::isfinite(fraction)) return;
+  const Dataset& ds = s.dataset;
+  if (fraction >= 1) return setLevel(s, ~0u);
+  double vertices = std::round(std::max(0.0, fraction) * ds.manifest.vertices);
+  setLevel(s, vertices > ds.pm.baseVertices ? uint32_t(vertices - ds.pm.baseVertices) : 0);
+}
+
+void setPaused(ViewerState& s, bool paused) {
+  if (s.paused == paused) return;
+  s.paused = paused;
+  s.pausedChanged = true;
 }
 
 void setIsovalue(ViewerState& s, float value) {
@@ -93,6 +250,7 @@ bool setField(ViewerState& s, int index) {
   if (index < 0 || size_t(index) >= m.fields.size()) return false;
   s.field = index;
   s.isovalue = middleOf(m.fields[size_t(index)].range);
+  s.surface.reset();  // another field: the interval tree is built again
   extract(s);
   return true;
 }
@@ -104,29 +262,60 @@ void failLoad(ViewerState& s, std::string_view message) {
   s.error = message.empty() ? "Unknown error." : std::string(message);
 }
 
-void extract(ViewerState& s) {
-  const TetMesh& mesh = s.dataset.pm.mesh;
-  s.surfaceDirty = true;
-  int f = s.field >= 0 ? mesh.findField(s.dataset.manifest.fields[size_t(s.field)].name) : -1;
-  if (mesh.tetCount() == 0 || f < 0 || mesh.fields[size_t(f)].values.size() != mesh.vertexCount()) {
-    s.surface.clear();
-    s.surfaceArea = 0;
-    s.extractMs = 0;
-    return;
-  }
-  double t0 = nowMs();
-  extractIsosurface(mesh, mesh.fields[size_t(f)].values, s.isovalue, s.extractor, s.surface);
-  s.extractMs = nowMs() - t0;
-  s.surfaceArea = surfaceArea(s.surface);
-  s.surfaceReady = true;
+// ------------------------------------------------------------------ download figures
+
+void RateMeter::add(double nowMs, double totalBytes) {
+  latestT_ = nowMs;
+  latestBytes_ = totalBytes;
+  if (count_ > 0 && nowMs - t_[(head_ + kSamples - 1) % kSamples] < 100) return;
+  t_[head_] = nowMs;
+  bytes_[head_] = totalBytes;
+  head_ = (head_ + 1) % kSamples;
+  count_ = std::min(count_ + 1, kSamples);
 }
 
-void updateBoundary(ViewerState& s) {
-  if (!s.boundaryStale) return;
-  buildBoundary(s.dataset.pm.mesh, s.boundary);
-  s.boundaryStale = false;
-  s.boundaryDirty = true;
+double RateMeter::bytesPerSecond(double nowMs, double windowMs) const {
+  // The oldest sample inside the window is the reference; bytes since then over time since then.
+  for (int i = count_; i > 0; --i) {
+    int k = (head_ + kSamples - i) % kSamples;
+    if (t_[k] < nowMs - windowMs) continue;
+    double dt = std::max(nowMs, latestT_) - t_[k];
+    return dt > 0 ? (latestBytes_ - bytes_[k]) * 1000.0 / dt : 0;
+  }
+  return 0;
 }
+
+void noteDownload(ViewerState& s, uint64_t networkBytes, uint64_t datasetBytes, double nowMs) {
+  s.networkBytes = networkBytes;
+  s.datasetBytes = datasetBytes;
+  s.rate.add(nowMs, double(networkBytes));
+}
+
+void tick(ViewerState& s, double nowMs) { s.rateBytesPerSec = downloading(s) ? s.rate.bytesPerSecond(nowMs) : 0; }
+
+bool downloading(const ViewerState& s) {
+  return (s.state == LoadState::Loading || s.state == LoadState::Streaming) && !s.paused &&
+         s.dataset.chunksReceived < s.chunksTotal;
+}
+
+double secondsLeft(const ViewerState& s) {
+  if (!downloading(s) || s.rateBytesPerSec <= 0) return -1;
+  uint64_t total = s.dataset.manifest.totalBytes();
+  uint64_t have = std::max(s.datasetBytes, s.dataset.bytesReceived);
+  return have >= total ? 0 : double(total - have) / s.rateBytesPerSec;
+}
+
+double levelFraction(const ViewerState& s) {
+  uint32_t full = s.dataset.manifest.vertices;
+  return full ? double(s.dataset.pm.vertexCount()) / full : 0;
+}
+
+double fieldErrorBound(const ViewerState& s) {
+  uint32_t c = s.dataset.chunksApplied();
+  return c ? s.dataset.manifest.chunks[c - 1].fieldError : -1;
+}
+
+// ------------------------------------------------------------------ the hull, from scratch
 
 void buildBoundary(const TetMesh& mesh, BoundaryMesh& out) {
   out = {};
@@ -142,15 +331,10 @@ void buildBoundary(const TetMesh& mesh, BoundaryMesh& out) {
   out.positions.reserve(9 * nt);
   out.normals.reserve(9 * nt);
   for (size_t t = 0; t < nt; ++t) {
-    const float* a = p + 3 * size_t(tris[3 * t]);
-    const float* b = p + 3 * size_t(tris[3 * t + 1]);
-    const float* c = p + 3 * size_t(tris[3 * t + 2]);
-    float u[3], v[3];
-    for (int k = 0; k < 3; ++k) { u[k] = b[k] - a[k]; v[k] = c[k] - a[k]; }
-    float n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
-    float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    for (int k = 0; k < 3; ++k) n[k] = len > 0 ? n[k] / len : 0.f;
-    for (const float* q : {a, b, c}) {
+    float n[3];
+    faceNormal(p, &tris[3 * t], n);
+    for (int k = 0; k < 3; ++k) {
+      const float* q = p + 3 * size_t(tris[3 * t + k]);
       out.positions.insert(out.positions.end(), q, q + 3);
       out.normals.insert(out.normals.end(), n, n + 3);
     }
@@ -167,12 +351,8 @@ void buildBoundary(const TetMesh& mesh, BoundaryMesh& out) {
   std::vector<EdgeUse> edges;
   edges.reserve(3 * nt);
   for (size_t t = 0; t < nt; ++t)
-    for (int k = 0; k < 3; ++k) {
-      uint32_t a = tris[3 * t + k], b = tris[3 * t + (k + 1) % 3];
-      edges.push_back({uint64_t(std::min(a, b)) << 32 | std::max(a, b), uint32_t(t)});
-    }
+    for (int k = 0; k < 3; ++k) edges.push_back({edgeKey(tris[3 * t + k], tris[3 * t + (k + 1) % 3]), uint32_t(t)});
   std::sort(edges.begin(), edges.end(), [](const EdgeUse& x, const EdgeUse& y) { return x.key < y.key; });
-  const float kCreaseCos = 0.866f;
   for (size_t i = 0; i < edges.size();) {
     size_t j = i;
     while (j < edges.size() && edges[j].key == edges[i].key) ++j;
@@ -191,32 +371,292 @@ void buildBoundary(const TetMesh& mesh, BoundaryMesh& out) {
   }
 }
 
+// ------------------------------------------------------------------ the hull, kept up to date
+
+void HullTracker::clear() {
+  faces_.clear();
+  positions_.clear();
+  normals_.clear();
+  head_.clear();
+  next_.clear();
+  prev_.clear();
+  lines_.clear();
+  lineKeys_.clear();
+  lineOfEdge_.clear();
+  dirtyEdges_.clear();
+  changedTriangles_.clear();
+  changedLines_.clear();
+  fullUpload_ = true;
+}
+
+void HullTracker::clearChanges() {
+  changedTriangles_.clear();
+  changedLines_.clear();
+  fullUpload_ = false;
+}
+
+void HullTracker::rebuild(const ProgressiveMesh& pm) {
+  clear();
+  const TetMesh& mesh = pm.mesh;
+  head_.assign(mesh.vertexCount(), kNone);
+  if (mesh.tetCount() == 0) return;
+  FaceAdjacency adj;
+  buildFaceAdjacency(mesh.tets, mesh.vertexCount(), adj);
+  std::vector<uint32_t> tris;
+  extractBoundary(mesh.tets, adj, tris);
+  for (size_t t = 0; t + 2 < tris.size(); t += 3) addFace(mesh.positions.data(), &tris[t]);
+  std::sort(dirtyEdges_.begin(), dirtyEdges_.end());
+  dirtyEdges_.erase(std::unique(dirtyEdges_.begin(), dirtyEdges_.end()), dirtyEdges_.end());
+  for (uint64_t e : dirtyEdges_) updateEdge(mesh.positions.data(), e);
+  dirtyEdges_.clear();
+  fullUpload_ = true;
+}
+
+void HullTracker::update(const ProgressiveMesh& pm, std::span<const uint32_t> vertices) {
+  const uint32_t nv = pm.vertexCount();
+  if (head_.size() < nv) head_.resize(nv, kNone);
+  vertexScratch_.assign(vertices.begin(), vertices.end());
+  std::sort(vertexScratch_.begin(), vertexScratch_.end());
+  vertexScratch_.erase(std::unique(vertexScratch_.begin(), vertexScratch_.end()), vertexScratch_.end());
+  // Removed vertices first (their faces go), then a recount around each remaining one. Every
+  // face whose set of tets changed contains a split's i or j, so nothing else can change.
+  std::vector<uint32_t>& drop = dropScratch_;
+  for (uint32_t v : vertexScratch_) {
+    if (v < nv || v >= head_.size()) continue;
+    drop.clear();
+    for (uint32_t c = head_[v]; c != kNone; c = next_[c]) drop.push_back(c / 3);
+    std::sort(drop.begin(), drop.end(), std::greater<>());
+    for (uint32_t slot : drop) removeFace(slot);
+  }
+  for (uint32_t v : vertexScratch_)
+    if (v < nv) recount(pm, v);
+  std::sort(dirtyEdges_.begin(), dirtyEdges_.end());
+  dirtyEdges_.erase(std::unique(dirtyEdges_.begin(), dirtyEdges_.end()), dirtyEdges_.end());
+  for (uint64_t e : dirtyEdges_) updateEdge(pm.mesh.positions.data(), e);
+  dirtyEdges_.clear();
+}
+
+// The faces containing v: a face with one tet is on the boundary, with two it is inside.
+// Keyed by the two other vertices. Most split vertices are inside the domain: an XOR of the
+// faces' hashes, where every face seen twice cancels, tells so without sorting (a boundary face
+// would have to hash to exactly the XOR of the others to go unnoticed: p ~ 2^-64).
+void HullTracker::recount(const ProgressiveMesh& pm, uint32_t v) {
+  const uint32_t* tets = pm.mesh.tets.data();
+  entries_.clear();
+  uint64_t parity = 0;
+  for (uint32_t c = pm.vertexHead[v]; c != kNoCorner; c = pm.cornerNext[c]) {
+    const uint32_t t = c >> 2, k = c & 3;
+    for (uint32_t f = 0; f < 4; ++f) {
+      if (f == k) continue;  // face f is opposite local vertex f: the others contain v
+      uint32_t other[2], n = 0;
+      for (int i = 0; i < 3; ++i)
+        if (kTetFaces[f][i] != k) other[n++] = tets[4 * t + kTetFaces[f][i]];
+      const uint64_t key = edgeKey(other[0], other[1]);
+      parity ^= mix(key);
+      entries_.push_back({key, t << 2 | f});
+    }
+  }
+  if (parity == 0 && head_[v] == kNone) return;
+  std::sort(entries_.begin(), entries_.end(), [](const FaceEntry& x, const FaceEntry& y) { return x.key < y.key; });
+  auto countOf = [&](uint64_t key) {
+    auto lo = std::lower_bound(entries_.begin(), entries_.end(), key,
+                               [](const FaceEntry& e, uint64_t k) { return e.key < k; });
+    size_t n = 0;
+    for (; lo != entries_.end() && lo->key == key; ++lo) ++n;
+    return n;
+  };
+  auto keyWithout = [&](uint32_t slot) {
+    const uint32_t* f = &faces_[3 * size_t(slot)];
+    return f[0] == v ? edgeKey(f[1], f[2]) : f[1] == v ? edgeKey(f[0], f[2]) : edgeKey(f[0], f[1]);
+  };
+
+  std::vector<uint32_t>& drop = dropScratch_;
+  drop.clear();
+  for (uint32_t c = head_[v]; c != kNone; c = next_[c])
+    if (countOf(keyWithout(c / 3)) != 1) drop.push_back(c / 3);
+  std::sort(drop.begin(), drop.end(), std::greater<>());
+  for (uint32_t slot : drop) removeFace(slot);
+
+  for (size_t i = 0; i < entries_.size();) {
+    size_t j = i + 1;
+    while (j < entries_.size() && entries_[j].key == entries_[i].key) ++j;
+    if (j - i == 1) {
+      bool present = false;
+      for (uint32_t c = head_[v]; c != kNone && !present; c = next_[c]) present = keyWithout(c / 3) == entries_[i].key;
+      if (!present) {
+        const uint32_t t = entries_[i].tetFace >> 2, f = entries_[i].tetFace & 3;
+        const uint32_t tri[3] = {tets[4 * t + kTetFaces[f][0]], tets[4 * t + kTetFaces[f][1]],
+                                 tets[4 * t + kTetFaces[f][2]]};
+        addFace(pm.mesh.positions.data(), tri);
+      }
+    }
+    i = j;
+  }
+}
+
+void HullTracker::link(uint32_t corner, uint32_t v) {
+  next_[corner] = head_[v];
+  prev_[corner] = kNone;
+  if (head_[v] != kNone) prev_[head_[v]] = corner;
+  head_[v] = corner;
+}
+
+void HullTracker::unlink(uint32_t corner) {
+  const uint32_t v = faces_[corner];
+  if (prev_[corner] != kNone)
+    next_[prev_[corner]] = next_[corner];
+  else
+    head_[v] = next_[corner];
+  if (next_[corner] != kNone) prev_[next_[corner]] = prev_[corner];
+}
+
+void HullTracker::markEdges(const uint32_t tri[3]) {
+  for (int k = 0; k < 3; ++k) dirtyEdges_.push_back(edgeKey(tri[k], tri[(k + 1) % 3]));
+}
+
+void HullTracker::addFace(const float* p, const uint32_t tri[3]) {
+  const uint32_t slot = triangleCount();
+  faces_.insert(faces_.end(), tri, tri + 3);
+  float n[3];
+  faceNormal(p, tri, n);
+  for (int k = 0; k < 3; ++k) {
+    const float* q = p + 3 * size_t(tri[k]);
+    positions_.insert(positions_.end(), q, q + 3);
+    normals_.insert(normals_.end(), n, n + 3);
+  }
+  next_.resize(faces_.size());
+  prev_.resize(faces_.size());
+  for (uint32_t k = 0; k < 3; ++k) link(3 * slot + k, tri[k]);
+  markEdges(tri);
+  if (!fullUpload_) changedTriangles_.push_back(slot);
+}
+
+void HullTracker::removeFace(uint32_t slot) {
+  markEdges(&faces_[3 * size_t(slot)]);
+  for (uint32_t k = 0; k < 3; ++k) unlink(3 * slot + k);
+  const uint32_t last = triangleCount() - 1;
+  if (slot != last) {
+    for (uint32_t k = 0; k < 3; ++k) unlink(3 * last + k);
+    std::copy_n(&faces_[3 * size_t(last)], 3, &faces_[3 * size_t(slot)]);
+    std::copy_n(&positions_[9 * size_t(last)], 9, &positions_[9 * size_t(slot)]);
+    std::copy_n(&normals_[9 * size_t(last)], 9, &normals_[9 * size_t(slot)]);
+    for (uint32_t k = 0; k < 3; ++k) link(3 * slot + k, faces_[3 * slot + k]);
+    if (!fullUpload_) changedTriangles_.push_back(slot);
+  }
+  faces_.resize(3 * size_t(last));
+  positions_.resize(9 * size_t(last));
+  normals_.resize(9 * size_t(last));
+  next_.resize(faces_.size());
+  prev_.resize(faces_.size());
+}
+
+void HullTracker::updateEdge(const float* p, uint64_t key) {
+  const uint32_t a = uint32_t(key >> 32), b = uint32_t(key);
+  uint32_t count = 0, slots[2] = {kNone, kNone};
+  if (a < head_.size())
+    for (uint32_t c = head_[a]; c != kNone; c = next_[c]) {
+      const uint32_t* f = &faces_[3 * size_t(c / 3)];
+      if (f[0] != b && f[1] != b && f[2] != b) continue;
+      if (count < 2) slots[count] = c / 3;
+      ++count;
+    }
+  bool draw = count == 1 || count > 2;
+  if (count == 2) {
+    const float* n0 = &normals_[9 * size_t(slots[0])];
+    const float* n1 = &normals_[9 * size_t(slots[1])];
+    draw = n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2] < kCreaseCos;
+  }
+  const uint32_t line = lineOfEdge_.find(key);
+  if (draw && line == SurfaceVertexMap::kNone) {
+    const uint32_t slot = lineCount();
+    lines_.insert(lines_.end(), p + 3 * size_t(a), p + 3 * size_t(a) + 3);
+    lines_.insert(lines_.end(), p + 3 * size_t(b), p + 3 * size_t(b) + 3);
+    lineKeys_.push_back(key);
+    bool inserted;
+    lineOfEdge_.findOrInsert(key, slot, &inserted);
+    if (!fullUpload_) changedLines_.push_back(slot);
+  } else if (!draw && line != SurfaceVertexMap::kNone) {
+    removeLine(line);
+  }
+}
+
+void HullTracker::removeLine(uint32_t slot) {
+  lineOfEdge_.erase(lineKeys_[slot]);
+  const uint32_t last = lineCount() - 1;
+  if (slot != last) {
+    const uint64_t moved = lineKeys_[last];
+    lineOfEdge_.erase(moved);
+    bool inserted;
+    lineOfEdge_.findOrInsert(moved, slot, &inserted);
+    lineKeys_[slot] = moved;
+    std::copy_n(&lines_[6 * size_t(last)], 6, &lines_[6 * size_t(slot)]);
+    if (!fullUpload_) changedLines_.push_back(slot);
+  }
+  lineKeys_.pop_back();
+  lines_.resize(6 * size_t(last));
+}
+
+// ------------------------------------------------------------------ stats
+
 std::string statsJson(const ViewerState& s) {
   using json = nlohmann::json;
   const Dataset& ds = s.dataset;
+  const Manifest& m = ds.manifest;
   json fields = json::array();
-  for (const FieldInfo& f : ds.manifest.fields) fields.push_back(json{{"name", f.name}, {"min", f.range.min}, {"max", f.range.max}});
+  for (const FieldInfo& f : m.fields) fields.push_back(json{{"name", f.name}, {"min", f.range.min}, {"max", f.range.max}});
+  auto rect = [](const Rect& r) { return json{{"x", r.x}, {"y", r.y}, {"w", r.w}, {"h", r.h}}; };
+  auto time = [](double t) { return t >= 0 ? json(t) : json(nullptr); };
+  uint32_t splitsTotal = 0;
+  for (size_t c = 1; c < m.chunks.size(); ++c) splitsTotal += m.chunks[c].splits;
+  const double fieldError = fieldErrorBound(s);
+  const double left = secondsLeft(s);
   json j = {
       {"state", loadStateName(s.state)},
       {"error", s.error},
-      {"name", ds.manifest.name},
+      {"name", m.name},
       {"vertices", ds.pm.mesh.vertexCount()},
       {"tets", ds.pm.mesh.tetCount()},
       {"triangles", s.surface.triangleCount()},
       {"surfaceVertices", s.surface.vertexCount()},
       {"isovalue", s.isovalue},
-      {"surfaceArea", s.surfaceArea},
-      {"field", s.field >= 0 ? json(ds.manifest.fields[size_t(s.field)].name) : json(nullptr)},
+      {"surfaceArea", s.surface.area()},
+      {"field", s.field >= 0 ? json(m.fields[size_t(s.field)].name) : json(nullptr)},
       {"fields", std::move(fields)},
-      {"bytesLoaded", s.bytesLoaded},
-      {"bytesTotal", ds.manifest.totalBytes()},
-      {"chunksLoaded", s.chunksLoaded},
+      {"chunksReceived", ds.chunksReceived},
+      {"chunksApplied", ds.chunksApplied()},
       {"chunksTotal", s.chunksTotal},
-      {"firstSurfaceMs", s.firstSurfaceMs >= 0 ? json(s.firstSurfaceMs) : json(nullptr)},
+      {"bytesReceived", ds.bytesReceived},
+      {"bytesDownloaded", s.networkBytes},
+      {"bytesTotal", m.totalBytes()},
+      {"rateBytesPerSec", s.rateBytesPerSec},
+      {"secondsLeft", left >= 0 ? json(left) : json(nullptr)},
+      {"splitsApplied", ds.splitsApplied()},
+      {"splitsReceived", ds.splitsReceived()},
+      {"splitsTotal", splitsTotal},
+      {"targetSplits", std::min(s.targetSplits, ds.splitsReceived())},
+      {"level", levelFraction(s)},
+      {"live", s.live},
+      {"paused", s.paused},
+      {"fieldError", fieldError >= 0 ? json(fieldError) : json(nullptr)},
+      {"baseVertices", ds.pm.baseVertices},
+      {"hullTriangles", s.hull.triangleCount()},
+      {"hullLines", s.hull.lineCount()},
+      {"firstSurfaceMs", time(s.firstSurfaceMs)},
+      {"completeMs", time(s.completeMs)},
       {"extractMs", s.extractMs},
+      {"refineMs", s.refineMs},
+      {"maxRefineMs", s.maxRefineMs},
+      {"refineSteps", s.refineSteps},
       {"frameMs", s.frameMs},
+      {"maxFrameMs", s.maxFrameMs},
+      {"maxFrameGapMs", s.maxFrameGapMs},
+      {"uploadBytes", s.uploadBytes},
+      {"fullUploads", s.fullUploads},
+      {"partialUploads", s.partialUploads},
       {"showBoundary", s.showBoundary},
-      {"sliderRect", {{"x", s.sliderRect.x}, {"y", s.sliderRect.y}, {"w", s.sliderRect.w}, {"h", s.sliderRect.h}}},
+      {"sliderRect", rect(s.sliderRect)},
+      {"levelSliderRect", rect(s.levelSliderRect)},
+      {"pauseButtonRect", rect(s.pauseButtonRect)},
   };
   // Messages may carry bytes from the network: never let invalid UTF-8 abort the dump.
   return j.dump(-1, ' ', false, json::error_handler_t::replace);

@@ -1,13 +1,23 @@
-// The viewer's model: the dataset streamed so far, the chosen field and isovalue, the current
-// isosurface and the loading state. No GL, no ImGui, no Emscripten: it compiles natively so the
-// viewer's logic can be unit-tested and debugged without a browser.
+// The viewer's model: the dataset streamed so far, the level of detail shown, the chosen field
+// and isovalue, the isosurface and domain hull kept up to date by local edits, and the loading
+// state. No GL, no ImGui, no Emscripten: it compiles natively so the viewer's logic can be
+// unit-tested and debugged without a browser.
 //
 // Flow (driven by wasm/main.cpp from the JS calls documented there):
-//   openManifest(bytes)         state idle/error -> loading (or error)
-//   addChunk(i, bytes) ...      loading -> streaming -> complete; every applied chunk re-extracts
-//   setIsovalue / setField      re-extract at once (a slider drag calls this once a frame)
-//   failLoad(message)           network problems reported by JS -> error
-// Errors never drop what is on screen: the last valid level and its surface stay.
+//   openManifest(bytes)          state idle/error -> loading (or error)
+//   addChunk(i, bytes)           verification only (cheap): the chunk is kept; the base chunk is
+//                                shown at once (surface and hull built)      loading -> streaming
+//   advance(deadline) per frame  applies or undoes splits toward the level target until the
+//                                deadline, updating surface and hull from the changed tets only
+//                                (paper §4.3)        streaming -> complete once all is applied
+//   setLevel / setLevelFraction  moves the target (the level slider); at the newest level the
+//                                target follows new data ("live")
+//   setIsovalue / setField       the whole surface again, through the interval tree (§4.2)
+//   setPaused                    the shell stops or restarts downloading; applying goes on
+//   noteDownload                 network progress reported by the shell (for the rate)
+//   failLoad(message)            network problems reported by JS -> error
+// Errors never drop what is on screen: the last valid level, its surface and hull stay, and the
+// level slider keeps working over the chunks that did arrive.
 #pragma once
 #include <cstdint>
 #include <span>
@@ -16,21 +26,109 @@
 #include <vector>
 
 #include "dataset.h"
-#include "isosurface.h"
+#include "isosurface_incremental.h"
 
 namespace tetstream::viewer {
 
 enum class LoadState : uint8_t { Idle, Loading, Streaming, Complete, Error };
-const char* loadStateName(LoadState s);  // "idle", "loading", "streaming", "complete", "error"
+// "idle", "loading" (no base yet), "streaming" (base shown; chunks still to come or splits not
+// yet applied), "complete" (every chunk received and every split applied), "error".
+const char* loadStateName(LoadState s);
 
-// The domain boundary of the current level, for the translucent hull (GL-free; the renderer
-// uploads it). Triangles are unshared so each carries its flat normal.
+// The domain boundary of a mesh, built from scratch (reference for tests; the viewer keeps a
+// HullTracker instead). Triangles are unshared so each carries its flat normal.
 struct BoundaryMesh {
   std::vector<float> positions;     // 3 per corner, 9 per triangle
   std::vector<float> normals;       // 3 per corner, outward unit normal of the triangle
   std::vector<float> featureLines;  // 6 per segment: boundary edges whose faces meet at a crease
   uint32_t triangleCount() const { return uint32_t(positions.size() / 9); }
   uint32_t lineCount() const { return uint32_t(featureLines.size() / 6); }
+};
+
+// Boundary triangles of a mesh and their crease edges (dihedral angle above ~30 degrees, or an
+// edge not shared by exactly two boundary triangles).
+void buildBoundary(const TetMesh& mesh, BoundaryMesh& out);
+
+// The domain boundary (translucent hull and crease lines) of a ProgressiveMesh, kept up to date
+// across vertex splits and their undo without looking at the whole mesh: only faces and edges
+// at the split vertices can change (a split touches star(i) ∪ star(j) only, paper §4.3), so
+// update() recounts the faces around those vertices.
+//
+// Renderer-facing arrays, dense (a removed slot is refilled with the last one):
+//   trianglePositions(): 9 floats per triangle slot (3 corners), triangleNormals(): the same
+//   layout, the triangle's outward unit normal at each corner; lineVertices(): 6 floats per
+//   crease segment. Change tracking as IncrementalIsosurface: changedTriangles()/changedLines()
+//   list slots written since clearChanges() (possibly >= the current count: ignore those);
+//   fullUploadNeeded() after rebuild().
+// Memory: per boundary triangle about 110 bytes, per vertex 4 bytes, per crease line ~40 bytes.
+class HullTracker {
+ public:
+  static constexpr uint32_t kNone = ~uint32_t(0);
+
+  void clear();
+  // From scratch (face adjacency over the whole mesh): the base level, or after a failure.
+  void rebuild(const ProgressiveMesh& pm);
+  // After splits or undos: `vertices` holds every split's i and j (ids may repeat; ids >=
+  // pm.vertexCount() are vertices removed by undo).
+  void update(const ProgressiveMesh& pm, std::span<const uint32_t> vertices);
+
+  uint32_t triangleCount() const { return uint32_t(faces_.size() / 3); }
+  uint32_t lineCount() const { return uint32_t(lineKeys_.size()); }
+  std::span<const float> trianglePositions() const { return positions_; }
+  std::span<const float> triangleNormals() const { return normals_; }
+  std::span<const float> lineVertices() const { return lines_; }
+  // Boundary triangles as outward-wound vertex id triples (tests).
+  std::span<const uint32_t> faces() const { return faces_; }
+
+  bool fullUploadNeeded() const { return fullUpload_; }
+  std::span<const uint32_t> changedTriangles() const { return changedTriangles_; }
+  std::span<const uint32_t> changedLines() const { return changedLines_; }
+  void clearChanges();
+
+ private:
+  struct FaceEntry {
+    uint64_t key;      // the face's two vertices other than the one recounted (edge key)
+    uint32_t tetFace;  // tet << 2 | local face
+  };
+  void recount(const ProgressiveMesh& pm, uint32_t v);
+  void addFace(const float* positions, const uint32_t tri[3]);
+  void removeFace(uint32_t slot);
+  void link(uint32_t corner, uint32_t v);
+  void unlink(uint32_t corner);
+  void markEdges(const uint32_t tri[3]);
+  void updateEdge(const float* positions, uint64_t key);
+  void removeLine(uint32_t slot);
+
+  // Triangle slots: faces_ 3 vertex ids, positions_/normals_ 9 floats. Corner c = 3 slot + k is
+  // linked into the list of vertex faces_[c] (head_, next_, prev_; kNone ends a list).
+  std::vector<uint32_t> faces_;
+  std::vector<float> positions_, normals_;
+  std::vector<uint32_t> head_, next_, prev_;
+  // Crease lines: lines_ 6 floats per slot, lineKeys_ the edge of each slot, lineOfEdge_ the
+  // reverse (edge key lo << 32 | hi -> slot).
+  std::vector<float> lines_;
+  std::vector<uint64_t> lineKeys_;
+  SurfaceVertexMap lineOfEdge_;
+
+  std::vector<uint64_t> dirtyEdges_;
+  std::vector<FaceEntry> entries_;        // recount scratch
+  std::vector<uint32_t> vertexScratch_, dropScratch_;  // update scratch
+  std::vector<uint32_t> changedTriangles_, changedLines_;
+  bool fullUpload_ = false;
+};
+
+// Download throughput over a sliding window, from cumulative byte counts and times (ms).
+class RateMeter {
+ public:
+  void reset() { count_ = 0; }
+  void add(double nowMs, double totalBytes);
+  double bytesPerSecond(double nowMs, double windowMs = 2000) const;
+
+ private:
+  static constexpr int kSamples = 40;  // at >= 100 ms apart: 4 s of history
+  double t_[kSamples] = {}, bytes_[kSamples] = {};
+  int head_ = 0, count_ = 0;  // newest sample at head_ - 1
+  double latestT_ = 0, latestBytes_ = 0;
 };
 
 // Screen rectangle in CSS pixels relative to the canvas' top-left corner.
@@ -42,39 +140,83 @@ struct ViewerState {
   Dataset dataset;
   int field = -1;        // index into dataset.manifest.fields, -1 before a manifest
   float isovalue = 0;
-  IsoSurface surface;
-  IsoExtractor extractor;  // reused for every extraction
-  BoundaryMesh boundary;
+  IncrementalIsosurface surface;
+  HullTracker hull;
 
   LoadState state = LoadState::Idle;
   std::string error;       // plain words, shown in the panel; empty unless state == Error
+  uint32_t chunksTotal = 0;
 
-  uint64_t bytesLoaded = 0;  // manifest + chunk bytes handed to the viewer
-  uint32_t chunksLoaded = 0, chunksTotal = 0;
-  double firstSurfaceMs = -1;  // performance.now() when the first surface was drawn; -1 = not yet
-  double extractMs = 0;        // duration of the last extraction
-  double frameMs = 0;          // smoothed frame time, set by the main loop
-  double surfaceArea = 0;
+  // Level of detail: splits to have applied. `live`: the target follows new data (the slider
+  // sits at the newest level); cleared when the user moves it back.
+  uint32_t targetSplits = 0;
+  bool live = true;
+  bool paused = false;  // downloading paused by the user (the shell stops fetching)
+
+  // Network, as reported by the shell: bytes off the wire (aborted requests included, for the
+  // rate) and bytes of the dataset in hand (verified chunks plus partial downloads).
+  uint64_t networkBytes = 0, datasetBytes = 0;
+  RateMeter rate;
+  double rateBytesPerSec = 0;  // refreshed by tick()
+
+  // Timings (ms). performance.now()-based absolute times are -1 until they happen.
+  double firstSurfaceMs = -1;  // when the first surface was drawn
+  double completeMs = -1;      // when the frame loop first found the state complete
+  double extractMs = 0;        // duration of the last full extraction (rebuild)
+  double refineMs = 0;         // refinement work in the last frame that did any
+  double maxRefineMs = 0;      // longest refinement work in one frame
+  uint32_t refineSteps = 0;    // splits applied or undone in the last frame that did any
+  // Set by the main loop, counted from the first surface on (before it, start-up work such as
+  // WebGL and ImGui set-up is not the viewer's frame rate):
+  double frameMs = 0;          // smoothed interval between frame callbacks
+  double maxFrameMs = 0;       // longest frame callback (refinement, uploads, drawing)
+  double maxFrameGapMs = 0;    // longest interval between two frame callbacks (browser included)
+  uint64_t uploadBytes = 0;    // GPU bytes uploaded in all (renderer)
+  uint32_t fullUploads = 0, partialUploads = 0;
 
   // Set by the model, cleared by whoever consumes them.
-  bool surfaceDirty = false;   // surface changed: renderer re-uploads the isosurface buffers
-  bool boundaryStale = false;  // level changed: the hull must be rebuilt (updateBoundary)
-  bool boundaryDirty = false;  // hull rebuilt: renderer re-uploads it
+  bool surfaceDirty = false;   // surface changed: renderer uploads the changed ranges
+  bool hullDirty = false;      // hull changed: renderer uploads the changed ranges
   bool frameRequested = false; // new bounds known: the camera should frame them
-  bool surfaceReady = false;   // at least one level has been extracted (first-surface timing)
+  bool surfaceReady = false;   // a level has been extracted (first-surface timing)
+  bool pausedChanged = false;  // the panel toggled pause: the platform tells the shell
 
   // View options and UI feedback.
   bool showBoundary = true;
-  Rect sliderRect;  // the isovalue slider, recorded by the panel so tests can drag it
+  Rect sliderRect;       // the isovalue slider, recorded by the panel so tests can drag it
+  Rect levelSliderRect;  // the level slider
+  Rect pauseButtonRect;  // the pause/resume button (while parts are still to come)
+
+  // Scratch, reused every frame.
+  std::vector<uint32_t> changed, splitVertices;
 };
+
+// Splits per stepTowards call inside advance(), between two looks at the clock: small enough to
+// stop close to the deadline (a split with its surface and hull updates costs ~15-25 us in wasm,
+// so a batch ~0.6 ms).
+inline constexpr uint32_t kStepBatch = 32;
 
 // Parses and validates the manifest (untrusted) and resets everything to the new dataset.
 // The isovalue becomes the middle of the iso field's range.
 Result openManifest(ViewerState& s, std::string_view manifestJson);
 
-// Verifies and applies chunk `index` (must be the next one), then re-extracts the surface and
-// marks the boundary stale. On failure the previous level stays and the state becomes Error.
+// Verifies and keeps chunk `index` (must be the next one); the base chunk is shown at once.
+// Splits are applied later by advance(). On failure the previous level stays and the state
+// becomes Error; chunks are refused once in Error.
 Result addChunk(ViewerState& s, uint32_t index, std::span<const uint8_t> bytes);
+
+// Applies or undoes splits toward targetSplits until now() passes deadlineMs (checked every
+// kStepBatch splits), updating surface and hull locally. Returns true when the level changed.
+// A record that fails to decode ends in Error with the level at the last valid chunk.
+using Clock = double (*)();
+bool advance(ViewerState& s, double deadlineMs, Clock now);
+
+// Level target in splits (clamped to those received) or as a fraction of the full mesh's
+// vertices (clamped likewise). At the newest level the target becomes live.
+void setLevel(ViewerState& s, uint32_t splits);
+void setLevelFraction(ViewerState& s, double fraction);
+
+void setPaused(ViewerState& s, bool paused);
 
 // Re-extracts when the value changes (non-finite values are ignored).
 void setIsovalue(ViewerState& s, float value);
@@ -87,22 +229,25 @@ bool setField(ViewerState& s, std::string_view name);
 // Reports a failure from outside the model (network, platform) in plain words.
 void failLoad(ViewerState& s, std::string_view message);
 
-// Extracts the surface of the current level for the current field and isovalue.
-void extract(ViewerState& s);
+// Network progress from the shell (cumulative counts), and the rate refresh (once a frame).
+void noteDownload(ViewerState& s, uint64_t networkBytes, uint64_t datasetBytes, double nowMs);
+void tick(ViewerState& s, double nowMs);
 
-// Rebuilds the hull when it is stale. Kept out of addChunk because face adjacency costs more
-// than extraction (~0.2 s for 1.5 M tets natively): the platform layer calls this after the
-// first surface is on screen.
-void updateBoundary(ViewerState& s);
-
-// Boundary triangles of a mesh and their crease edges (dihedral angle above ~30 degrees).
-void buildBoundary(const TetMesh& mesh, BoundaryMesh& out);
+// Derived figures for panel and stats.
+double levelFraction(const ViewerState& s);      // vertices shown / vertices of the full mesh
+double fieldErrorBound(const ViewerState& s);    // manifest estimate for the last complete chunk
+bool downloading(const ViewerState& s);          // chunks still to fetch, not paused, no error
+double secondsLeft(const ViewerState& s);        // at the current rate; < 0 when unknown
 
 // Everything a test or the JS shell wants to know, as one JSON object:
 // {state, error, name, vertices, tets, triangles, surfaceVertices, isovalue, surfaceArea, field,
-//  fields:[{name,min,max}], bytesLoaded, bytesTotal, chunksLoaded, chunksTotal, firstSurfaceMs,
-//  extractMs, frameMs, showBoundary, sliderRect:{x,y,w,h}}. Times in ms; firstSurfaceMs is null
-// until the first surface is drawn.
+//  fields:[{name,min,max}], chunksReceived, chunksApplied, chunksTotal, bytesReceived,
+//  bytesDownloaded, bytesTotal, rateBytesPerSec, secondsLeft, splitsApplied, splitsReceived,
+//  splitsTotal, targetSplits, level, live, paused, fieldError, baseVertices, hullTriangles,
+//  hullLines, firstSurfaceMs, completeMs, extractMs, refineMs, maxRefineMs, refineSteps,
+//  frameMs, maxFrameMs, maxFrameGapMs, uploadBytes, fullUploads, partialUploads, showBoundary,
+//  sliderRect:{x,y,w,h}, levelSliderRect:{x,y,w,h}, pauseButtonRect:{x,y,w,h}}.
+// Times in ms; absolute times (firstSurfaceMs, completeMs) are null until they happen.
 std::string statsJson(const ViewerState& s);
 
 }  // namespace tetstream::viewer

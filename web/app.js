@@ -1,17 +1,29 @@
 // tetstream web shell: reads ?data=URL (a packed dataset's manifest.json; relative, absolute or
 // cross-origin with CORS), optional &iso=VALUE and &field=NAME, loads the wasm viewer, streams
-// the manifest and then every chunk in order into it, and reports HTTP/network failures in
-// plain words. The wasm functions used here are documented at the top of wasm/main.cpp.
+// the manifest and then the chunks into it (a few requests in flight, handed over in order as
+// they arrive), and reports HTTP/network failures in plain words. The wasm functions used here
+// are documented at the top of wasm/main.cpp.
 //
 // window.tetstream = {
-//   stats()         -> the viewer's state (statsJson in wasm/viewer_state.h); state is one of
-//                      "idle" (no dataset given), "loading", "streaming", "complete", "error".
-//                      sliderRect is in CSS pixels of the page.
-//   setIsovalue(v)  -> re-extracts the surface at v
-//   setField(name)  -> true when the field exists
+//   stats()          -> the viewer's state (statsJson in wasm/viewer_state.h). state is one of
+//                       "idle" (no dataset given), "loading" (before the base mesh), "streaming"
+//                       (base shown; parts still to come or splits still to apply), "complete"
+//                       (every part received and every split applied), "error". Level fields:
+//                       splitsApplied, splitsReceived, splitsTotal, targetSplits, level (vertices
+//                       shown / full), live, paused, fieldError; network: chunksReceived,
+//                       bytesReceived, bytesDownloaded, bytesTotal, rateBytesPerSec, secondsLeft;
+//                       frame timing: maxFrameMs, maxFrameGapMs, maxRefineMs. sliderRect,
+//                       levelSliderRect and pauseButtonRect are in CSS pixels of the page.
+//   setIsovalue(v)   -> re-extracts the surface at v
+//   setField(name)   -> true when the field exists
+//   setLevel(f)      -> level target: fraction f of the full mesh's vertices, clamped to what has
+//                       been received (0 = base mesh; 1 = newest, and it then follows new data)
+//   pause(), resume() downloading; pausing drops requests under way, the level keeps refining
+//                       up to what has been received
 // }
 
-const MAX_PARALLEL_FETCHES = 4;
+const MAX_IN_FLIGHT = 4; // requests under way at once
+const MAX_AHEAD = 12;    // chunks fetched past the next one the viewer needs
 
 const statusBox = document.getElementById('status');
 const statusText = document.getElementById('status-text');
@@ -44,7 +56,8 @@ function stats() {
   if (!viewer || shellState.aborted) return { ...shellState };
   const s = JSON.parse(viewer.UTF8ToString(viewer._ts_stats_json()));
   const r = canvas.getBoundingClientRect();
-  s.sliderRect = { ...s.sliderRect, x: s.sliderRect.x + r.left, y: s.sliderRect.y + r.top };
+  for (const key of ['sliderRect', 'levelSliderRect', 'pauseButtonRect'])
+    s[key] = { ...s[key], x: s[key].x + r.left, y: s[key].y + r.top };
   return s;
 }
 
@@ -93,6 +106,15 @@ window.tetstream = {
   },
   setField(name) {
     return viewer ? viewer.ccall('ts_set_field', 'number', ['string'], [String(name)]) === 1 : false;
+  },
+  setLevel(fraction) {
+    if (viewer) viewer._ts_set_level(Number(fraction));
+  },
+  pause() {
+    if (viewer) viewer._ts_set_paused(1);
+  },
+  resume() {
+    if (viewer) viewer._ts_set_paused(0);
   },
 };
 
@@ -162,6 +184,137 @@ function loadViewer() {
 }
 
 // ------------------------------------------------------------------ streaming a dataset
+// Chunks are fetched ahead, a few at a time, in the order the viewer needs them, and each is
+// handed over as soon as it and every chunk before it have arrived. Handing over only verifies
+// (cheap); the viewer applies the splits in its frame loop under a per-frame time budget, so
+// downloading, verifying and refining overlap and the page never stalls.
+class ChunkLoader {
+  constructor({ files, sizes, manifestUrl, name, onDone }) {
+    this.files = files;
+    this.sizes = sizes;
+    this.manifestUrl = manifestUrl;
+    this.name = name;
+    this.onDone = onDone;         // called once: every chunk handed over, or stopped
+    this.total = files.length;
+    this.next = 0;               // next chunk to hand to the viewer
+    this.inFlight = new Map();   // index -> { controller, received }
+    this.arrived = new Map();    // index -> bytes, complete but waiting for an earlier chunk
+    this.deliveredBytes = 0;
+    this.networkBytes = 0;       // off the wire, aborted requests included (for the rate)
+    this.paused = false;
+    this.stopped = false;
+    this.failure = null;         // { index, message } of the first chunk that could not be had
+  }
+
+  // Keeps MAX_IN_FLIGHT requests going, never further than MAX_AHEAD chunks past the next one
+  // needed (so one slow chunk cannot make the page hold the whole dataset in JS memory).
+  pump() {
+    if (this.paused || this.stopped || this.failure) return;
+    const end = Math.min(this.total, this.next + MAX_AHEAD);
+    for (let i = this.next; i < end && this.inFlight.size < MAX_IN_FLIGHT; i++) {
+      if (!this.arrived.has(i) && !this.inFlight.has(i)) this.fetchChunk(i);
+    }
+  }
+
+  fetchChunk(i) {
+    const entry = { controller: new AbortController(), received: 0 };
+    this.inFlight.set(i, entry);
+    const url = new URL(this.files[i], this.manifestUrl).href;
+    fetchBytes(url, `part ${i + 1} of ${this.total} of the dataset`, {
+      signal: entry.controller.signal,
+      limit: this.sizes[i],
+      onProgress: (n) => {
+        entry.received += n;
+        this.networkBytes += n;
+        this.report();
+      },
+    }).then((bytes) => {
+      if (this.inFlight.get(i) !== entry) return; // aborted meanwhile (pause)
+      this.inFlight.delete(i);
+      this.arrived.set(i, bytes);
+      this.deliver();
+      this.pump();
+    }, (e) => {
+      if (this.inFlight.get(i) === entry) this.inFlight.delete(i);
+      if (entry.controller.signal.aborted || this.stopped) return;
+      this.failAt(i, e.message);
+    });
+  }
+
+  // Chunk i cannot be had: the chunks before it that are still coming are used first, then the
+  // error is reported. The level reached stays on screen and usable.
+  failAt(i, message) {
+    if (this.failure && this.failure.index <= i) return;
+    this.failure = { index: i, message };
+    for (const [j, e] of [...this.inFlight]) {
+      if (j > i) {
+        e.controller.abort();
+        this.inFlight.delete(j);
+      }
+    }
+    for (const j of [...this.arrived.keys()]) if (j > i) this.arrived.delete(j);
+    this.reportFailure();
+  }
+
+  reportFailure() {
+    if (!this.failure || this.next < this.failure.index || this.stopped) return;
+    this.stop();
+    fail(this.failure.message);
+  }
+
+  deliver() {
+    while (!this.stopped && this.arrived.has(this.next)) {
+      const i = this.next;
+      const bytes = this.arrived.get(i);
+      this.arrived.delete(i);
+      const ok = withWasmBytes(bytes, (ptr, len) => viewer._ts_add_chunk(i, ptr, len));
+      if (!ok) {
+        this.stop();
+        showError(stats().error);
+        return;
+      }
+      this.deliveredBytes += bytes.length;
+      this.next++;
+      startViewer(); // the base is in: show it as soon as possible
+    }
+    this.report();
+    if (this.next === this.total) this.stop();
+    this.reportFailure();
+  }
+
+  // Network progress for the viewer's panel (rate, bytes, time left).
+  report() {
+    if (shellState.aborted) return;
+    let have = this.deliveredBytes;
+    for (const b of this.arrived.values()) have += b.length;
+    for (const e of this.inFlight.values()) have += e.received;
+    viewer._ts_download_progress(this.networkBytes, have);
+  }
+
+  // Pausing stops the network at once: requests under way are dropped (and fetched again on
+  // resume); what arrived completely is kept.
+  setPaused(paused) {
+    this.paused = paused;
+    if (paused) {
+      for (const e of this.inFlight.values()) e.controller.abort();
+      this.inFlight.clear();
+      this.report();
+    } else {
+      this.pump();
+    }
+  }
+
+  stop() {
+    if (this.stopped) return;
+    this.stopped = true;
+    for (const e of this.inFlight.values()) e.controller.abort();
+    this.inFlight.clear();
+    this.onDone();
+  }
+}
+
+let loader = null;
+
 async function stream(manifestUrl, params) {
   showStatus('Loading the viewer and the dataset description…', 0);
   const viewerPromise = loadViewer();
@@ -169,6 +322,7 @@ async function stream(manifestUrl, params) {
   manifestPromise.catch(() => {}); // awaited below; avoid an "unhandled rejection" meanwhile
 
   viewer = await viewerPromise; // a failure here has no viewer to report into: caught by start()
+  viewer.onPauseChange = (paused) => { if (loader) loader.setPaused(paused); };
   let manifestBytes;
   try {
     manifestBytes = await manifestPromise;
@@ -176,7 +330,7 @@ async function stream(manifestUrl, params) {
     return fail(e.message);
   }
   const opened = withWasmBytes(manifestBytes, (ptr, len) => viewer._ts_open_manifest(ptr, len));
-  let s = stats();
+  const s = stats();
   if (!opened) return showError(s.error);
   document.title = `tetstream — ${s.name || manifestUrl.pathname}`;
 
@@ -189,53 +343,47 @@ async function stream(manifestUrl, params) {
     else console.warn(`tetstream: ignoring iso=${iso} (not a number)`);
   }
 
-  // The manifest has been validated by the viewer; read the chunk sizes from it for progress.
+  // The manifest has been validated by the viewer: chunk files come from it, sizes (to cap a
+  // response that is longer than announced) from the JSON.
   const manifest = JSON.parse(new TextDecoder().decode(manifestBytes));
-  const total = s.chunksTotal;
   const files = [];
-  for (let i = 0; i < total; i++) files.push(viewer.UTF8ToString(viewer._ts_chunk_file(i)));
-  const totalBytes = s.bytesTotal;
-  let received = 0;
-  const progress = (applied) =>
-    showStatus(`Streaming ${s.name || 'dataset'}: part ${Math.min(applied + 1, total)} of ${total}, ` +
-      `${megabytes(received)} of ${megabytes(totalBytes)}`, totalBytes ? received / totalBytes : 0);
-
-  // Fetch a few chunks ahead, apply strictly in order.
-  const abort = new AbortController();
-  const fetches = [];
-  const startFetch = (i) => {
-    const url = new URL(files[i], manifestUrl).href;
-    const p = fetchBytes(url, `part ${i + 1} of ${total} of the dataset`, {
-      signal: abort.signal,
-      limit: manifest.chunks[i].bytes,
-      onProgress: (n) => { received += n; progress(i); },
+  for (let i = 0; i < s.chunksTotal; i++) files.push(viewer.UTF8ToString(viewer._ts_chunk_file(i)));
+  await new Promise((resolve) => {
+    loader = new ChunkLoader({
+      files,
+      sizes: manifest.chunks.map((c) => c.bytes),
+      manifestUrl,
+      name: s.name,
+      onDone: resolve,
     });
-    p.catch(() => {});
-    fetches[i] = p;
-  };
-  progress(0);
-  for (let i = 0; i < Math.min(total, MAX_PARALLEL_FETCHES); i++) startFetch(i);
-  startViewer(); // WebGL setup overlaps the downloads
-  for (let i = 0; i < total; i++) {
-    for (let j = i; j < Math.min(total, i + MAX_PARALLEL_FETCHES); j++) if (!fetches[j]) startFetch(j);
-    let bytes;
-    try {
-      bytes = await fetches[i];
-    } catch (e) {
-      abort.abort();
-      return fail(e.message);
-    }
-    fetches[i] = null;
-    const ok = withWasmBytes(bytes, (ptr, len) => viewer._ts_add_chunk(i, ptr, len));
-    if (!ok) {
-      abort.abort();
-      return showError(stats().error);
-    }
-    progress(i + 1);
+    loader.report();
+    loader.pump();
+    startViewer(); // WebGL setup overlaps the downloads
+  });
+}
+
+// The status line under the canvas, from the viewer's state (the panel has the details).
+function updateStatus() {
+  if (shellState.state === 'idle' || shellState.aborted || !viewer) return;
+  const s = stats();
+  if (s.state === 'error') {
+    if (loader) loader.stop();
+    if (statusText.textContent !== s.error) showError(s.error);
+    return;
   }
-  s = stats();
-  showStatus(`${s.name || 'Dataset'}: ${total} part${total === 1 ? '' : 's'}, ${megabytes(s.bytesLoaded)} loaded`, 1);
-  setTimeout(() => { if (stats().state === 'complete') statusBox.className = 'done'; }, 1500);
+  if (s.state === 'idle') return;
+  const name = s.name || 'Dataset';
+  const have = s.chunksReceived === s.chunksTotal ? s.bytesReceived : Math.max(s.bytesReceived, s.bytesDownloaded);
+  if (s.state === 'loading') {
+    showStatus(`Loading ${name}…`, s.bytesTotal ? have / s.bytesTotal : 0);
+  } else if (s.chunksReceived < s.chunksTotal) {
+    showStatus(`${name}: ${s.chunksReceived} of ${s.chunksTotal} parts, ${megabytes(have)} of ` +
+      `${megabytes(s.bytesTotal)}${s.paused ? ' (paused)' : ''}; level ${(100 * s.level).toFixed(1)}%`,
+      s.bytesTotal ? have / s.bytesTotal : 0);
+  } else {
+    showStatus(`${name}: ${s.chunksTotal} part${s.chunksTotal === 1 ? '' : 's'}, ${megabytes(s.bytesTotal)} received`, 1);
+    statusBox.className = 'done';
+  }
 }
 
 function showHelp() {
@@ -262,9 +410,12 @@ async function start() {
   } catch {
     return fail(`"${data}" is not a valid dataset URL.`);
   }
+  const statusTimer = setInterval(updateStatus, 250);
   try {
     await stream(manifestUrl, params);
+    updateStatus();
   } catch (e) {
+    clearInterval(statusTimer);
     const message = e instanceof LoadError ? e.message : `Unexpected problem while loading: ${e && e.message ? e.message : e}`;
     if (!(e instanceof LoadError)) console.error(e);
     fail(message);

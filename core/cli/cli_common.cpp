@@ -32,7 +32,7 @@ Result loadInput(const std::string& path, Input& in, const LevelOption& level) {
     if (Result r = loadPackedDir(path, ds, level.chunks, maxVertices); !r) return r;
     in.packed = true;
     in.manifest = ds.manifest;
-    in.chunksApplied = ds.chunksApplied;
+    in.chunksApplied = ds.chunksApplied();
     in.splitsApplied = ds.pm.splitsApplied();
     in.mesh = std::move(ds.pm.mesh);
     return Result::success();

@@ -1,5 +1,6 @@
 // tetstream pack INPUT -o OUTDIR [--field NAME] [--weights G,F,S] [--base-fraction F |
 //   --base-vertices N | --max-error E] [--lossless] [--chunk-kb K] [--json]
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -17,23 +18,27 @@ namespace {
 class ProgressLine {
  public:
   explicit ProgressLine(bool enabled) : enabled_(enabled) {}
-  void update(const char* phase, double fraction) {
+  void update(const char* phase, uint64_t done, uint64_t planned) {
     if (!enabled_) return;
     auto now = std::chrono::steady_clock::now();
     if (phase != phase_) {
       finishLine();
       phase_ = phase;
       phaseStart_ = now;
-    } else if (fraction < 1 && now - lastDraw_ < std::chrono::milliseconds(100)) {
+    } else if (done < planned && now - lastDraw_ < std::chrono::milliseconds(100)) {
       return;
     }
     lastDraw_ = now;
-    double secs = std::chrono::duration<double>(now - phaseStart_).count();
-    char eta[32] = "";
-    if (fraction > 0.02 && fraction < 1) std::snprintf(eta, sizeof eta, ", %.0f s left", secs * (1 - fraction) / fraction);
-    int filled = int(fraction * 30 + 0.5);
-    std::fprintf(stderr, "\r  %-9s [%.*s%*s] %5.1f%%  %.1f s%s   ", phase, filled, "##############################",
-                 30 - filled, "", 100 * fraction, secs, eta);
+    const double secs = std::chrono::duration<double>(now - phaseStart_).count();
+    const double fraction = planned ? double(done) / double(planned) : 0.0;
+    char rate[48] = "", eta[32] = "";
+    if (planned && secs > 0.2) {
+      std::snprintf(rate, sizeof rate, ", %.0fk %s/s", done / secs / 1000, phase_ == "simplify" ? "collapses" : "splits");
+      if (fraction > 0.02 && fraction < 1) std::snprintf(eta, sizeof eta, ", %.0f s left", secs * (1 - fraction) / fraction);
+    }
+    const int filled = int(fraction * 30 + 0.5);
+    std::fprintf(stderr, "\r  %-9s [%.*s%*s] %5.1f%%  %.1f s%s%s   ", phase, filled, "##############################",
+                 30 - filled, "", 100 * fraction, secs, rate, eta);
     drawn_ = true;
   }
   void finishLine() {
@@ -47,6 +52,12 @@ class ProgressLine {
   std::chrono::steady_clock::time_point phaseStart_, lastDraw_;
 };
 
+double peakMemoryMB() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return u.ru_maxrss / 1024.0;  // Linux reports KiB
+}
+
 }  // namespace
 
 Runner addPack(CLI::App& app) {
@@ -54,7 +65,7 @@ Runner addPack(CLI::App& app) {
     std::string input, out, field, name;
     std::vector<double> weights;
     double baseFraction = 0.01, maxError = -1;
-    uint32_t baseVertices = 0, chunkKb = 256;
+    uint32_t baseVertices = 0, baseTets = 0, chunkKb = 256;
     int level = 19;
     bool lossless = false, json = false;
   };
@@ -69,6 +80,7 @@ Runner addPack(CLI::App& app) {
   auto* bf = sub->add_option("--base-fraction", o->baseFraction, "base mesh size as a fraction of the vertices")
                  ->check(CLI::Range(0.0, 1.0))->capture_default_str();
   auto* bv = sub->add_option("--base-vertices", o->baseVertices, "base mesh size in vertices");
+  auto* bt = sub->add_option("--base-tets", o->baseTets, "base mesh size in tets (with --base-fraction 0: the only target)");
   auto* me = sub->add_option("--max-error", o->maxError, "stop simplifying when the cheapest collapse costs more (relative error units)")
                  ->check(CLI::PositiveNumber);
   bv->excludes(bf);
@@ -79,17 +91,17 @@ Runner addPack(CLI::App& app) {
       ->check(CLI::Range(1u, 65536u))->capture_default_str();
   sub->add_option("--zstd-level", o->level, "zstd compression level")->check(CLI::Range(1, 22))->capture_default_str();
   sub->add_flag("--json", o->json, "print the result as JSON on stdout");
-  return [o, me, bv] {
+  return [o, me, bv, bt] {
     Stopwatch total;
     ProgressLine bar(!o->json && isatty(2));
-    bar.update("read", 0);
+    bar.update("read", 0, 1);
     Input in;
     if (Result r = loadInput(o->input, in); !r) {
       bar.finishLine();
       return reportError(r, o->json);
     }
     if (in.packed) return reportError(fail(Status::BadArgument, o->input + " is already packed; give a mesh file"), o->json);
-    bar.update("read", 1);
+    bar.update("read", 1, 1);
     double readMs = total.ms();
     const uint32_t inputVertices = in.mesh.vertexCount();
     PackOptions opt;
@@ -100,13 +112,14 @@ Runner addPack(CLI::App& app) {
       for (int k = 0; k < 3; ++k) opt.weights[k] = o->weights[size_t(k)];
     opt.baseFraction = o->baseFraction;
     if (bv->count()) opt.baseVertices = std::max<uint32_t>(o->baseVertices, 4);
+    if (bt->count()) opt.baseTets = o->baseTets;
     if (me->count()) {
       opt.maxError = o->maxError;
       opt.baseFraction = 0;  // as far as the error bound allows
     }
     opt.lossless = o->lossless;
     opt.chunkKb = o->chunkKb;
-    opt.progress = [&bar](const char* phase, double f) { bar.update(phase, f); };
+    opt.progress = [&bar](const char* phase, uint64_t done, uint64_t planned) { bar.update(phase, done, planned); };
     PackSummary s;
     Result r = packMesh(std::move(in.mesh), o->out, opt, s);
     bar.finishLine();
@@ -127,7 +140,7 @@ Runner addPack(CLI::App& app) {
                  {"baseFieldError", m.chunks[0].fieldError}, {"stopReason", s.stopReason},
                  {"flatTetsRemoved", s.flatTetsRemoved}, {"flatTetsLeft", s.flatTetsLeft},
                  {"readMs", readMs}, {"simplifyMs", s.simplifyMs}, {"encodeMs", s.encodeMs}, {"writeMs", s.writeMs},
-                 {"ms", total.ms()}, {"notes", notes}});
+                 {"ms", total.ms()}, {"peakMemoryMB", peakMemoryMB()}, {"notes", notes}});
       return 0;
     }
     for (const auto& n : notes) std::printf("note: %s\n", n.get<std::string>().c_str());
@@ -144,8 +157,8 @@ Runner addPack(CLI::App& app) {
     std::printf("  stopped   %s", s.stopReason.c_str());
     if (s.flatTetsRemoved || s.flatTetsLeft)
       std::printf("; flat input tets: %u removed, %u left", s.flatTetsRemoved, s.flatTetsLeft);
-    std::printf("\n  time      read %.0f ms, simplify %.0f ms, encode %.0f ms, write %.0f ms\n", readMs, s.simplifyMs,
-                s.encodeMs, s.writeMs);
+    std::printf("\n  time      read %.0f ms, simplify %.0f ms, encode %.0f ms, write %.0f ms; peak memory %.0f MB\n",
+                readMs, s.simplifyMs, s.encodeMs, s.writeMs, peakMemoryMB());
     return 0;
   };
 }

@@ -56,8 +56,10 @@ uint64_t snapToGrid(TetMesh& mesh, const Manifest& m) {
 
 Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt, PackSummary& summary) {
   summary = PackSummary{};
-  auto progress = [&](const char* phase, double f) { if (opt.progress) opt.progress(phase, f); };
-  progress("validate", 0);
+  auto progress = [&](const char* phase, uint64_t done, uint64_t planned) {
+    if (opt.progress) opt.progress(phase, done, planned);
+  };
+  progress("validate", 0, 0);
   ValidationReport report = validateMesh(mesh);
   if (report.fatal()) {
     std::string why;
@@ -122,13 +124,14 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   so.weightShape = opt.weights[2];
   so.field = iso;
   so.maxError = opt.maxError;
+  so.targetTets = opt.baseTets;
   so.targetVertices = opt.baseVertices ? opt.baseVertices
                                        : uint32_t(std::llround(std::clamp(opt.baseFraction, 0.0, 1.0) * mesh.vertexCount()));
   if (report.nonManifoldFaces || report.duplicateTets) {
     summary.notes.push_back("non-manifold or duplicated tetrahedra: packed without simplification");
     so.targetVertices = mesh.vertexCount();
   }
-  so.progress = [&](uint32_t done, uint32_t planned) { progress("simplify", planned ? double(done) / planned : 1.0); };
+  so.progress = [&](uint32_t done, uint32_t planned) { progress("simplify", done, planned); };
   if (Result r = simplifyMesh(mesh, so, simplified); !r) return r;
   summary.simplifyMs = msSince(t0);
   summary.stopReason = simplified.stopReason;
@@ -136,11 +139,12 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   summary.flatTetsLeft = simplified.flatTetsLeft;
 
   t0 = std::chrono::steady_clock::now();
-  progress("encode", 0);
+  progress("encode", 0, simplified.log.size());
   StreamOptions stream;
   stream.chunkBytes = std::max<uint32_t>(opt.chunkKb, 1) << 10;
   stream.firstChunkBytes = std::min<uint32_t>(stream.chunkBytes, 16u << 10);
   stream.zstdLevel = opt.zstdLevel;
+  stream.progress = [&](uint32_t done, uint32_t planned) { progress("encode", done, planned); };
   EncodedStream enc;
   if (Result r = encodeStream(mesh, simplified, m, stream, enc); !r) return r;
   std::vector<uint8_t> baseFile;
@@ -158,7 +162,7 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   summary.splits = simplified.log.size();
 
   t0 = std::chrono::steady_clock::now();
-  progress("write", 0);
+  progress("write", 0, 0);
   std::error_code ec;
   fs::create_directories(fs::path(outDir) / "chunks", ec);
   if (ec) return fail(Status::IoError, outDir + ": cannot create folder: " + ec.message());

@@ -21,11 +21,13 @@ struct PackOptions {
   double weights[3] = {10.0, 1.0, 0.002};  // geometry, field, shape (simplify.h)
   double baseFraction = 0.01;             // base mesh size as a fraction of the vertices...
   uint32_t baseVertices = 0;              // ...or as a vertex count (wins when non-zero)
+  uint32_t baseTets = 0;                  // stop earlier once the base has this many tets
   double maxError = std::numeric_limits<double>::infinity();  // stop simplifying at this cost
   bool lossless = false;                  // keep float32 values in split records
   uint32_t chunkKb = 256;                 // largest split chunk, compressed
-  // Phase name and fraction done, for progress displays.
-  std::function<void(const char* phase, double fraction)> progress;
+  // Progress for displays: phase ("validate", "simplify", "encode", "write"), items done and
+  // planned in that phase (collapses, splits; 0 planned when not countable).
+  std::function<void(const char* phase, uint64_t done, uint64_t planned)> progress;
 };
 
 struct PackSummary {

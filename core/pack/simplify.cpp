@@ -21,7 +21,8 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr uint32_t kOmega = 0xfffffffeu;   // the virtual vertex the boundary is coned to
 constexpr double kFlat = 1e-7;            // |6V| <= kFlat * (longest edge)^3 counts as flat
-constexpr float kKappaCap = 1e4f;         // κ of flat tets, capped so averages stay finite
+constexpr float kKappaCap = 1e4f;
+const int kFieldMode = std::getenv("TS_FIELD_MODE") ? std::atoi(std::getenv("TS_FIELD_MODE")) : 0;         // κ of flat tets, capped so averages stay finite
 
 struct Quadric {
   double q[10] = {};  // xx xy xz xw yy yz yw zz zw ww
@@ -41,6 +42,35 @@ struct Quadric {
     double x = p[0], y = p[1], z = p[2];
     return q[0] * x * x + 2 * q[1] * x * y + 2 * q[2] * x * z + 2 * q[3] * x + q[4] * y * y + 2 * q[5] * y * z +
            2 * q[6] * y + q[7] * z * z + 2 * q[8] * z + q[9];
+  }
+};
+
+// Field quadric (Garland & Heckbert's attribute quadrics, applied to the scalar field): each tet
+// defines a linear field s(x) = g·x + c; its volume-weighted squared deviation (g·x + c − s)² at a
+// point (x, s) of 4D space is a quadric in (x, y, z, s, 1). Summed over the original tets around a
+// vertex, and summed again on every collapse, it measures how far a kept vertex and its value
+// stray from the original field over the whole region it now stands for.
+struct FieldQuadric {
+  double q[15] = {};  // upper triangle of the symmetric 5×5 matrix, row by row
+  double volume = 0;
+  void addTet(const double g[3], double c, double w) {
+    const double a[5] = {g[0], g[1], g[2], -1.0, c};
+    int n = 0;
+    for (int r = 0; r < 5; ++r)
+      for (int k = r; k < 5; ++k) q[n++] += w * a[r] * a[k];
+    volume += w;
+  }
+  void add(const FieldQuadric& o) {
+    for (int k = 0; k < 15; ++k) q[k] += o.q[k];
+    volume += o.volume;
+  }
+  double eval(const double* p, double s) const {
+    const double x[5] = {p[0], p[1], p[2], s, 1.0};
+    double sum = 0;
+    int n = 0;
+    for (int r = 0; r < 5; ++r)
+      for (int k = r; k < 5; ++k) sum += (r == k ? 1.0 : 2.0) * q[n++] * x[r] * x[k];
+    return sum;
   }
 };
 
@@ -92,7 +122,7 @@ class Simplifier {
   CollapseVerdict check(uint32_t i, uint32_t j) {
     init();
     neighbours(i, nbr_);
-    if (!std::binary_search(nbr_.begin(), nbr_.end(), j)) return CollapseVerdict::NotAnEdge;
+    if (std::find(nbr_.begin(), nbr_.end(), j) == nbr_.end()) return CollapseVerdict::NotAnEdge;
     float ef;
     CollapseVerdict v = CollapseVerdict::Legal;
     prepareStar(i);
@@ -106,7 +136,8 @@ class Simplifier {
     const uint32_t target = std::max<uint32_t>(opt_.targetVertices, 4);
     const uint32_t planned = alive_ > target ? alive_ - target : 0;
     out_.stopReason = "target reached";
-    while (alive_ > target) {
+    tetsAlive_ = T_;
+    while (alive_ > target && tetsAlive_ > opt_.targetTets) {
       if (heap_.empty()) { out_.stopReason = "no legal collapse left"; break; }
       Entry e = heap_.top();
       heap_.pop();
@@ -176,8 +207,35 @@ class Simplifier {
       if (kappa_[t] >= kKappaCap) ++flatInput_;
       for (int k = 0; k < 4; ++k) kappaSum_[out_.tets[4 * size_t(t) + k]] += kappa_[t];
     }
-    acc_.assign(V_, 0.0f);
+    fieldQuadric_.assign(V_, {});
+    for (uint32_t t = 0; t < T_; ++t) {
+      const uint32_t* v = &out_.tets[4 * size_t(t)];
+      const double *p0 = p(v[0]), *p1 = p(v[1]), *p2 = p(v[2]), *p3 = p(v[3]);
+      double e[3][3], ds[3];
+      for (int k = 0; k < 3; ++k) {
+        e[0][k] = p1[k] - p0[k];
+        e[1][k] = p2[k] - p0[k];
+        e[2][k] = p3[k] - p0[k];
+      }
+      for (int k = 0; k < 3; ++k) ds[k] = double(field_[v[k + 1]]) - field_[v[0]];
+      // Gradient g solves e·g = ds (Cramer's rule).
+      double det = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) - e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+                   e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
+      if (!(std::abs(det) > 0)) continue;
+      double g[3];
+      for (int col = 0; col < 3; ++col) {
+        double m[3][3];
+        for (int r = 0; r < 3; ++r)
+          for (int k = 0; k < 3; ++k) m[r][k] = k == col ? ds[r] : e[r][k];
+        g[col] = (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                  m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])) / det;
+      }
+      double c = field_[v[0]] - (g[0] * p0[0] + g[1] * p0[1] + g[2] * p0[2]);
+      double w = std::abs(det) / 24.0;  // a quarter of the volume to each vertex
+      for (int k = 0; k < 4; ++k) fieldQuadric_[v[k]].addTet(g, c, w);
+    }
     version_.assign(V_, 0);
+    seen_.assign(V_, 0);
     lastCost_.assign(V_, float(kInf));
     for (uint32_t v = 0; v < V_; ++v)
       if (out_.vertexAlive[v]) pushVertex(v);
@@ -221,6 +279,8 @@ class Simplifier {
     double fixedEdges, longestFixed, sumSq, sum[3], fixedFace;
     double C[3][3], D[3][3];  // faces (P, x, y): cross = C - P × D
     double x[3][3];           // positions of the other vertices
+    double sign;              // orientation sign of the slot of i
+    bool baryReady;           // g[1..3], h[1..3] computed
     float f[3];               // field at the other vertices
     float kappa;              // κ of the tet now
   };
@@ -236,6 +296,7 @@ class Simplifier {
 
   void prepareStar(uint32_t i) {
     starData_.clear();
+    shapeReady_ = false;
     const double* pi = p(i);
     for (uint32_t t : star_[i]) {
       const uint32_t* v = &out_.tets[4 * size_t(t)];
@@ -252,15 +313,31 @@ class Simplifier {
       // Moving the vertex at slot si to the front takes si adjacent swaps.
       const double sign = (si & 1) ? -1.0 : 1.0;
       affineDet(x[0], x[1], x[2], sign, st.g[0], &st.h[0]);
-      for (int k = 0; k < 3; ++k) {
-        const double* y[3] = {x[0], x[1], x[2]};
-        y[k] = pi;
-        affineDet(y[0], y[1], y[2], sign, st.g[k + 1], &st.h[k + 1]);
-      }
+      st.sign = sign;
+      st.baryReady = false;
       st.detOld = st.g[0][0] * pi[0] + st.g[0][1] * pi[1] + st.g[0][2] * pi[2] + st.h[0];
-      double e01 = dist2(x[0], x[1]), e02 = dist2(x[0], x[2]), e12 = dist2(x[1], x[2]);
-      st.fixedEdges = e01 + e02 + e12;
-      st.longestFixed = std::max({e01, e02, e12});
+      st.longestFixed = std::max({dist2(x[0], x[1]), dist2(x[0], x[2]), dist2(x[1], x[2])});
+      starData_.push_back(st);
+    }
+  }
+
+  static double dist2(const double* a, const double* b) {
+    double d0 = a[0] - b[0], d1 = a[1] - b[1], d2 = a[2] - b[2];
+    return d0 * d0 + d1 * d1 + d2 * d2;
+  }
+  static void cross(const double* u, const double* v, double* n) {
+    n[0] = u[1] * v[2] - u[2] * v[1];
+    n[1] = u[2] * v[0] - u[0] * v[2];
+    n[2] = u[0] * v[1] - u[1] * v[0];
+  }
+
+  // The parts of κ that do not depend on the target: only needed once a candidate is finished.
+  void prepareShape() {
+    if (shapeReady_) return;
+    shapeReady_ = true;
+    for (StarTet& st : starData_) {
+      const double* x[3] = {st.x[0], st.x[1], st.x[2]};
+      st.fixedEdges = dist2(x[0], x[1]) + dist2(x[0], x[2]) + dist2(x[1], x[2]);
       st.sumSq = 0;
       for (int k = 0; k < 3; ++k) {
         st.sum[k] = x[0][k] + x[1][k] + x[2][k];
@@ -277,60 +354,39 @@ class Simplifier {
       double n3[3];
       cross(u, w, n3);
       st.fixedFace = n3[0] * n3[0] + n3[1] * n3[1] + n3[2] * n3[2];
-      starData_.push_back(st);
     }
   }
 
-  static double dist2(const double* a, const double* b) {
-    double d0 = a[0] - b[0], d1 = a[1] - b[1], d2 = a[2] - b[2];
-    return d0 * d0 + d1 * d1 + d2 * d2;
-  }
-  static void cross(const double* u, const double* v, double* n) {
-    n[0] = u[1] * v[2] - u[2] * v[1];
-    n[1] = u[2] * v[0] - u[0] * v[2];
-    n[2] = u[0] * v[1] - u[1] * v[0];
-  }
-
-  // Cost of hec(i → j) given prepareStar(i), or infinity when a tet would invert, flatten or
-  // fall below the minimum quality, or a boundary vertex would leave the boundary.
-  double evaluate(uint32_t i, uint32_t j, float* fieldErr, CollapseVerdict* verdict = nullptr) {
+  // Cost of hec(i → j) given prepareStar(i), in two parts so that the expensive shape term is
+  // only computed for candidates that can still win: lowerBound() checks that no tet inverts or
+  // flattens and adds the geometric and field terms (E_s ≥ 0, so this bounds the cost from
+  // below); finishCost() adds the shape term and the minimum-quality check. Infinity marks an
+  // illegal collapse (the verdict says why).
+  double lowerBound(uint32_t i, uint32_t j, float* fieldErr, CollapseVerdict* verdict) {
     ++out_.costEvaluations;
-    auto reject = [&](CollapseVerdict v) {
-      if (verdict) *verdict = v;
-      return kInf;
-    };
-    if (boundary_[i] && !isBoundaryEdge(i, j)) return reject(CollapseVerdict::BoundaryRule);
+    *verdict = CollapseVerdict::Legal;
+    if (boundary_[i] && !isBoundaryEdge(i, j)) return *verdict = CollapseVerdict::BoundaryRule, kInf;
     const double* P = p(j);
-    const double PP = P[0] * P[0] + P[1] * P[1] + P[2] * P[2];
-    double kappaSum = kappaSum_[j];
-    int64_t count = int64_t(star_[j].size());
     double bestInside = -kInf, interp = field_[j];
-    for (const StarTet& st : starData_) {
-      if (st.other[0] == j || st.other[1] == j || st.other[2] == j) {  // removed by the collapse
-        kappaSum -= st.kappa;
-        --count;
-        continue;
-      }
+    for (StarTet& st : starData_) {
+      if (st.other[0] == j || st.other[1] == j || st.other[2] == j) continue;  // removed
       const double det = st.g[0][0] * P[0] + st.g[0][1] * P[1] + st.g[0][2] * P[2] + st.h[0];
+      if (det <= 0) return *verdict = CollapseVerdict::Inverted, kInf;
       double longest = st.longestFixed;
       for (int k = 0; k < 3; ++k) longest = std::max(longest, dist2(P, st.x[k]));
-      if (det <= 0) return reject(CollapseVerdict::Inverted);
-      if (det <= kFlat * longest * std::sqrt(longest)) return reject(CollapseVerdict::Flat);
-      const double edges = st.fixedEdges + 3 * PP - 2 * (P[0] * st.sum[0] + P[1] * st.sum[1] + P[2] * st.sum[2]) + st.sumSq;
-      double faces = st.fixedFace;
-      for (int q = 0; q < 3; ++q) {
-        double pd[3];
-        cross(P, st.D[q], pd);
-        double c0 = st.C[q][0] - pd[0], c1 = st.C[q][1] - pd[1], c2 = st.C[q][2] - pd[2];
-        faces += c0 * c0 + c1 * c1 + c2 * c2;
-      }
-      const double kappa = std::sqrt(edges * 0.25 * faces) / det;
-      if (3.0 / kappa < opt_.minQuality) return reject(CollapseVerdict::LowQuality);
-      kappaSum += std::min<double>(kappa, kKappaCap);
-      ++count;
+      if (det <= kFlat * longest * std::sqrt(longest)) return *verdict = CollapseVerdict::Flat, kInf;
       // Barycentric coordinates of p_i in the new tet, to interpolate the coarse field there;
       // the first tet that contains p_i wins.
       if (bestInside >= 0) continue;
+      if (!st.baryReady) {  // numerators with p_i in each other slot, computed on first use
+        st.baryReady = true;
+        const double* pi = p(i);
+        for (int k = 0; k < 3; ++k) {
+          const double* y[3] = {st.x[0], st.x[1], st.x[2]};
+          y[k] = pi;
+          affineDet(y[0], y[1], y[2], st.sign, st.g[k + 1], &st.h[k + 1]);
+        }
+      }
       double lambda[4] = {st.detOld / det, 0, 0, 0}, lo = lambda[0];
       for (int k = 1; k < 4; ++k) {
         lambda[k] = (st.g[k][0] * P[0] + st.g[k][1] * P[1] + st.g[k][2] * P[2] + st.h[k]) / det;
@@ -341,8 +397,12 @@ class Simplifier {
         interp = lambda[0] * field_[j] + lambda[1] * st.f[0] + lambda[2] * st.f[1] + lambda[3] * st.f[2];
       }
     }
-    double es = count > 0 ? (kappaSum / double(count) - 3.0) / 3.0 : 0.0;
-    double ef = std::abs(double(field_[i]) - interp) / range_ + acc_[i];
+    // Paper eq. (6) at p_i, plus the field quadric over everything i and j stand for.
+    double local = std::abs(double(field_[i]) - interp) / range_;
+    FieldQuadric fq = fieldQuadric_[i];
+    fq.add(fieldQuadric_[j]);
+    double region = fq.volume > 0 ? std::sqrt(std::max(0.0, fq.eval(P, field_[j])) / fq.volume) / range_ : 0.0;
+    double ef = local + region;
     double eg = 0;
     if (boundary_[i]) {
       Quadric q = quadric_[i];
@@ -350,55 +410,126 @@ class Simplifier {
       if (q.area > 0) eg = std::sqrt(std::max(0.0, q.eval(P)) / q.area) / diag_;
     }
     *fieldErr = float(ef);
-    if (verdict) *verdict = CollapseVerdict::Legal;
-    return opt_.weightGeometry * eg + opt_.weightField * ef + opt_.weightShape * es;
+    return opt_.weightGeometry * eg + opt_.weightField * ef;
   }
 
-  void neighbours(uint32_t v, std::vector<uint32_t>& out) const {
+  double finishCost(uint32_t j, double lower, CollapseVerdict* verdict) {
+    prepareShape();
+    const double* P = p(j);
+    const double PP = P[0] * P[0] + P[1] * P[1] + P[2] * P[2];
+    double kappaSum = kappaSum_[j];
+    int64_t count = int64_t(star_[j].size());
+    for (const StarTet& st : starData_) {
+      if (st.other[0] == j || st.other[1] == j || st.other[2] == j) {  // removed by the collapse
+        kappaSum -= st.kappa;
+        --count;
+        continue;
+      }
+      const double det = st.g[0][0] * P[0] + st.g[0][1] * P[1] + st.g[0][2] * P[2] + st.h[0];
+      const double edges = st.fixedEdges + 3 * PP - 2 * (P[0] * st.sum[0] + P[1] * st.sum[1] + P[2] * st.sum[2]) + st.sumSq;
+      double faces = st.fixedFace;
+      for (int q = 0; q < 3; ++q) {
+        double pd[3];
+        cross(P, st.D[q], pd);
+        double c0 = st.C[q][0] - pd[0], c1 = st.C[q][1] - pd[1], c2 = st.C[q][2] - pd[2];
+        faces += c0 * c0 + c1 * c1 + c2 * c2;
+      }
+      const double kappa = std::sqrt(edges * 0.25 * faces) / det;
+      if (3.0 / kappa < opt_.minQuality) return *verdict = CollapseVerdict::LowQuality, kInf;
+      kappaSum += std::min<double>(kappa, kKappaCap);
+      ++count;
+    }
+    double es = count > 0 ? (kappaSum / double(count) - 3.0) / 3.0 : 0.0;
+    return lower + opt_.weightShape * es;
+  }
+
+  double evaluate(uint32_t i, uint32_t j, float* fieldErr, CollapseVerdict* verdict) {
+    double lower = lowerBound(i, j, fieldErr, verdict);
+    return lower < kInf ? finishCost(j, lower, verdict) : kInf;
+  }
+
+  // The out-edges of i with their lower bounds (prepareStar(i) and neighbours(i) first).
+  void gatherCandidates(uint32_t i) {
+    candidates_.clear();
+    for (uint32_t w : nbr_) {
+      float ef;
+      CollapseVerdict v;
+      double lb = lowerBound(i, w, &ef, &v);
+      if (lb < kInf) candidates_.push_back({lb, w, ef, false});
+    }
+  }
+
+  // Best-first over the candidates: the cheapest one with an exact cost, finishing bounds only
+  // while one could still win. Returns its index, or -1 when none is legal.
+  int cheapestCandidate() {
+    for (;;) {
+      int best = -1;
+      for (int c = 0; c < int(candidates_.size()); ++c) {
+        const Candidate& x = candidates_[size_t(c)];
+        if (best < 0 || x.cost < candidates_[size_t(best)].cost ||
+            (x.cost == candidates_[size_t(best)].cost && x.j < candidates_[size_t(best)].j))
+          best = c;
+      }
+      if (best < 0) return -1;
+      Candidate& b = candidates_[size_t(best)];
+      if (b.exact) return best;
+      CollapseVerdict v;
+      b.cost = finishCost(b.j, b.cost, &v);
+      b.exact = true;
+      if (!(b.cost < kInf)) candidates_.erase(candidates_.begin() + best);
+    }
+  }
+
+  // Distinct vertices of the tets around v (v excluded), in first-seen order: a stamp per vertex
+  // instead of sorting, as this runs for every queue pop.
+  void neighbours(uint32_t v, std::vector<uint32_t>& out) {
     out.clear();
+    ++stamp_;
+    seen_[v] = stamp_;
     for (uint32_t t : star_[v])
       for (int k = 0; k < 4; ++k) {
         uint32_t w = out_.tets[4 * size_t(t) + k];
-        if (w != v) out.push_back(w);
+        if (seen_[w] != stamp_) {
+          seen_[w] = stamp_;
+          out.push_back(w);
+        }
       }
-    sortUnique(out);
   }
 
-  // Evaluates every half-edge out of v and queues v with the cheapest legal one.
+  // Evaluates the half-edges out of v and queues v with the cheapest legal one.
   void pushVertex(uint32_t v) {
     neighbours(v, nbr_);
     prepareStar(v);
-    double best = kInf;
-    float ef;
-    for (uint32_t w : nbr_) best = std::min(best, evaluate(v, w, &ef));
-    lastCost_[v] = float(best);
-    if (best < kInf) heap_.push({float(best), v, version_[v]});
+    gatherCandidates(v);
+    int best = cheapestCandidate();
+    lastCost_[v] = best < 0 ? float(kInf) : float(candidates_[size_t(best)].cost);
+    if (best >= 0) heap_.push({lastCost_[v], v, version_[v]});
   }
 
   // Pops are re-evaluated: the neighbourhood of the target may have changed since the push.
   void tryCollapse(uint32_t i) {
     neighbours(i, nbr_);
     prepareStar(i);
-    candidates_.clear();
-    for (uint32_t w : nbr_) {
-      float ef;
-      double c = evaluate(i, w, &ef);
-      if (c < kInf) candidates_.push_back({c, w, ef});
-    }
-    std::sort(candidates_.begin(), candidates_.end(), [](const Candidate& a, const Candidate& b) {
-      return a.cost < b.cost || (a.cost == b.cost && a.j < b.j);
-    });
-    lastCost_[i] = candidates_.empty() ? float(kInf) : float(candidates_[0].cost);
-    for (const Candidate& c : candidates_) {
-      if (!heap_.empty() && float(c.cost) > heap_.top().cost) {
-        heap_.push({float(c.cost), i, version_[i]});  // something else is cheaper now
+    gatherCandidates(i);
+    bool first = true;
+    for (int c; (c = cheapestCandidate()) >= 0;) {
+      const Candidate cand = candidates_[size_t(c)];
+      if (first) lastCost_[i] = float(cand.cost);
+      first = false;
+      if (!heap_.empty() && float(cand.cost) > heap_.top().cost) {
+        heap_.push({float(cand.cost), i, version_[i]});  // something else is cheaper now
         return;
       }
-      if (c.cost > opt_.maxError) return;
-      if (!linkCondition(i, c.j)) { ++out_.rejectedByLink; continue; }
-      collapse(i, c.j, c.fieldErr);
+      if (cand.cost > opt_.maxError) return;
+      if (!linkCondition(i, cand.j)) {
+        ++out_.rejectedByLink;
+        candidates_.erase(candidates_.begin() + c);
+        continue;
+      }
+      collapse(i, cand.j, cand.fieldErr);
       return;
     }
+    if (first) lastCost_[i] = float(kInf);
     // No legal collapse from i until its neighbourhood changes (then it is queued again).
   }
 
@@ -501,6 +632,7 @@ class Simplifier {
       for (int f = 0; f < 4; ++f) opp_[4 * t + f] = kNoNeighbor;
       if (kappa_[t] >= kKappaCap) ++out_.flatTetsRemoved;
       out_.tetAlive[t] = 0;
+      --tetsAlive_;
       for (int k = 0; k < 4; ++k) kappaSum_[v[k]] -= kappa_[t];
       for (int k = 0; k < 4; ++k)
         if (v[k] != i) eraseFrom(star_[v[k]], t);
@@ -522,16 +654,22 @@ class Simplifier {
     --alive_;
     boundary_[j] |= boundary_[i];
     quadric_[j].add(quadric_[i]);
-    acc_[j] = std::max(acc_[j], float(fieldErr / 1.0));
+    fieldQuadric_[j].add(fieldQuadric_[i]);
 
     // Everything around j changed. Requeue j and its neighbours lazily: under their last known
     // cost (the neighbourhood of a blocked vertex changed, so it gets another chance), to be
     // re-evaluated only when they reach the top.
     touched_.clear();
+    ++stamp_;
+    seen_[i] = stamp_;
     for (uint32_t t : around)
-      for (int k = 0; k < 4; ++k) touched_.push_back(out_.tets[4 * size_t(t)+ k]);
-    sortUnique(touched_);
-    touched_.erase(std::remove(touched_.begin(), touched_.end(), i), touched_.end());
+      for (int k = 0; k < 4; ++k) {
+        uint32_t w = out_.tets[4 * size_t(t) + k];
+        if (seen_[w] != stamp_) {
+          seen_[w] = stamp_;
+          touched_.push_back(w);
+        }
+      }
     for (uint32_t v : touched_) {
       ++version_[v];
       float key = std::isfinite(lastCost_[v]) ? lastCost_[v] : 0.0f;
@@ -540,15 +678,16 @@ class Simplifier {
   }
 
   struct Candidate {
-    double cost;
+    double cost;     // exact, or a lower bound until `exact`
     uint32_t j;
     float fieldErr;
+    bool exact;
   };
 
   const TetMesh& mesh_;
   const SimplifyOptions& opt_;
   SimplifyResult& out_;
-  uint32_t V_ = 0, T_ = 0, alive_ = 0, flatInput_ = 0;
+  uint32_t V_ = 0, T_ = 0, alive_ = 0, tetsAlive_ = 0, flatInput_ = 0;
   std::vector<double> pos_;
   const float* field_ = nullptr;
   double range_ = 1, diag_ = 1;
@@ -556,10 +695,14 @@ class Simplifier {
   std::vector<uint32_t> opp_;
   std::vector<uint8_t> boundary_;
   std::vector<Quadric> quadric_;
-  std::vector<float> kappa_, acc_, lastCost_;
+  std::vector<float> kappa_, lastCost_;
+  std::vector<FieldQuadric> fieldQuadric_;
   std::vector<double> kappaSum_;  // per vertex: Σ κ over its star
   std::vector<StarTet> starData_;
+  bool shapeReady_ = false;
   std::vector<uint32_t> version_;
+  std::vector<uint32_t> seen_;  // neighbour stamps
+  uint32_t stamp_ = 0;
   std::priority_queue<Entry, std::vector<Entry>, EntryAfter> heap_;
   // scratch, reused
   std::vector<uint32_t> nbr_, touched_, lvI_, lvJ_, lvE_;

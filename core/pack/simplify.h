@@ -5,10 +5,12 @@
 //   E_g  geometric error, paper eq. (3)-(4): boundary plane quadrics (area weighted, summed on
 //        collapse) evaluated at p_j, as an RMS distance divided by the bounding-box diagonal.
 //        Zero for interior vertices, whose collapse does not move the boundary.
-//   E_f  field error, paper eq. (6) plus accumulation: |S(p_i) − S'(p_i)| / field range, where
-//        S' interpolates the coarse field at p_i inside the tets around p_j after the collapse,
-//        plus the error p_i had already absorbed from earlier collapses (so the estimate grows
-//        where the mesh has been coarsened, and collapses spread evenly).
+//   E_f  field error, paper eq. (6) plus a region term, both divided by the field range:
+//        |S(p_i) − S'(p_i)|, where S' interpolates the coarse field at p_i inside the tets around
+//        p_j after the collapse (the paper's local estimate), plus the RMS deviation of (p_j, s_j)
+//        from the linear fields of all original tets that i and j now stand for, kept as
+//        volume-weighted 4D field quadrics summed on collapse (Garland & Heckbert's attribute
+//        quadrics; our stand-in for eq. (5)'s integral over the original vertices of the region).
 //   E_s  shape error, paper §3.3: mean of κ(S) − 3 over the tets around p_j after the collapse,
 //        divided by 3 (0 for equilateral tets).
 // Defaults (10, 1, 0.002) keep the boundary first, then the field; tet shape is a
@@ -40,6 +42,7 @@ namespace tetstream {
 struct SimplifyOptions {
   double weightGeometry = 10.0, weightField = 1.0, weightShape = 0.002;
   uint32_t targetVertices = 0;  // stop at this many vertices (0: as far as legal collapses go)
+  uint32_t targetTets = 0;      // ...or at this many tets, whichever comes first
   double maxError = std::numeric_limits<double>::infinity();  // stop when the cheapest cost exceeds it
   int field = 0;                // index of the field that steers the field error
   double minQuality = 0.02;     // 3/κ of every tet a collapse changes must stay at or above this

@@ -43,6 +43,7 @@ class Encoder {
     for (uint32_t c = C; c-- > 0;) {
       encodeSplit(c);
       ++inChunk_;
+      if (opt_.progress && (c & 4095) == 0) opt_.progress(C - c, C);
       if (records_.size() >= target_ * ratio_ || c == 0)
         if (Result r = flushChunk(C - c); !r) return r;
     }

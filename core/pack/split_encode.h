@@ -4,6 +4,7 @@
 // exactly the ones a decoder will see.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "manifest.h"
@@ -17,6 +18,7 @@ struct StreamOptions {
   uint32_t firstChunkBytes = 16u << 10;  // compressed size aimed at by the first split chunk
   uint32_t chunkBytes = 256u << 10;      // later chunks double up to this size
   int zstdLevel = 19;
+  std::function<void(uint32_t done, uint32_t planned)> progress;  // splits encoded so far
 };
 
 struct EncodedStream {

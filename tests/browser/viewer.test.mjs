@@ -6,6 +6,7 @@
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { spawnSync } from 'node:child_process';
+import http from 'node:http';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
@@ -26,7 +27,8 @@ const chromiumArgs = [
   '--disable-background-networking', '--disable-component-update', '--disable-sync', '--disable-quic',
 ];
 
-let tmp, pack, distPack, badPack, server, baseUrl, browser;
+let tmp, pack, distPack, badPack, gapPack, server, baseUrl, browser;
+const chunkRequests = []; // [time, url] of every chunk request the server saw
 
 function cli(...args) {
   const r = spawnSync(cliPath, args, { encoding: 'utf8', timeout: 120000 });
@@ -34,17 +36,27 @@ function cli(...args) {
   return r.stdout;
 }
 
-// The reference: the native CLI's isosurface of the same packed dataset.
-function cliIso(value, { field, dir = pack } = {}) {
+// The reference: the native CLI's isosurface of the same packed dataset, at any level.
+function cliIso(value, { field, dir = pack, chunks, fraction } = {}) {
   const args = ['iso', dir, '--value', String(value), '--json'];
   if (field) args.push('--field', field);
+  if (chunks !== undefined) args.push('--chunks', String(chunks));
+  if (fraction !== undefined) args.push('--fraction', String(fraction));
   return JSON.parse(cli(...args));
+}
+
+function readManifest(dir = pack) {
+  return JSON.parse(fs.readFileSync(path.join(dir, 'manifest.json'), 'utf8'));
 }
 
 function assertClose(actual, expected, rel, what) {
   const err = Math.abs(actual - expected) / Math.max(Math.abs(expected), 1e-30);
   assert.ok(err <= rel, `${what}: ${actual} vs ${expected} (relative error ${err.toExponential(2)} > ${rel})`);
 }
+
+// SwiftShader renders in software, so frames are far slower than on a GPU: a generous bound.
+// The real figures go to the test output (t.diagnostic).
+const MAX_FRAME_MS = 250;
 
 // A page that records everything that went wrong on it. `allow`: console errors to tolerate.
 async function openViewer(query, { allow = [] } = {}) {
@@ -59,9 +71,24 @@ async function openViewer(query, { allow = [] } = {}) {
   return { page, problems };
 }
 
-async function waitForState(page, states, timeout = 60000) {
+async function waitForState(page, states, timeout = 120000) {
   await page.waitForFunction((s) => window.tetstream && s.includes(window.tetstream.stats().state), states, { timeout });
   return page.evaluate(() => window.tetstream.stats());
+}
+
+// Waits until the level has reached its target (the frame loop applies splits a few ms a frame).
+async function waitForLevel(page, timeout = 120000) {
+  await page.waitForFunction(() => {
+    const s = window.tetstream.stats();
+    return s.splitsApplied === s.targetSplits;
+  }, null, { timeout });
+  return page.evaluate(() => window.tetstream.stats());
+}
+
+function frameReport(s) {
+  return `max frame callback ${s.maxFrameMs.toFixed(1)} ms, max gap between frames ${s.maxFrameGapMs.toFixed(1)} ms, ` +
+    `max refinement slice ${s.maxRefineMs.toFixed(1)} ms; uploads ${s.partialUploads} partial / ${s.fullUploads} full, ` +
+    `${(s.uploadBytes / 1048576).toFixed(1)} MB`;
 }
 
 // Lets the viewer draw a few frames (ImGui reads input and applies it on the next frame).
@@ -75,10 +102,11 @@ before(async () => {
   tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'tetstream-browser-'));
   fs.mkdirSync(outDir, { recursive: true });
 
+  // Harmonic 32³ (~180k tets) in many small chunks, so that streaming takes a while.
   const vtu = path.join(tmp, 'h.vtu');
   pack = path.join(tmp, 'pack');
-  cli('gen', 'harmonic', '--n', '24', '-o', vtu);
-  cli('pack', vtu, '-o', pack, '--name', 'Harmonic 24³');
+  cli('gen', 'harmonic', '--n', '32', '-o', vtu);
+  cli('pack', vtu, '-o', pack, '--chunk-kb', '16', '--name', 'Harmonic 32³');
   const distVtu = path.join(tmp, 'd.vtu');
   distPack = path.join(tmp, 'dist');
   cli('gen', 'distance', '--n', '16', '-o', distVtu);
@@ -87,19 +115,34 @@ before(async () => {
   // A copy whose base chunk has one flipped byte: the viewer must refuse it in plain words.
   badPack = path.join(tmp, 'bad');
   fs.cpSync(pack, badPack, { recursive: true });
-  const manifest = JSON.parse(fs.readFileSync(path.join(badPack, 'manifest.json'), 'utf8'));
+  const manifest = readManifest(badPack);
   const chunk = path.join(badPack, manifest.chunks[0].file);
   const bytes = fs.readFileSync(chunk);
   bytes[bytes.length >> 1] ^= 0x5a;
   fs.writeFileSync(chunk, bytes);
 
-  server = createServer({
+  // A copy without its sixth chunk: a 404 in the middle of the stream.
+  gapPack = path.join(tmp, 'gap');
+  fs.cpSync(pack, gapPack, { recursive: true });
+  fs.rmSync(path.join(gapPack, readManifest(gapPack).chunks[5].file));
+
+  const files = createServer({
     mounts: [
       { prefix: '/data', dir: pack },
       { prefix: '/dist', dir: distPack },
       { prefix: '/bad', dir: badPack },
+      { prefix: '/gap', dir: gapPack },
       { prefix: '/', dir: webDir },
     ],
+  });
+  // /slow/... serves /data/... with every chunk 300 ms late (a slow link, for pause/resume),
+  // and every chunk request is logged.
+  server = http.createServer((req, res) => {
+    if (/\.tsc$/.test(req.url)) chunkRequests.push([Date.now(), req.url]);
+    const slow = /^\/slow(\/.*)$/.exec(req.url);
+    if (!slow) return files.emit('request', req, res);
+    req.url = `/data${slow[1]}`;
+    setTimeout(() => files.emit('request', req, res), /\.tsc$/.test(req.url) ? 300 : 0);
   });
   await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
   baseUrl = `http://127.0.0.1:${server.address().port}`;
@@ -112,21 +155,34 @@ after(async () => {
   if (tmp) fs.rmSync(tmp, { recursive: true, force: true });
 });
 
-test('streams a packed dataset, matches the CLI surface, and the isovalue slider drags', async (t) => {
+test('streams a multi-chunk pack to complete, matches the CLI surface, and the isovalue slider drags', async (t) => {
+  const manifest = readManifest();
+  assert.ok(manifest.chunks.length >= 20, `a stream of many chunks (${manifest.chunks.length})`);
   const { page, problems } = await openViewer('?data=/data/manifest.json');
+  const first = await waitForState(page, ['streaming', 'complete', 'error']);
+  assert.equal(first.state, 'streaming', `the base is shown before the rest: ${first.state} ${first.error}`);
+  assert.ok(first.triangles > 0 && first.vertices < manifest.vertices);
   const s = await waitForState(page, ['complete', 'error']);
   assert.equal(s.state, 'complete', `viewer ended in ${s.state}: ${s.error}`);
-  const manifest = JSON.parse(fs.readFileSync(path.join(pack, 'manifest.json'), 'utf8'));
   assert.equal(s.vertices, manifest.vertices);
   assert.equal(s.tets, manifest.tets);
-  assert.equal(s.chunksLoaded, manifest.chunks.length);
+  assert.equal(s.chunksReceived, manifest.chunks.length);
+  assert.equal(s.chunksApplied, manifest.chunks.length);
+  assert.equal(s.splitsApplied, s.splitsTotal);
+  assert.equal(s.level, 1);
+  assert.equal(s.fieldError, 0);
+  assert.equal(s.bytesReceived, s.bytesTotal);
   assert.equal(s.field, manifest.isoField);
   const range = manifest.fields.find((f) => f.name === manifest.isoField);
   assert.ok(s.isovalue > range.min && s.isovalue < range.max, 'default isovalue lies inside the field range');
-  assert.ok(s.firstSurfaceMs > 0, 'first surface time recorded');
-  t.diagnostic(`first isosurface drawn ${s.firstSurfaceMs.toFixed(0)} ms after navigation start; ` +
-    `extraction ${s.extractMs.toFixed(1)} ms, ${s.triangles} triangles`);
+  assert.ok(s.firstSurfaceMs > 0 && s.completeMs > s.firstSurfaceMs, 'first surface and completion times recorded');
+  t.diagnostic(`Harmonic 32³, ${manifest.chunks.length} chunks, ${s.splitsTotal} splits: first surface ` +
+    `${s.firstSurfaceMs.toFixed(0)} ms after navigation start, complete after ${s.completeMs.toFixed(0)} ms`);
+  t.diagnostic(frameReport(s));
+  assert.ok(s.maxFrameMs < MAX_FRAME_MS, `longest frame ${s.maxFrameMs} ms`);
+  assert.ok(s.partialUploads > 2 * s.fullUploads, 'streaming uploads changed ranges, not whole buffers');
 
+  // The surface after every split equals a from-scratch extraction of the full mesh.
   const ref = cliIso(s.isovalue);
   assert.ok(ref.triangles > 100, 'the reference surface is not trivial');
   assert.equal(s.triangles, ref.triangles);
@@ -134,9 +190,19 @@ test('streams a packed dataset, matches the CLI surface, and the isovalue slider
   assertClose(s.surfaceArea, ref.area, 1e-6, 'surface area');
 
   await frames(page);
-  await page.screenshot({ path: path.join(outDir, 'viewer.png') });
+  await page.screenshot({ path: path.join(outDir, 'viewer-complete.png') });
 
-  // Drag the ImGui slider from its middle to 85% of its width with the mouse.
+  // The picture itself: the surface built by 32k local updates draws exactly like a surface
+  // extracted from scratch (selecting the field again rebuilds it), pixel for pixel.
+  const view = { x: 360, y: 0, width: 920, height: 700 }; // right of the panel, above the status line
+  const streamed = await page.screenshot({ clip: view });
+  await page.evaluate((f) => window.tetstream.setField(f), manifest.isoField);
+  await frames(page, 6);
+  const rebuilt = await page.evaluate(() => window.tetstream.stats());
+  assert.equal(rebuilt.triangles, s.triangles);
+  assert.ok((await page.screenshot({ clip: view })).equals(streamed), 'streamed and rebuilt surfaces draw the same');
+
+  // Drag the ImGui isovalue slider from its middle to 85% of its width with the mouse.
   const r = s.sliderRect;
   assert.ok(r.w > 50 && r.h > 5, `slider rectangle recorded: ${JSON.stringify(r)}`);
   const y = r.y + r.h / 2;
@@ -173,6 +239,160 @@ test('streams a packed dataset, matches the CLI surface, and the isovalue slider
   await page.close();
 });
 
+test('the level moves between the base mesh and the newest level, by API and by slider', async (t) => {
+  const manifest = readManifest();
+  const base = manifest.chunks[0];
+  const { page, problems } = await openViewer('?data=/data/manifest.json');
+  const full = await waitForState(page, ['complete', 'error']);
+  assert.equal(full.state, 'complete', full.error);
+
+  // Back to the base mesh: every split undone, the surface following locally.
+  await page.evaluate(() => window.tetstream.setLevel(0));
+  let s = await waitForLevel(page);
+  assert.equal(s.splitsApplied, 0);
+  assert.equal(s.vertices, base.vertices);
+  assert.equal(s.tets, base.tets);
+  assert.equal(s.level, base.vertices / manifest.vertices);
+  assert.equal(s.fieldError, base.fieldError);
+  assert.equal(s.live, false);
+  assert.equal(s.state, 'streaming', 'not every split is applied any more');
+  const refBase = cliIso(s.isovalue, { chunks: 1 });
+  assert.equal(s.triangles, refBase.triangles);
+  assert.equal(s.surfaceVertices, refBase.vertices);
+  assertClose(s.surfaceArea, refBase.area, 1e-6, 'surface area at the base');
+  t.diagnostic(`undoing ${full.splitsApplied} splits: ${frameReport(s)}`);
+  assert.ok(s.maxFrameMs < MAX_FRAME_MS, `longest frame ${s.maxFrameMs} ms`);
+  await frames(page);
+  await page.screenshot({ path: path.join(outDir, 'viewer-base.png') });
+
+  // Half of the vertices: equal to the CLI at --fraction 0.5.
+  await page.evaluate(() => window.tetstream.setLevel(0.5));
+  s = await waitForLevel(page);
+  assert.equal(s.vertices, Math.round(0.5 * manifest.vertices));
+  const refHalf = cliIso(s.isovalue, { fraction: 0.5 });
+  assert.equal(s.tets, refHalf.tets);
+  assert.equal(s.triangles, refHalf.triangles);
+  assertClose(s.surfaceArea, refHalf.area, 1e-6, 'surface area at half the vertices');
+
+  // The ImGui level slider, dragged with the mouse from its left end to the middle.
+  await page.evaluate(() => window.tetstream.setLevel(0));
+  s = await waitForLevel(page);
+  await frames(page);
+  const r = (await page.evaluate(() => window.tetstream.stats())).levelSliderRect;
+  assert.ok(r.w > 50 && r.h > 5, `level slider rectangle recorded: ${JSON.stringify(r)}`);
+  const y = r.y + r.h / 2;
+  await page.mouse.move(r.x + 2, y);
+  await frames(page, 2);
+  await page.mouse.down();
+  await frames(page, 2);
+  for (let i = 1; i <= 5; i++) {
+    await page.mouse.move(r.x + 0.1 * i * r.w, y);
+    await frames(page, 2);
+  }
+  await page.mouse.up();
+  const dragged = await waitForLevel(page);
+  assert.ok(dragged.vertices > base.vertices + 0.2 * (manifest.vertices - base.vertices),
+    `dragging the level slider right refined the mesh: ${base.vertices} -> ${dragged.vertices} vertices`);
+  assert.ok(dragged.vertices < manifest.vertices, 'but not to the full mesh');
+  assert.equal(dragged.live, false);
+  const refDragged = cliIso(dragged.isovalue, { fraction: dragged.vertices / manifest.vertices });
+  if (refDragged.tets === dragged.tets) assert.equal(dragged.triangles, refDragged.triangles);
+  await frames(page);
+  await page.screenshot({ path: path.join(outDir, 'viewer-level-dragged.png') });
+
+  // And forward to the newest level: complete again, equal to the full mesh.
+  await page.evaluate(() => window.tetstream.setLevel(1));
+  s = await waitForState(page, ['complete', 'error']);
+  assert.equal(s.state, 'complete');
+  assert.equal(s.vertices, manifest.vertices);
+  assert.equal(s.live, true);
+  assert.equal(s.triangles, full.triangles);
+  assertClose(s.surfaceArea, full.surfaceArea, 1e-9, 'surface area back at the full level');
+  t.diagnostic(`level moves: ${frameReport(s)}`);
+  assert.ok(s.maxFrameMs < MAX_FRAME_MS, `longest frame ${s.maxFrameMs} ms`);
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test('pause stops fetching, resume completes the stream', async (t) => {
+  const manifest = readManifest();
+  const { page, problems } = await openViewer('?data=/slow/manifest.json');
+  await page.waitForFunction(() => window.tetstream.stats().chunksReceived >= 3, null, { timeout: 60000 });
+  const before = await page.evaluate(() => window.tetstream.stats());
+  assert.ok(before.rateBytesPerSec > 0, `a download rate is shown: ${before.rateBytesPerSec}`);
+  assert.ok(before.secondsLeft > 0, `and the time left: ${before.secondsLeft}`);
+  t.diagnostic(`slow link: ${(before.rateBytesPerSec / 1024).toFixed(0)} KB/s, ${before.secondsLeft.toFixed(1)} s left`);
+
+  // Pause with the panel's button (the same path as tetstream.pause()). Rectangles are those
+  // of the last drawn frame: let the panel settle first.
+  await frames(page, 6);
+  const b = (await page.evaluate(() => window.tetstream.stats())).pauseButtonRect;
+  assert.ok(b.w > 20 && b.h > 5, `pause button recorded: ${JSON.stringify(b)}`);
+  await page.mouse.move(b.x + b.w / 2, b.y + b.h / 2);
+  await frames(page, 2);
+  await page.mouse.down();
+  await frames(page, 2);
+  await page.mouse.up();
+  await page.waitForFunction(() => window.tetstream.stats().paused, null, { timeout: 5000 });
+  const pausedAt = Date.now();
+  const p = await page.evaluate(() => window.tetstream.stats());
+  assert.equal(p.paused, true);
+  assert.ok(p.chunksReceived < manifest.chunks.length, 'paused before the end');
+  await new Promise((resolve) => setTimeout(resolve, 1200));
+  const q = await page.evaluate(() => window.tetstream.stats());
+  assert.equal(q.chunksReceived, p.chunksReceived, 'no chunk arrives while paused');
+  const started = chunkRequests.filter(([time, url]) => time > pausedAt + 20 && url.startsWith('/slow/'));
+  assert.deepEqual(started, [], 'no request is made while paused');
+  assert.equal(q.rateBytesPerSec, 0);
+  assert.equal(q.splitsApplied, q.splitsReceived, 'what had arrived is still applied');
+  assert.equal(q.state, 'streaming');
+  await page.mouse.move(900, 500); // no tooltip in the picture
+  await frames(page, 4);
+  await page.screenshot({ path: path.join(outDir, 'viewer-paused.png') });
+
+  await page.evaluate(() => window.tetstream.resume());
+  const s = await waitForState(page, ['complete', 'error']);
+  assert.equal(s.state, 'complete', s.error);
+  assert.equal(s.paused, false);
+  assert.equal(s.vertices, manifest.vertices);
+  const ref = cliIso(s.isovalue);
+  assert.equal(s.triangles, ref.triangles);
+  assertClose(s.surfaceArea, ref.area, 1e-6, 'surface area after pause and resume');
+  t.diagnostic(`slow link, paused ${q.chunksReceived} of ${manifest.chunks.length} chunks in: ${frameReport(s)}`);
+  assert.ok(s.maxFrameMs < MAX_FRAME_MS, `longest frame ${s.maxFrameMs} ms`);
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test('a split chunk missing mid-stream: the error is shown and the level reached stays usable', async () => {
+  const manifest = readManifest(gapPack);
+  const { page, problems } = await openViewer('?data=/gap/manifest.json', { allow: [/Failed to load resource.*404/] });
+  const s = await waitForState(page, ['complete', 'error']);
+  assert.equal(s.state, 'error');
+  assert.match(s.error, /part 6 of/);
+  assert.match(s.error, /HTTP 404/);
+  assert.match(await page.textContent('#status-text'), /HTTP 404/);
+  assert.equal(s.chunksReceived, 5, 'the five chunks before the gap were kept');
+  // What did arrive is applied, and stays on screen.
+  const t = await waitForLevel(page);
+  assert.equal(t.state, 'error');
+  assert.equal(t.splitsApplied, t.splitsReceived);
+  assert.equal(t.vertices, manifest.chunks[4].vertices);
+  assert.ok(t.triangles > 0, 'the surface of the last good level stays');
+  assert.equal(t.triangles, cliIso(t.isovalue, { chunks: 5, dir: gapPack }).triangles);
+  // The level slider still works over what arrived.
+  await page.evaluate(() => window.tetstream.setLevel(0));
+  const b = await waitForLevel(page);
+  assert.equal(b.vertices, manifest.chunks[0].vertices);
+  assert.equal(b.state, 'error', 'and the error stays shown');
+  await page.evaluate(() => window.tetstream.setLevel(1));
+  await waitForLevel(page);
+  await frames(page);
+  await page.screenshot({ path: path.join(outDir, 'viewer-404.png') });
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
 test('?iso= and ?field= choose the surface', async () => {
   {
     const { page, problems } = await openViewer('?data=/data/manifest.json&iso=0.5');
@@ -181,6 +401,7 @@ test('?iso= and ?field= choose the surface', async () => {
     assert.equal(s.isovalue, Math.fround(0.5));
     const ref = cliIso(0.5);
     assert.equal(s.triangles, ref.triangles);
+    assert.equal(s.vertices, readManifest().vertices);
     assertClose(s.surfaceArea, ref.area, 1e-6, 'surface area at iso=0.5');
     assert.deepEqual(problems, []);
     await page.close();

@@ -1,32 +1,52 @@
-// Loads a packed dataset, extracts one isosurface and prints a JSON line with its counts, area,
-// time and a hash of the exact output arrays. Built natively and as wasm (run under node with
-// NODERAWFS); tests/node/core.test.mjs checks that both print the same surface.
+// The core's view side on a packed dataset, built natively and as wasm (run under node with
+// NODERAWFS) so both can be compared and timed:
 //   tetstream_core_check PACKDIR ISOVALUE [FIELD] [REPEATS]
+//       one isosurface of the full mesh: counts, area, time and hashes of the exact output
+//       arrays (tests/node/core.test.mjs checks native == wasm)
+//   tetstream_core_check --stream PACKDIR ISOVALUE
+//       decode + apply + local isosurface update over every split, the undo rate, and isovalue
+//       re-extraction with the interval tree against a plain scan at several levels (benchmarks)
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <string>
+#include <vector>
 
 #include "dataset.h"
 #include "hash.h"
 #include "isosurface.h"
+#include "isosurface_incremental.h"
 
 using namespace tetstream;
+using Clock = std::chrono::steady_clock;
 
-int main(int argc, char** argv) {
-  if (argc < 3) {
-    std::fprintf(stderr, "usage: %s PACKDIR ISOVALUE [FIELD] [REPEATS]\n", argv[0]);
-    return 2;
-  }
+namespace {
+
+double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+bool readAll(const std::string& path, std::vector<uint8_t>& out) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return false;
+  out.clear();
+  uint8_t buf[1 << 16];
+  for (size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) out.insert(out.end(), buf, buf + n);
+  std::fclose(f);
+  return true;
+}
+
+int surfaceCheck(int argc, char** argv) {
   Dataset ds;
-  auto t0 = std::chrono::steady_clock::now();
+  auto t0 = Clock::now();
   if (Result r = loadPackedDir(argv[1], ds); !r) {
     std::fprintf(stderr, "error: %s\n", r.message.c_str());
     return 1;
   }
-  double loadMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  double loadMs = msSince(t0);
   const std::string field = argc > 3 ? argv[3] : ds.manifest.isoField;
-  int f = ds.pm.mesh.findField(field);
+  const TetMesh& mesh = ds.pm.mesh;
+  int f = mesh.findField(field);
   if (f < 0) {
     std::fprintf(stderr, "error: no field '%s'\n", field.c_str());
     return 1;
@@ -36,9 +56,9 @@ int main(int argc, char** argv) {
   IsoSurface s;
   double best = 1e300;
   for (int i = 0; i < repeats; ++i) {
-    auto t = std::chrono::steady_clock::now();
-    extractIsosurface(ds.pm.mesh, ds.pm.mesh.fields[size_t(f)].values, std::strtof(argv[2], nullptr), x, s);
-    best = std::min(best, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count());
+    auto t = Clock::now();
+    extractIsosurface(mesh, mesh.fields[size_t(f)].values, std::strtof(argv[2], nullptr), x, s);
+    best = std::min(best, msSince(t));
   }
   auto bytes = [](const auto& v) {
     return std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(v.data()), v.size() * sizeof(v[0]));
@@ -46,7 +66,94 @@ int main(int argc, char** argv) {
   std::printf(
       "{\"tets\": %u, \"triangles\": %u, \"vertices\": %u, \"area\": %.17g, \"positionsHash\": \"%s\", "
       "\"indicesHash\": \"%s\", \"normalsHash\": \"%s\", \"loadMs\": %.3f, \"ms\": %.3f}\n",
-      ds.pm.mesh.tetCount(), s.triangleCount(), s.vertexCount(), surfaceArea(s), formatHash(contentHash(bytes(s.positions))).c_str(),
+      mesh.tetCount(), s.triangleCount(), s.vertexCount(), surfaceArea(s), formatHash(contentHash(bytes(s.positions))).c_str(),
       formatHash(contentHash(bytes(s.indices))).c_str(), formatHash(contentHash(bytes(s.normals))).c_str(), loadMs, best);
   return 0;
+}
+
+int streamBench(const std::string& dir, float iso) {
+  Dataset ds;
+  if (Result r = loadPackedDir(dir, ds, 1); !r) {
+    std::fprintf(stderr, "error: %s\n", r.message.c_str());
+    return 1;
+  }
+  std::vector<std::vector<uint8_t>> files(ds.manifest.chunks.size());
+  for (uint32_t c = 1; c < files.size(); ++c)
+    if (!readAll(dir + "/" + ds.manifest.chunks[c].file, files[c])) return 1;
+  const int field = ds.manifest.findField(ds.manifest.isoField);
+  IncrementalIsosurface inc;
+  inc.rebuild(ds.pm.mesh, ds.pm.mesh.fields[size_t(field)].values, iso);
+  std::vector<uint32_t> changed;
+  bool reached;
+  // As the viewer does: receive each chunk, then splits in batches with a local update each.
+  auto t0 = Clock::now();
+  for (uint32_t c = 1; c < files.size(); ++c) {
+    if (Result r = receiveChunk(ds, c, files[c]); !r) {
+      std::fprintf(stderr, "error: %s\n", r.message.c_str());
+      return 1;
+    }
+    while (ds.splitsApplied() < ds.splitsReceived()) {
+      changed.clear();
+      if (Result r = stepTowards(ds, ~0u, 64, changed, &reached); !r) return 1;
+      inc.updateTets(ds.pm.mesh, ds.pm.mesh.fields[size_t(field)].values, changed);
+      inc.clearChanges();
+    }
+  }
+  const double streamMs = msSince(t0);
+  const uint32_t splits = ds.splitsApplied(), finalTriangles = inc.triangleCount();
+  t0 = Clock::now();
+  while (ds.splitsApplied() > 0) {  // the level slider all the way down
+    changed.clear();
+    stepTowards(ds, 0, 64, changed, &reached);
+    inc.updateTets(ds.pm.mesh, ds.pm.mesh.fields[size_t(field)].values, changed);
+    inc.clearChanges();
+  }
+  const double undoMs = msSince(t0);
+  std::printf("{\"splits\": %u, \"finalTriangles\": %u, \"streamMs\": %.1f, \"splitsPerSecond\": %.0f, \"undoMs\": %.1f, "
+              "\"undoSplitsPerSecond\": %.0f, \"levels\": [",
+              splits, finalTriangles, streamMs, splits / streamMs * 1000, undoMs, splits / undoMs * 1000);
+  // Isovalue changes at several levels: interval tree (rebuild) against a scan of every tet.
+  bool first = true;
+  for (double fraction : {0.05, 0.10, 0.15, 0.30, 1.0}) {
+    const uint32_t target = uint32_t(fraction * splits);
+    changed.clear();
+    stepTowards(ds, target, ~0u, changed, &reached);
+    const TetMesh& m = ds.pm.mesh;
+    const std::vector<float>& values = m.fields[size_t(field)].values;
+    const Range range = ds.manifest.fields[size_t(field)].range;
+    std::printf("%s{\"fraction\": %.2f, \"vertices\": %u, \"tets\": %u, \"isovalues\": [", first ? "" : ", ", fraction,
+                m.vertexCount(), m.tetCount());
+    first = false;
+    IncrementalIsosurface tree;
+    for (int k = 0; k < 4; ++k) {
+      const float value = range.min + (range.max - range.min) * (0.2f + 0.2f * k);
+      double treeMs = 1e30, scanMs = 1e30;
+      IsoExtractor x;
+      IsoSurface s;
+      for (int rep = 0; rep < 3; ++rep) {
+        auto a = Clock::now();
+        tree.rebuild(m, values, value);
+        if (rep > 0 || k > 0) treeMs = std::min(treeMs, msSince(a));  // the first call builds the tree
+        a = Clock::now();
+        extractIsosurface(m, values, value, x, s);
+        scanMs = std::min(scanMs, msSince(a));
+      }
+      std::printf("%s{\"isovalue\": %.4g, \"triangles\": %u, \"treeMs\": %.2f, \"scanMs\": %.2f}", k ? ", " : "", value,
+                  tree.triangleCount(), treeMs, scanMs);
+    }
+    std::printf("]}");
+  }
+  std::printf("]}\n");
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc >= 4 && !std::strcmp(argv[1], "--stream")) return streamBench(argv[2], std::strtof(argv[3], nullptr));
+  if (argc < 3) {
+    std::fprintf(stderr, "usage: %s PACKDIR ISOVALUE [FIELD] [REPEATS] | --stream PACKDIR ISOVALUE\n", argv[0]);
+    return 2;
+  }
+  return surfaceCheck(argc, argv);
 }

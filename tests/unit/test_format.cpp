@@ -18,22 +18,8 @@ using namespace tetstream;
 
 namespace {
 
-// A folder for one test under this suite's scratch folder (removed at exit).
-std::string tempDir(const std::string& name) {
-  static test::ScratchDir root("format");
-  std::string dir = root.path + "/" + name;
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
-
-TetMesh harmonic(uint32_t n) {
-  TetMesh m = makeGridMesh(n);
-  addHarmonicField(m);
-  addDistanceField(m);
-  m.name = "harmonic";
-  return m;
-}
+std::string tempDir(const std::string& name) { return test::suiteDir("format", name); }
+TetMesh harmonic(uint32_t n) { return test::harmonicMesh(n); }
 
 // The whole mesh as one exact base chunk (no simplification, no quantization): the tests here
 // are about the container; test_progressive.cpp covers the split stream.
@@ -69,7 +55,7 @@ TEST(Format, PackThenLoadIsExact) {
   EXPECT_EQ(ds.pm.mesh.fields[0].values, m.fields[0].values);
   EXPECT_EQ(ds.pm.mesh.fields[1].values, m.fields[1].values);
   EXPECT_EQ(ds.manifest.isoField, "harmonic");
-  EXPECT_EQ(ds.chunksApplied, 1u);
+  EXPECT_EQ(ds.chunksApplied(), 1u);
 }
 
 TEST(Format, PackOrientsTetsPositively) {
@@ -188,7 +174,7 @@ TEST(Format, CorruptTruncatedAndWrongChunksAreNeverApplied) {
   for (size_t len : {size_t(0), size_t(1), good.size() / 2, good.size() - 1})
     EXPECT_EQ(applyChunk(ds, 0, std::span(good.data(), len)).status, Status::SizeMismatch);
   EXPECT_EQ(applyChunk(ds, 1, good).status, Status::BadArgument) << "out of order";
-  EXPECT_EQ(ds.chunksApplied, 0u);
+  EXPECT_EQ(ds.chunksApplied(), 0u);
   EXPECT_EQ(ds.pm.mesh.tetCount(), 0u) << "nothing applied";
   Result ok = applyChunk(ds, 0, good);
   EXPECT_TRUE(ok) << ok.message;
@@ -245,6 +231,6 @@ TEST(Format, SplitChunksAreRefusedByThisVersion) {
   std::vector<uint8_t> base = test::loadBytes(dir + "/" + m.chunks[0].file);
   ASSERT_TRUE(applyChunk(ds, 0, base));
   EXPECT_FALSE(applyChunk(ds, 1, base).ok());
-  EXPECT_EQ(ds.chunksApplied, 1u);
+  EXPECT_EQ(ds.chunksApplied(), 1u);
   EXPECT_GT(ds.pm.mesh.tetCount(), 0u);
 }

@@ -9,6 +9,10 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
+#include <memory>
+
+#include "pack/generators.h"
 
 namespace tetstream::test {
 
@@ -48,6 +52,24 @@ ScratchDir::ScratchDir(const std::string& name) {
 ScratchDir::~ScratchDir() {
   std::error_code ec;
   std::filesystem::remove_all(path, ec);
+}
+
+TetMesh harmonicMesh(uint32_t n) {
+  TetMesh m = makeGridMesh(n);
+  addHarmonicField(m);
+  addDistanceField(m);
+  m.name = "harmonic";
+  return m;
+}
+
+std::string suiteDir(const std::string& suite, const std::string& name) {
+  static std::map<std::string, std::unique_ptr<ScratchDir>> roots;  // destroyed at exit
+  auto& root = roots[suite];
+  if (!root) root = std::make_unique<ScratchDir>(suite);
+  std::string dir = root->path + "/" + name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
 }
 
 int runCommand(const std::string& command, std::string& output) {

@@ -53,6 +53,13 @@ inline TetMesh twoTets() {
   return m;
 }
 
+// Harmonic n³ with both generated fields ("harmonic", then "distance").
+TetMesh harmonicMesh(uint32_t n);
+
+// A fresh, empty folder `name` inside a scratch folder shared by one test suite; everything is
+// removed when the test program exits.
+std::string suiteDir(const std::string& suite, const std::string& name);
+
 // A file's bytes as a byte vector (for the chunk decoder's span).
 inline std::vector<uint8_t> loadBytes(const std::string& path) {
   std::string s = loadFile(path);

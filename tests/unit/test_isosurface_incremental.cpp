@@ -14,7 +14,9 @@
 
 #include "isosurface.h"
 #include "isosurface_incremental.h"
+#include "dataset.h"
 #include "pack/generators.h"
+#include "pack/packer.h"
 #include "test_helpers.h"
 
 using namespace tetstream;
@@ -450,4 +452,42 @@ TEST(IncrementalIso, BenchmarkHarmonic64) {
   RecordProperty("split_update_us", std::to_string(1000 * splitMs / splits));
   RecordProperty("undo_update_us", std::to_string(1000 * undoMs / splits));
   expectSameSurface(inc, m, "after undoing every split");
+}
+
+// The same property on the real stream: pack Harmonic, then walk the level up and down through
+// every received split (applySplit / undoSplit via the dataset), updating locally after every
+// few splits, and compare with a from-scratch extraction each time.
+TEST(IncrementalIso, RealVertexSplitsEqualFromScratch) {
+  test::ScratchDir dir("incremental-real");
+  TetMesh m = makeGridMesh(10);
+  addHarmonicField(m);
+  PackOptions o;
+  o.chunkKb = 1;
+  o.zstdLevel = 3;
+  PackSummary s;
+  ASSERT_TRUE(packMesh(m, dir.path, o, s));
+  Dataset ds;
+  ASSERT_TRUE(loadPackedDir(dir.path, ds, 1));
+  for (uint32_t c = 1; c < ds.manifest.chunks.size(); ++c)
+    ASSERT_TRUE(receiveChunk(ds, c, test::loadBytes(dir.path + "/" + ds.manifest.chunks[c].file)));
+  for (float iso : {0.2f, -0.1f}) {
+    IncrementalIsosurface inc;
+    std::vector<uint32_t> changed;
+    bool reached = false;
+    ASSERT_TRUE(stepTowards(ds, 0, ~0u, changed, &reached));
+    inc.rebuild(ds.pm.mesh, ds.pm.mesh.fields[0].values, iso);
+    expectSameSurface(inc, ds.pm.mesh, "base");
+    const uint32_t total = ds.splitsReceived();
+    // Up in steps of 7, down in steps of 13 to the middle, up again to the end.
+    for (uint32_t target : {total, total / 2, total}) {
+      const uint32_t stride = target < ds.splitsApplied() ? 13 : 7;
+      while (ds.splitsApplied() != target) {
+        changed.clear();
+        ASSERT_TRUE(stepTowards(ds, target, stride, changed, &reached));
+        inc.updateTets(ds.pm.mesh, ds.pm.mesh.fields[0].values, changed);
+        expectSameSurface(inc, ds.pm.mesh, "at " + std::to_string(ds.splitsApplied()) + " splits");
+      }
+    }
+    EXPECT_EQ(ds.pm.vertexCount(), m.vertexCount());
+  }
 }

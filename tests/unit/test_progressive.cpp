@@ -12,8 +12,11 @@
 #include <map>
 #include <unordered_map>
 
+#include <zstd.h>
+
 #include "adjacency.h"
 #include "dataset.h"
+#include "pack/chunk_encode.h"
 #include "pack/generators.h"
 #include "pack/packer.h"
 #include "pack/simplify.h"
@@ -25,21 +28,8 @@ using namespace tetstream;
 
 namespace {
 
-std::string tempDir(const std::string& name) {
-  static test::ScratchDir root("progressive");
-  std::string dir = root.path + "/" + name;
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
-
-TetMesh harmonic(uint32_t n) {
-  TetMesh m = makeGridMesh(n);
-  addHarmonicField(m);
-  addDistanceField(m);
-  m.name = "harmonic";
-  return m;
-}
+std::string tempDir(const std::string& name) { return test::suiteDir("progressive", name); }
+TetMesh harmonic(uint32_t n) { return test::harmonicMesh(n); }
 
 // Drops the tets in the octant x, y, z > 0 (a non-convex domain with concave creases) and the
 // vertices no tet uses any more.
@@ -294,8 +284,9 @@ TEST(Legality, LinkConditionProtectsTopology) {
 }
 
 TEST(Legality, FlatInputTetsAreRemovedNotCreated) {
-  // A grid whose middle layer is squashed flat in one cube: the packer must not fail, must not
-  // create new flat tets, and removes the flat ones where it can.
+  // A grid with one vertex pushed onto the layer below, flattening the tets between: the
+  // simplifier must not fail, must not create flat tets, and gets rid of the flat ones (a
+  // collapse removes a flat tet that contains its edge, or moves it into a proper shape).
   TetMesh m = harmonic(7);
   uint32_t v = gridVertex(7, 3, 3, 3);
   m.positions[3 * v + 2] = m.positions[3 * gridVertex(7, 3, 3, 2) + 2];  // onto the layer below
@@ -305,6 +296,71 @@ TEST(Legality, FlatInputTetsAreRemovedNotCreated) {
   o.targetVertices = 20;
   SimplifyResult r;
   ASSERT_TRUE(simplifyMesh(m, o, r));
-  EXPECT_GT(r.flatTetsRemoved, 0u);
-  EXPECT_LE(r.flatTetsLeft, before.zeroVolumeTets);
+  EXPECT_EQ(r.flatTetsLeft, 0u);
+  EXPECT_LE(r.flatTetsRemoved, before.zeroVolumeTets);
+  TetMesh base;
+  base.positions = m.positions;
+  for (uint32_t t = 0; t < m.tetCount(); ++t)
+    if (r.tetAlive[t]) base.tets.insert(base.tets.end(), &r.tets[4 * t], &r.tets[4 * t] + 4);
+  ValidationReport after = validateMesh(base);
+  EXPECT_EQ(after.zeroVolumeTets, 0u);
+  EXPECT_EQ(after.negativeTets, 0u);
+}
+
+// ------------------------------------------------------------------ level control
+
+TEST(Level, UndoAndRedoReachTheSameMeshes) {
+  TetMesh m = harmonic(9);
+  PackOptions o;
+  o.chunkKb = 1;
+  std::string dir = pack("level", m, o);
+  Dataset ds;
+  ASSERT_TRUE(loadPackedDir(dir, ds, 1));
+  for (uint32_t c = 1; c < ds.manifest.chunks.size(); ++c)
+    ASSERT_TRUE(receiveChunk(ds, c, test::loadBytes(dir + "/" + ds.manifest.chunks[c].file)));
+  const uint32_t total = ds.splitsReceived();
+  ASSERT_EQ(ds.pm.baseVertices + total, m.vertexCount());
+  std::vector<uint32_t> changed;
+  bool reached;
+  for (uint32_t target : {total, 0u, total / 3, total / 2, total / 5, total}) {
+    ASSERT_TRUE(stepTowards(ds, target, ~0u, changed, &reached));
+    ASSERT_TRUE(reached);
+    Dataset fresh;
+    ASSERT_TRUE(loadPackedDir(dir, fresh, -1, ds.pm.baseVertices + target));
+    EXPECT_EQ(ds.pm.mesh.positions, fresh.pm.mesh.positions) << target;
+    EXPECT_EQ(ds.pm.mesh.tets, fresh.pm.mesh.tets) << target;
+    EXPECT_EQ(ds.pm.mesh.fields[0].values, fresh.pm.mesh.fields[0].values) << target;
+    EXPECT_EQ(ds.chunksApplied(), fresh.chunksApplied()) << target;
+  }
+  EXPECT_EQ(ds.chunksApplied(), ds.manifest.chunks.size());
+}
+
+// A chunk whose hash matches a lying manifest: the bad record is found while applying, the
+// chunk's splits are undone, it is dropped, and the level stays where the last good chunk ended.
+TEST(Level, BadRecordInAHashedChunkUndoesItsChunk) {
+  std::string dir = pack("bad-record", harmonic(9), [] { PackOptions o; o.chunkKb = 1; return o; }());
+  Dataset ds;
+  ASSERT_TRUE(loadPackedDir(dir, ds, 2));
+  const uint32_t goodVertices = ds.pm.vertexCount(), goodTets = ds.pm.tetCount();
+  ChunkInfo& info = ds.manifest.chunks[2];
+  std::vector<uint8_t> file = test::loadBytes(dir + "/" + info.file);
+  std::vector<uint8_t> raw(info.rawBytes);
+  ASSERT_EQ(ZSTD_decompress(raw.data(), raw.size(), file.data(), file.size()), raw.size());
+  raw.pop_back();  // the last record ends early
+  std::vector<uint8_t> bad;
+  ChunkInfo forged = info;
+  ASSERT_TRUE(finishChunk(raw, 3, bad, forged));
+  info.bytes = forged.bytes;
+  info.rawBytes = forged.rawBytes;
+  info.hash = forged.hash;
+  ASSERT_TRUE(receiveChunk(ds, 2, bad));
+  std::vector<uint32_t> changed;
+  bool reached;
+  Result r = stepTowards(ds, ~0u, ~0u, changed, &reached);
+  EXPECT_TRUE(r.status == Status::Truncated || r.status == Status::Corrupt) << r.message;
+  EXPECT_NE(r.message.find("chunk 2"), std::string::npos) << r.message;
+  EXPECT_EQ(ds.chunksReceived, 2u);
+  EXPECT_EQ(ds.pm.vertexCount(), goodVertices);
+  EXPECT_EQ(ds.pm.tetCount(), goodTets);
+  expectValidLevel(ds.pm.mesh, "after the dropped chunk");
 }

@@ -31,6 +31,9 @@ struct FixtureCase {
   std::vector<std::string> fileHas;    // substrings of the file itself: proves what the writer did
 };
 
+// gtest prints parameters in test listings (and so in ctest's test names): name the file only.
+void PrintTo(const FixtureCase& c, std::ostream* os) { *os << c.file; }
+
 const std::vector<std::string> kVtkFields = {"f", "v_magnitude", "label"};
 const std::vector<std::string> kMeshioFields = {"f", "v_magnitude"};
 

@@ -1,14 +1,22 @@
 // The viewer's model natively (no GL, no ImGui, no Emscripten): loading states, hostile input,
-// isovalue and field changes, the hull, and the camera framing the dataset.
+// isovalue and field changes, streaming splits under a time budget with the surface and hull
+// kept up to date locally, the level of detail moving back and forth, the download rate, and
+// the camera framing the dataset.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <numbers>
+#include <random>
 
 #include <nlohmann/json.hpp>
+#include <zstd.h>
 
+#include "adjacency.h"
 #include "camera.h"
+#include "pack/chunk_encode.h"
 #include "pack/generators.h"
 #include "pack/packer.h"
 #include "test_helpers.h"
@@ -21,31 +29,87 @@ namespace {
 
 struct Packed {
   std::string manifest;
-  std::vector<uint8_t> chunk;
+  std::vector<std::vector<uint8_t>> chunks;
 };
 
-// Harmonic 24³ with a distance field, packed once for the whole suite.
-const Packed& packed() {
-  static test::ScratchDir dir("viewer-state");
-  static Packed p = [] {
-    TetMesh m = makeGridMesh(24);
-    addHarmonicField(m);
-    addDistanceField(m);
-    PackSummary s;
-    PackOptions o;
-    o.baseFraction = 1.0;  // one base chunk: streaming splits is covered elsewhere
-    o.zstdLevel = 3;
-    Result r = packMesh(m, dir.path, o, s);
-    EXPECT_TRUE(r) << r.message;
-    Packed out;
-    out.manifest = test::loadFile(dir.path + "/manifest.json");
-    out.chunk = test::loadBytes(dir.path + "/" + s.manifest.chunks[0].file);
-    return out;
-  }();
+Packed pack(int n, double baseFraction, uint32_t chunkKb, const char* name) {
+  test::ScratchDir dir(name);
+  TetMesh m = makeGridMesh(n);
+  addHarmonicField(m);
+  addDistanceField(m);
+  PackSummary s;
+  PackOptions o;
+  o.baseFraction = baseFraction;
+  o.chunkKb = chunkKb;
+  o.zstdLevel = 3;
+  Result r = packMesh(m, dir.path, o, s);
+  EXPECT_TRUE(r) << r.message;
+  Packed out;
+  out.manifest = test::loadFile(dir.path + "/manifest.json");
+  for (const ChunkInfo& c : s.manifest.chunks) out.chunks.push_back(test::loadBytes(dir.path + "/" + c.file));
+  return out;
+}
+
+// Harmonic 24³ with a distance field in one base chunk (no splits).
+const Packed& packedBase() {
+  static Packed p = pack(24, 1.0, 256, "viewer-state-base");
+  return p;
+}
+
+// Harmonic 12³: a 5% base and many small split chunks.
+const Packed& packedStream() {
+  static Packed p = pack(12, 0.05, 1, "viewer-state-stream");
   return p;
 }
 
 nlohmann::json stats(const ViewerState& s) { return nlohmann::json::parse(statsJson(s)); }
+
+// A clock that advances one unit per reading: advance() then does a bounded number of batches.
+double g_ticks = 0;
+double fakeNow() { return g_ticks += 1; }
+
+// Runs advance() until the level reaches its target; returns the number of calls.
+int settle(ViewerState& s, double ticksPerCall = 3) {
+  int calls = 0;
+  while (advance(s, g_ticks + ticksPerCall, fakeNow)) ++calls;
+  return calls;
+}
+
+// The surface and hull of the current level equal a from-scratch extraction.
+void expectMatchesFromScratch(const ViewerState& s, const char* where) {
+  SCOPED_TRACE(where);
+  const TetMesh& mesh = s.dataset.pm.mesh;
+  int f = mesh.findField(s.dataset.manifest.fields[size_t(s.field)].name);
+  ASSERT_GE(f, 0);
+  IsoExtractor x;
+  IsoSurface ref;
+  extractIsosurface(mesh, mesh.fields[size_t(f)].values, s.isovalue, x, ref);
+  EXPECT_EQ(s.surface.triangleCount(), ref.triangleCount());
+  EXPECT_EQ(s.surface.vertexCount(), ref.vertexCount());
+  EXPECT_NEAR(s.surface.area(), surfaceArea(ref), 1e-9 * std::max(1.0, surfaceArea(ref)));
+  EXPECT_TRUE(s.surface.validate());
+
+  // Hull: the same outward-wound triangles (compared with the smallest id first) and creases.
+  FaceAdjacency adj;
+  buildFaceAdjacency(mesh.tets, mesh.vertexCount(), adj);
+  std::vector<uint32_t> tris;
+  extractBoundary(mesh.tets, adj, tris);
+  auto canonical = [](std::span<const uint32_t> t) {
+    std::vector<std::array<uint32_t, 3>> out;
+    for (size_t i = 0; i + 2 < t.size(); i += 3) {
+      std::array<uint32_t, 3> a = {t[i], t[i + 1], t[i + 2]};
+      std::rotate(a.begin(), std::min_element(a.begin(), a.end()), a.end());
+      out.push_back(a);
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  EXPECT_EQ(canonical(s.hull.faces()), canonical(tris));
+  BoundaryMesh b;
+  buildBoundary(mesh, b);
+  EXPECT_EQ(s.hull.lineCount(), b.lineCount());
+  EXPECT_EQ(s.hull.trianglePositions().size(), 9 * size_t(s.hull.triangleCount()));
+}
 
 }  // namespace
 
@@ -65,36 +129,37 @@ TEST(ViewerState, HostileManifestsEndInErrorWithAMessage) {
 }
 
 TEST(ViewerState, BadChunksNeverReplaceTheShownLevel) {
-  const Packed& p = packed();
+  const Packed& p = packedBase();
   ViewerState s;
   ASSERT_TRUE(openManifest(s, p.manifest).ok());
   EXPECT_EQ(s.state, LoadState::Loading);
   EXPECT_EQ(s.chunksTotal, 1u);
-  EXPECT_FALSE(addChunk(s, 1, p.chunk).ok()) << "out of order";
+  EXPECT_FALSE(addChunk(s, 1, p.chunks[0]).ok()) << "out of order";
   EXPECT_EQ(s.state, LoadState::Error);
   ASSERT_TRUE(openManifest(s, p.manifest).ok());
-  EXPECT_FALSE(addChunk(s, 0, std::span<const uint8_t>(p.chunk).first(p.chunk.size() / 2)).ok());
+  EXPECT_FALSE(addChunk(s, 0, std::span<const uint8_t>(p.chunks[0]).first(p.chunks[0].size() / 2)).ok());
   EXPECT_EQ(s.state, LoadState::Error);
   EXPECT_EQ(s.dataset.pm.mesh.tetCount(), 0u);
   EXPECT_NE(s.error.find("chunk 0"), std::string::npos) << s.error;
+  EXPECT_FALSE(addChunk(s, 0, p.chunks[0]).ok()) << "nothing is accepted once in error";
 }
 
 TEST(ViewerState, LoadsExtractsAndFollowsTheControls) {
-  const Packed& p = packed();
+  const Packed& p = packedBase();
   ViewerState s;
   ASSERT_TRUE(openManifest(s, p.manifest).ok());
   auto mj = nlohmann::json::parse(p.manifest);
   float mid = 0.5f * (mj["fields"][0]["min"].get<float>() + mj["fields"][0]["max"].get<float>());
   EXPECT_NEAR(s.isovalue, mid, 1e-6f) << "starts in the middle of the range";
-  ASSERT_TRUE(addChunk(s, 0, p.chunk).ok());
-  EXPECT_EQ(s.state, LoadState::Complete);
+  ASSERT_TRUE(addChunk(s, 0, p.chunks[0]).ok());
+  EXPECT_EQ(s.state, LoadState::Complete) << "a base-only dataset is complete at once";
   EXPECT_GT(s.surface.triangleCount(), 0u);
   EXPECT_TRUE(s.surfaceDirty);
-
-  updateBoundary(s);
-  EXPECT_FALSE(s.boundaryStale);
-  EXPECT_GT(s.boundary.triangleCount(), 0u);
-  EXPECT_EQ(s.boundary.lineCount(), 12u * 23) << "the cube's 12 edges, 23 segments each";
+  EXPECT_TRUE(s.surface.fullUploadNeeded());
+  EXPECT_GT(s.hull.triangleCount(), 0u);
+  EXPECT_EQ(s.hull.lineCount(), 12u * 23) << "the cube's 12 edges, 23 segments each";
+  EXPECT_FALSE(advance(s, g_ticks + 10, fakeNow)) << "nothing to refine";
+  expectMatchesFromScratch(s, "base");
 
   uint32_t tris = s.surface.triangleCount();
   setIsovalue(s, s.isovalue + 0.2f);
@@ -104,9 +169,10 @@ TEST(ViewerState, LoadsExtractsAndFollowsTheControls) {
   EXPECT_FALSE(setField(s, "nope"));
   EXPECT_EQ(s.field, 1);
   setIsovalue(s, 0.8f);
-  EXPECT_NEAR(s.surfaceArea, 4 * std::numbers::pi * 0.64, 0.02 * s.surfaceArea) << "sphere of radius 0.8";
+  EXPECT_NEAR(s.surface.area(), 4 * std::numbers::pi * 0.64, 0.02 * s.surface.area()) << "sphere of radius 0.8";
+  expectMatchesFromScratch(s, "distance field");
 
-  EXPECT_FALSE(addChunk(s, 1, p.chunk).ok()) << "a chunk past the end is refused";
+  EXPECT_FALSE(addChunk(s, 1, p.chunks[0]).ok()) << "a chunk past the end is refused";
   EXPECT_GT(s.surface.triangleCount(), 0u) << "and the surface stays";
   failLoad(s, "network down");
   auto j = stats(s);
@@ -115,6 +181,171 @@ TEST(ViewerState, LoadsExtractsAndFollowsTheControls) {
   EXPECT_EQ(j["field"], "distance");
   EXPECT_EQ(j["fields"].size(), 2u);
   EXPECT_EQ(j["triangles"].get<uint32_t>(), s.surface.triangleCount());
+}
+
+TEST(ViewerState, StreamsSplitsUnderABudgetWithLocalUpdates) {
+  const Packed& p = packedStream();
+  ASSERT_GE(p.chunks.size(), 4u) << "the test needs several split chunks";
+  ViewerState s;
+  ASSERT_TRUE(openManifest(s, p.manifest).ok());
+  ASSERT_TRUE(setField(s, "harmonic"));
+  setIsovalue(s, 0.1f);
+  ASSERT_TRUE(addChunk(s, 0, p.chunks[0]).ok());
+  EXPECT_EQ(s.state, LoadState::Streaming);
+  const uint32_t baseVertices = s.dataset.pm.vertexCount();
+  expectMatchesFromScratch(s, "base");
+  s.surface.clearChanges();
+  s.hull.clearChanges();
+
+  // Verification only: nothing is applied until the frame loop advances.
+  ASSERT_TRUE(addChunk(s, 1, p.chunks[1]).ok());
+  EXPECT_EQ(s.dataset.pm.vertexCount(), baseVertices);
+  EXPECT_EQ(s.targetSplits, s.dataset.splitsReceived()) << "live: the target follows new data";
+
+  // One bounded slice: some splits, not all, and only local changes for the renderer.
+  ASSERT_TRUE(advance(s, g_ticks + 2, fakeNow));
+  EXPECT_GT(s.refineSteps, 0u);
+  EXPECT_LE(s.refineSteps, 2 * kStepBatch);
+  EXPECT_EQ(s.dataset.splitsApplied(), s.refineSteps);
+  EXPECT_FALSE(s.surface.fullUploadNeeded()) << "splits never re-extract the whole surface";
+  EXPECT_FALSE(s.hull.fullUploadNeeded());
+  expectMatchesFromScratch(s, "inside chunk 1");
+
+  for (uint32_t c = 2; c < p.chunks.size(); ++c) {
+    ASSERT_TRUE(addChunk(s, c, p.chunks[c]).ok()) << c;
+    advance(s, g_ticks + 4, fakeNow);
+    if (c + 1 < p.chunks.size()) {
+      EXPECT_EQ(s.state, LoadState::Streaming);
+    }
+  }
+  settle(s);
+  EXPECT_EQ(s.state, LoadState::Complete);
+  EXPECT_EQ(s.dataset.pm.vertexCount(), s.dataset.manifest.vertices);
+  EXPECT_FALSE(s.surface.fullUploadNeeded());
+  expectMatchesFromScratch(s, "complete");
+  auto j = stats(s);
+  EXPECT_EQ(j["level"].get<double>(), 1.0);
+  EXPECT_EQ(j["fieldError"].get<double>(), 0.0);
+  EXPECT_EQ(j["splitsApplied"], j["splitsTotal"]);
+  EXPECT_EQ(j["chunksApplied"].get<uint32_t>(), s.chunksTotal);
+}
+
+TEST(ViewerState, LevelMovesBackAndForthAndStaysWhereTheUserPutsIt) {
+  const Packed& p = packedStream();
+  ViewerState s;
+  ASSERT_TRUE(openManifest(s, p.manifest).ok());
+  ASSERT_TRUE(addChunk(s, 0, p.chunks[0]).ok());
+  const uint32_t base = s.dataset.pm.baseVertices;
+  ASSERT_TRUE(addChunk(s, 1, p.chunks[1]).ok());
+  ASSERT_TRUE(addChunk(s, 2, p.chunks[2]).ok());
+  settle(s);
+  const uint32_t received = s.dataset.splitsReceived();
+  EXPECT_EQ(s.dataset.splitsApplied(), received);
+
+  // Back to the base: coarser, the surface following through undos.
+  setLevelFraction(s, 0);
+  EXPECT_FALSE(s.live);
+  settle(s);
+  EXPECT_EQ(s.dataset.pm.vertexCount(), base);
+  EXPECT_EQ(stats(s)["fieldError"].get<double>(), s.dataset.manifest.chunks[0].fieldError);
+  expectMatchesFromScratch(s, "back at the base");
+
+  // New data does not move a level the user put back.
+  ASSERT_TRUE(addChunk(s, 3, p.chunks[3]).ok());
+  settle(s);
+  EXPECT_EQ(s.dataset.pm.vertexCount(), base);
+  EXPECT_EQ(s.state, LoadState::Streaming);
+
+  // Random levels, each equal to a from-scratch extraction.
+  std::mt19937 rng(7);
+  for (int k = 0; k < 6; ++k) {
+    uint32_t target = std::uniform_int_distribution<uint32_t>(0, s.dataset.splitsReceived())(rng);
+    setLevel(s, target);
+    settle(s, 2);
+    EXPECT_EQ(s.dataset.splitsApplied(), target);
+    expectMatchesFromScratch(s, ("level " + std::to_string(target)).c_str());
+  }
+
+  // Forward to the newest level: live again, so the next chunk is followed.
+  setLevelFraction(s, 1.0);
+  EXPECT_TRUE(s.live);
+  EXPECT_EQ(s.targetSplits, s.dataset.splitsReceived());
+  EXPECT_GT(s.dataset.splitsReceived(), received);
+  for (uint32_t c = 4; c < p.chunks.size(); ++c) ASSERT_TRUE(addChunk(s, c, p.chunks[c]).ok());
+  settle(s);
+  EXPECT_EQ(s.state, LoadState::Complete);
+  expectMatchesFromScratch(s, "complete after moving around");
+
+  // A fraction is of the full mesh's vertices.
+  setLevelFraction(s, 0.5);
+  settle(s);
+  EXPECT_EQ(s.dataset.pm.vertexCount(), uint32_t(std::round(0.5 * s.dataset.manifest.vertices)));
+  EXPECT_EQ(s.state, LoadState::Streaming) << "complete means every split applied";
+}
+
+TEST(ViewerState, ErrorsKeepTheLevelUsable) {
+  const Packed& p = packedStream();
+  ViewerState s;
+  ASSERT_TRUE(openManifest(s, p.manifest).ok());
+  ASSERT_TRUE(addChunk(s, 0, p.chunks[0]).ok());
+  ASSERT_TRUE(addChunk(s, 1, p.chunks[1]).ok());
+  failLoad(s, "Could not download part 3: HTTP 404 (not found).");
+  EXPECT_FALSE(addChunk(s, 2, p.chunks[2]).ok());
+  settle(s);
+  EXPECT_EQ(s.state, LoadState::Error);
+  EXPECT_EQ(s.dataset.splitsApplied(), s.dataset.splitsReceived()) << "what did arrive is still applied";
+  setLevelFraction(s, 0);
+  settle(s);
+  EXPECT_EQ(s.dataset.pm.vertexCount(), s.dataset.pm.baseVertices) << "and the level slider still works";
+  expectMatchesFromScratch(s, "after an error");
+}
+
+TEST(ViewerState, AHostileChunkWithAValidHashEndsInErrorAtTheLastGoodLevel) {
+  const Packed& p = packedStream();
+  ViewerState s;
+  ASSERT_TRUE(openManifest(s, p.manifest).ok());
+  ASSERT_TRUE(addChunk(s, 0, p.chunks[0]).ok());
+  ASSERT_TRUE(addChunk(s, 1, p.chunks[1]).ok());
+  settle(s);
+  const uint32_t goodVertices = s.dataset.pm.vertexCount();
+  // Chunk 2 with its last record cut short, compressed and hashed as if it were right.
+  ChunkInfo& info = s.dataset.manifest.chunks[2];
+  std::vector<uint8_t> raw(info.rawBytes);
+  ASSERT_EQ(ZSTD_decompress(raw.data(), raw.size(), p.chunks[2].data(), p.chunks[2].size()), raw.size());
+  raw.pop_back();
+  std::vector<uint8_t> bad;
+  ChunkInfo forged = info;
+  ASSERT_TRUE(finishChunk(raw, 3, bad, forged));
+  info.bytes = forged.bytes;
+  info.rawBytes = forged.rawBytes;
+  info.hash = forged.hash;
+  ASSERT_TRUE(addChunk(s, 2, bad).ok()) << "the hash matches: only applying finds the damage";
+  settle(s);
+  EXPECT_EQ(s.state, LoadState::Error);
+  EXPECT_NE(s.error.find("Part 3 of"), std::string::npos) << s.error;
+  EXPECT_EQ(s.dataset.chunksReceived, 2u);
+  EXPECT_EQ(s.dataset.pm.vertexCount(), goodVertices);
+  expectMatchesFromScratch(s, "after the dropped chunk");
+  EXPECT_FALSE(addChunk(s, 3, p.chunks[3]).ok());
+}
+
+TEST(ViewerState, PauseAndDownloadRate) {
+  const Packed& p = packedStream();
+  ViewerState s;
+  ASSERT_TRUE(openManifest(s, p.manifest).ok());
+  EXPECT_TRUE(downloading(s));
+  // 100 KB/s for 3 s, reported every 50 ms.
+  for (int ms = 0; ms <= 3000; ms += 50) noteDownload(s, uint64_t(ms) * 100, uint64_t(ms), ms);
+  tick(s, 3000);
+  EXPECT_NEAR(s.rateBytesPerSec, 100000, 5000);
+  EXPECT_GT(secondsLeft(s), 0);
+  tick(s, 6000);
+  EXPECT_EQ(s.rateBytesPerSec, 0) << "no bytes for 3 s: no rate";
+  setPaused(s, true);
+  EXPECT_TRUE(s.pausedChanged);
+  EXPECT_FALSE(downloading(s));
+  EXPECT_EQ(stats(s)["paused"], true);
+  EXPECT_LT(secondsLeft(s), 0);
 }
 
 TEST(ViewerState, CameraFramesTheBoundingBox) {
