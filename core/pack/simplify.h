@@ -13,7 +13,7 @@
 //        quadrics; our stand-in for eq. (5)'s integral over the original vertices of the region).
 //   E_s  shape error, paper §3.3: mean of κ(S) − 3 over the tets around p_j after the collapse,
 //        divided by 3 (0 for equilateral tets).
-// Defaults (10, 1, 0.002) keep the boundary first, then the field; tet shape is a
+// Defaults (100, 1, 0.002) keep the boundary first, then the field; tet shape is a
 // tie-breaker; all terms are scale free, so they work for any mesh size and field range.
 //
 // Legality, checked for every collapse (paper §3.2 and Staadt & Gross / Dey et al.):
@@ -40,7 +40,7 @@
 namespace tetstream {
 
 struct SimplifyOptions {
-  double weightGeometry = 10.0, weightField = 1.0, weightShape = 0.002;
+  double weightGeometry = 100.0, weightField = 1.0, weightShape = 0.002;
   uint32_t targetVertices = 0;  // stop at this many vertices (0: as far as legal collapses go)
   uint32_t targetTets = 0;      // ...or at this many tets, whichever comes first
   double maxError = std::numeric_limits<double>::infinity();  // stop when the cheapest cost exceeds it
