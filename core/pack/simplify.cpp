@@ -143,6 +143,7 @@ class Simplifier {
       heap_.pop();
       if (!out_.vertexAlive[e.vertex] || version_[e.vertex] != e.version) continue;
       if (e.cost > opt_.maxError) { out_.stopReason = "error bound reached"; break; }
+      ++out_.queuePops;
       tryCollapse(e.vertex);
       if (opt_.progress && (out_.log.size() & 4095) == 0) opt_.progress(out_.log.size(), planned);
     }
@@ -518,6 +519,7 @@ class Simplifier {
       first = false;
       if (!heap_.empty() && float(cand.cost) > heap_.top().cost) {
         heap_.push({float(cand.cost), i, version_[i]});  // something else is cheaper now
+        ++out_.requeued;
         return;
       }
       if (cand.cost > opt_.maxError) return;

@@ -71,6 +71,7 @@ struct SimplifyResult {
   uint32_t flatTetsRemoved = 0;    // input tets with zero volume that the collapses removed
   uint32_t flatTetsLeft = 0;
   uint64_t costEvaluations = 0, rejectedByLink = 0;
+  uint64_t queuePops = 0, requeued = 0;  // pops of current entries, and those pushed back costlier
   std::string stopReason;          // "target reached", "no legal collapse left", "error bound"
 };
 
