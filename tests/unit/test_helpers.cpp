@@ -12,6 +12,9 @@
 #include <map>
 #include <memory>
 
+#include <zstd.h>
+
+#include "pack/chunk_encode.h"
 #include "pack/generators.h"
 
 namespace tetstream::test {
@@ -70,6 +73,19 @@ std::string suiteDir(const std::string& suite, const std::string& name) {
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
+}
+
+std::vector<uint8_t> forgeTruncatedChunk(const std::vector<uint8_t>& file, ChunkInfo& info) {
+  std::vector<uint8_t> raw(info.rawBytes);
+  if (ZSTD_decompress(raw.data(), raw.size(), file.data(), file.size()) != raw.size()) return {};
+  raw.pop_back();  // the last record ends early
+  std::vector<uint8_t> bad;
+  ChunkInfo forged = info;
+  if (!finishChunk(raw, 3, bad, forged)) return {};
+  info.bytes = forged.bytes;
+  info.rawBytes = forged.rawBytes;
+  info.hash = forged.hash;
+  return bad;
 }
 
 int runCommand(const std::string& command, std::string& output) {

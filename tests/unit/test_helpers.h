@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "manifest.h"
 #include "mesh.h"
 
 namespace tetstream::test {
@@ -59,6 +60,10 @@ TetMesh harmonicMesh(uint32_t n);
 // A fresh, empty folder `name` inside a scratch folder shared by one test suite; everything is
 // removed when the test program exits.
 std::string suiteDir(const std::string& suite, const std::string& name);
+
+// A hostile but consistently hashed split chunk: `file` with its last record cut short,
+// recompressed; `info` (the manifest entry) is updated to match, so only applying finds it.
+std::vector<uint8_t> forgeTruncatedChunk(const std::vector<uint8_t>& file, ChunkInfo& info);
 
 // A file's bytes as a byte vector (for the chunk decoder's span).
 inline std::vector<uint8_t> loadBytes(const std::string& path) {
