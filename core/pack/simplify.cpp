@@ -11,6 +11,7 @@
 #include <cassert>
 #include <cmath>
 #include <queue>
+#include <thread>
 
 #include "adjacency.h"
 #include "tet_quality.h"
@@ -121,12 +122,13 @@ class Simplifier {
 
   CollapseVerdict check(uint32_t i, uint32_t j) {
     init();
-    neighbours(i, nbr_);
-    if (std::find(nbr_.begin(), nbr_.end(), j) == nbr_.end()) return CollapseVerdict::NotAnEdge;
+    Lane& L = main_;
+    neighbours(L, i, L.nbr);
+    if (std::find(L.nbr.begin(), L.nbr.end(), j) == L.nbr.end()) return CollapseVerdict::NotAnEdge;
     float ef;
     CollapseVerdict v = CollapseVerdict::Legal;
-    prepareStar(i);
-    evaluate(i, j, &ef, &v);
+    prepareStar(L, i);
+    evaluate(L, i, j, &ef, &v);
     if (v == CollapseVerdict::Legal && !linkCondition(i, j)) v = CollapseVerdict::LinkCondition;
     return v;
   }
@@ -149,6 +151,7 @@ class Simplifier {
     }
     if (opt_.progress) opt_.progress(out_.log.size(), planned);
     out_.vertices = alive_;
+    out_.costEvaluations = main_.evaluations + helper_.evaluations;
     out_.tetCount = 0;
     for (uint32_t t = 0; t < T_; ++t) {
       out_.tetCount += out_.tetAlive[t];
@@ -236,10 +239,20 @@ class Simplifier {
       for (int k = 0; k < 4; ++k) fieldQuadric_[v[k]].addTet(g, c, w);
     }
     version_.assign(V_, 0);
-    seen_.assign(V_, 0);
     lastCost_.assign(V_, float(kInf));
+    // Every vertex's first cost, on two threads (each with its own scratch lane; the mesh is
+    // only read), then queued in vertex order so the result does not depend on the threads.
+    main_.seen.assign(V_, 0);
+    helper_.seen.assign(V_, 0);
+    auto work = [this](Lane& L, uint32_t begin, uint32_t end) {
+      for (uint32_t v = begin; v < end; ++v)
+        if (out_.vertexAlive[v]) lastCost_[v] = bestCost(L, v);
+    };
+    std::thread second(work, std::ref(helper_), V_ / 2, V_);
+    work(main_, 0, V_ / 2);
+    second.join();
     for (uint32_t v = 0; v < V_; ++v)
-      if (out_.vertexAlive[v]) pushVertex(v);
+      if (lastCost_[v] < float(kInf)) heap_.push({lastCost_[v], v, version_[v]});
   }
 
   static constexpr uint8_t kFaces[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
@@ -286,6 +299,25 @@ class Simplifier {
     float kappa;              // κ of the tet now
   };
 
+  struct Candidate {
+    double cost;     // exact, or a lower bound until `exact`
+    uint32_t j;
+    float fieldErr;
+    bool exact;
+  };
+
+  // Scratch for evaluating one vertex's out-edges; one per thread.
+  struct Lane {
+    std::vector<StarTet> star;
+    bool shapeReady = false;
+    double flatBound = 0;  // see prepareStar
+    std::vector<uint32_t> nbr;
+    std::vector<Candidate> candidates;
+    std::vector<uint32_t> seen;  // neighbour stamps
+    uint32_t stamp = 0;
+    uint64_t evaluations = 0;
+  };
+
   static void affineDet(const double* a, const double* b, const double* c, double sign, double* g, double* h) {
     // (a - P)·((b - P) × (c - P)) = a·(b×c) - P·(b×c + c×a + a×b)
     double bc[3] = {b[1] * c[2] - b[2] * c[1], b[2] * c[0] - b[0] * c[2], b[0] * c[1] - b[1] * c[0]};
@@ -295,9 +327,22 @@ class Simplifier {
     *h = sign * (a[0] * bc[0] + a[1] * bc[1] + a[2] * bc[2]);
   }
 
-  void prepareStar(uint32_t i) {
-    starData_.clear();
-    shapeReady_ = false;
+  void prepareStar(Lane& L, uint32_t i) {
+    L.star.clear();
+    L.shapeReady = false;
+    // Every edge of a tet after the collapse lies in the star's bounding box, so the flatness
+    // threshold of the longest possible edge bounds every tet's own threshold from above.
+    double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
+    for (uint32_t t : star_[i])
+      for (int k = 0; k < 4; ++k) {
+        const double* q = p(out_.tets[4 * size_t(t) + k]);
+        for (int a = 0; a < 3; ++a) {
+          lo[a] = std::min(lo[a], q[a]);
+          hi[a] = std::max(hi[a], q[a]);
+        }
+      }
+    const double diam2 = (hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]);
+    L.flatBound = kFlat * diam2 * std::sqrt(diam2);
     const double* pi = p(i);
     for (uint32_t t : star_[i]) {
       const uint32_t* v = &out_.tets[4 * size_t(t)];
@@ -318,7 +363,7 @@ class Simplifier {
       st.baryReady = false;
       st.detOld = st.g[0][0] * pi[0] + st.g[0][1] * pi[1] + st.g[0][2] * pi[2] + st.h[0];
       st.longestFixed = std::max({dist2(x[0], x[1]), dist2(x[0], x[2]), dist2(x[1], x[2])});
-      starData_.push_back(st);
+      L.star.push_back(st);
     }
   }
 
@@ -333,10 +378,10 @@ class Simplifier {
   }
 
   // The parts of κ that do not depend on the target: only needed once a candidate is finished.
-  void prepareShape() {
-    if (shapeReady_) return;
-    shapeReady_ = true;
-    for (StarTet& st : starData_) {
+  void prepareShape(Lane& L) {
+    if (L.shapeReady) return;
+    L.shapeReady = true;
+    for (StarTet& st : L.star) {
       const double* x[3] = {st.x[0], st.x[1], st.x[2]};
       st.fixedEdges = dist2(x[0], x[1]) + dist2(x[0], x[2]) + dist2(x[1], x[2]);
       st.sumSq = 0;
@@ -363,19 +408,21 @@ class Simplifier {
   // flattens and adds the geometric and field terms (E_s ≥ 0, so this bounds the cost from
   // below); finishCost() adds the shape term and the minimum-quality check. Infinity marks an
   // illegal collapse (the verdict says why).
-  double lowerBound(uint32_t i, uint32_t j, float* fieldErr, CollapseVerdict* verdict) {
-    ++out_.costEvaluations;
+  double lowerBound(Lane& L, uint32_t i, uint32_t j, float* fieldErr, CollapseVerdict* verdict) {
+    ++L.evaluations;
     *verdict = CollapseVerdict::Legal;
     if (boundary_[i] && !isBoundaryEdge(i, j)) return *verdict = CollapseVerdict::BoundaryRule, kInf;
     const double* P = p(j);
     double bestInside = -kInf, interp = field_[j];
-    for (StarTet& st : starData_) {
+    for (StarTet& st : L.star) {
       if (st.other[0] == j || st.other[1] == j || st.other[2] == j) continue;  // removed
       const double det = st.g[0][0] * P[0] + st.g[0][1] * P[1] + st.g[0][2] * P[2] + st.h[0];
       if (det <= 0) return *verdict = CollapseVerdict::Inverted, kInf;
-      double longest = st.longestFixed;
-      for (int k = 0; k < 3; ++k) longest = std::max(longest, dist2(P, st.x[k]));
-      if (det <= kFlat * longest * std::sqrt(longest)) return *verdict = CollapseVerdict::Flat, kInf;
+      if (det <= L.flatBound) {  // only then can the tet be flat: check with its own edges
+        double longest = st.longestFixed;
+        for (int k = 0; k < 3; ++k) longest = std::max(longest, dist2(P, st.x[k]));
+        if (det <= kFlat * longest * std::sqrt(longest)) return *verdict = CollapseVerdict::Flat, kInf;
+      }
       // Barycentric coordinates of p_i in the new tet, to interpolate the coarse field there;
       // the first tet that contains p_i wins.
       if (bestInside >= 0) continue;
@@ -414,13 +461,13 @@ class Simplifier {
     return opt_.weightGeometry * eg + opt_.weightField * ef;
   }
 
-  double finishCost(uint32_t j, double lower, CollapseVerdict* verdict) {
-    prepareShape();
+  double finishCost(Lane& L, uint32_t j, double lower, CollapseVerdict* verdict) {
+    prepareShape(L);
     const double* P = p(j);
     const double PP = P[0] * P[0] + P[1] * P[1] + P[2] * P[2];
     double kappaSum = kappaSum_[j];
     int64_t count = int64_t(star_[j].size());
-    for (const StarTet& st : starData_) {
+    for (const StarTet& st : L.star) {
       if (st.other[0] == j || st.other[1] == j || st.other[2] == j) {  // removed by the collapse
         kappaSum -= st.kappa;
         --count;
@@ -444,77 +491,77 @@ class Simplifier {
     return lower + opt_.weightShape * es;
   }
 
-  double evaluate(uint32_t i, uint32_t j, float* fieldErr, CollapseVerdict* verdict) {
-    double lower = lowerBound(i, j, fieldErr, verdict);
-    return lower < kInf ? finishCost(j, lower, verdict) : kInf;
+  double evaluate(Lane& L, uint32_t i, uint32_t j, float* fieldErr, CollapseVerdict* verdict) {
+    double lower = lowerBound(L, i, j, fieldErr, verdict);
+    return lower < kInf ? finishCost(L, j, lower, verdict) : kInf;
   }
 
   // The out-edges of i with their lower bounds (prepareStar(i) and neighbours(i) first).
-  void gatherCandidates(uint32_t i) {
-    candidates_.clear();
-    for (uint32_t w : nbr_) {
+  void gatherCandidates(Lane& L, uint32_t i) {
+    L.candidates.clear();
+    for (uint32_t w : L.nbr) {
       float ef;
       CollapseVerdict v;
-      double lb = lowerBound(i, w, &ef, &v);
-      if (lb < kInf) candidates_.push_back({lb, w, ef, false});
+      double lb = lowerBound(L, i, w, &ef, &v);
+      if (lb < kInf) L.candidates.push_back({lb, w, ef, false});
     }
   }
 
   // Best-first over the candidates: the cheapest one with an exact cost, finishing bounds only
   // while one could still win. Returns its index, or -1 when none is legal.
-  int cheapestCandidate() {
+  int cheapestCandidate(Lane& L) {
     for (;;) {
       int best = -1;
-      for (int c = 0; c < int(candidates_.size()); ++c) {
-        const Candidate& x = candidates_[size_t(c)];
-        if (best < 0 || x.cost < candidates_[size_t(best)].cost ||
-            (x.cost == candidates_[size_t(best)].cost && x.j < candidates_[size_t(best)].j))
+      for (int c = 0; c < int(L.candidates.size()); ++c) {
+        const Candidate& x = L.candidates[size_t(c)];
+        if (best < 0 || x.cost < L.candidates[size_t(best)].cost ||
+            (x.cost == L.candidates[size_t(best)].cost && x.j < L.candidates[size_t(best)].j))
           best = c;
       }
       if (best < 0) return -1;
-      Candidate& b = candidates_[size_t(best)];
+      Candidate& b = L.candidates[size_t(best)];
       if (b.exact) return best;
       CollapseVerdict v;
-      b.cost = finishCost(b.j, b.cost, &v);
+      b.cost = finishCost(L, b.j, b.cost, &v);
       b.exact = true;
-      if (!(b.cost < kInf)) candidates_.erase(candidates_.begin() + best);
+      if (!(b.cost < kInf)) L.candidates.erase(L.candidates.begin() + best);
     }
   }
 
   // Distinct vertices of the tets around v (v excluded), in first-seen order: a stamp per vertex
   // instead of sorting, as this runs for every queue pop.
-  void neighbours(uint32_t v, std::vector<uint32_t>& out) {
+  void neighbours(Lane& L, uint32_t v, std::vector<uint32_t>& out) {
     out.clear();
-    ++stamp_;
-    seen_[v] = stamp_;
+    ++L.stamp;
+    L.seen[v] = L.stamp;
     for (uint32_t t : star_[v])
       for (int k = 0; k < 4; ++k) {
         uint32_t w = out_.tets[4 * size_t(t) + k];
-        if (seen_[w] != stamp_) {
-          seen_[w] = stamp_;
+        if (L.seen[w] != L.stamp) {
+          L.seen[w] = L.stamp;
           out.push_back(w);
         }
       }
   }
 
-  // Evaluates the half-edges out of v and queues v with the cheapest legal one.
-  void pushVertex(uint32_t v) {
-    neighbours(v, nbr_);
-    prepareStar(v);
-    gatherCandidates(v);
-    int best = cheapestCandidate();
-    lastCost_[v] = best < 0 ? float(kInf) : float(candidates_[size_t(best)].cost);
-    if (best >= 0) heap_.push({lastCost_[v], v, version_[v]});
+  // The cost of v's cheapest legal out-edge (infinity when it has none).
+  float bestCost(Lane& L, uint32_t v) {
+    neighbours(L, v, L.nbr);
+    prepareStar(L, v);
+    gatherCandidates(L, v);
+    int best = cheapestCandidate(L);
+    return best < 0 ? float(kInf) : float(L.candidates[size_t(best)].cost);
   }
 
   // Pops are re-evaluated: the neighbourhood of the target may have changed since the push.
   void tryCollapse(uint32_t i) {
-    neighbours(i, nbr_);
-    prepareStar(i);
-    gatherCandidates(i);
+    Lane& L = main_;
+    neighbours(L, i, L.nbr);
+    prepareStar(L, i);
+    gatherCandidates(L, i);
     bool first = true;
-    for (int c; (c = cheapestCandidate()) >= 0;) {
-      const Candidate cand = candidates_[size_t(c)];
+    for (int c; (c = cheapestCandidate(L)) >= 0;) {
+      const Candidate cand = L.candidates[size_t(c)];
       if (first) lastCost_[i] = float(cand.cost);
       first = false;
       if (!heap_.empty() && float(cand.cost) > heap_.top().cost) {
@@ -525,7 +572,7 @@ class Simplifier {
       if (cand.cost > opt_.maxError) return;
       if (!linkCondition(i, cand.j)) {
         ++out_.rejectedByLink;
-        candidates_.erase(candidates_.begin() + c);
+        L.candidates.erase(L.candidates.begin() + c);
         continue;
       }
       collapse(i, cand.j, cand.fieldErr);
@@ -661,14 +708,15 @@ class Simplifier {
     // Everything around j changed. Requeue j and its neighbours lazily: under their last known
     // cost (the neighbourhood of a blocked vertex changed, so it gets another chance), to be
     // re-evaluated only when they reach the top.
+    Lane& L = main_;
     touched_.clear();
-    ++stamp_;
-    seen_[i] = stamp_;
+    ++L.stamp;
+    L.seen[i] = L.stamp;
     for (uint32_t t : around)
       for (int k = 0; k < 4; ++k) {
         uint32_t w = out_.tets[4 * size_t(t) + k];
-        if (seen_[w] != stamp_) {
-          seen_[w] = stamp_;
+        if (L.seen[w] != L.stamp) {
+          L.seen[w] = L.stamp;
           touched_.push_back(w);
         }
       }
@@ -679,12 +727,6 @@ class Simplifier {
     }
   }
 
-  struct Candidate {
-    double cost;     // exact, or a lower bound until `exact`
-    uint32_t j;
-    float fieldErr;
-    bool exact;
-  };
 
   const TetMesh& mesh_;
   const SimplifyOptions& opt_;
@@ -700,17 +742,13 @@ class Simplifier {
   std::vector<float> kappa_, lastCost_;
   std::vector<FieldQuadric> fieldQuadric_;
   std::vector<double> kappaSum_;  // per vertex: Σ κ over its star
-  std::vector<StarTet> starData_;
-  bool shapeReady_ = false;
   std::vector<uint32_t> version_;
-  std::vector<uint32_t> seen_;  // neighbour stamps
-  uint32_t stamp_ = 0;
+  Lane main_, helper_;  // scratch of the queue loop, and of the second thread in init()
   std::priority_queue<Entry, std::vector<Entry>, EntryAfter> heap_;
   // scratch, reused
-  std::vector<uint32_t> nbr_, touched_, lvI_, lvJ_, lvE_;
+  std::vector<uint32_t> touched_, lvI_, lvJ_, lvE_;
   std::vector<uint64_t> leI_, leJ_, leE_;
   std::vector<Tri> ltI_, ltJ_;
-  std::vector<Candidate> candidates_;
 };
 
 }  // namespace
