@@ -127,6 +127,9 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   so.targetTets = opt.baseTets;
   so.targetVertices = opt.baseVertices ? opt.baseVertices
                                        : uint32_t(std::llround(std::clamp(opt.baseFraction, 0.0, 1.0) * mesh.vertexCount()));
+  // A fraction of a small mesh would leave a base too coarse to show anything: keep a floor.
+  if (!opt.baseVertices && opt.baseFraction > 0)
+    so.targetVertices = std::max(so.targetVertices, std::min(opt.minBaseVertices, mesh.vertexCount()));
   if (report.nonManifoldFaces || report.duplicateTets) {
     summary.notes.push_back("non-manifold or duplicated tetrahedra: packed without simplification");
     so.targetVertices = mesh.vertexCount();

@@ -21,6 +21,7 @@ struct PackOptions {
   double weights[3] = {100.0, 1.0, 0.002};  // geometry, field, shape (simplify.h)
   double baseFraction = 0.01;             // base mesh size as a fraction of the vertices...
   uint32_t baseVertices = 0;              // ...or as a vertex count (wins when non-zero)
+  uint32_t minBaseVertices = 256;         // floor for the fraction rule on small meshes
   uint32_t baseTets = 0;                  // stop earlier once the base has this many tets
   double maxError = std::numeric_limits<double>::infinity();  // stop simplifying at this cost
   bool lossless = false;                  // keep float32 values in split records

@@ -35,7 +35,11 @@ class Encoder {
     const uint32_t C = log.size();
     // Estimated field error with a splits applied: the largest of the collapses still in place.
     prefixMax_.resize(C);
-    for (uint32_t c = 0; c < C; ++c) prefixMax_[c] = std::max(c ? prefixMax_[c - 1] : 0.0f, log.fieldError[c]);
+    // The estimate sums terms that can overshoot; no error exceeds the field's range.
+    const int iso = m_.findField(m_.isoField);
+    const float range = iso >= 0 ? m_.fields[size_t(iso)].range.max - m_.fields[size_t(iso)].range.min : 0.0f;
+    for (uint32_t c = 0; c < C; ++c)
+      prefixMax_[c] = std::min(range, std::max(c ? prefixMax_[c - 1] : 0.0f, log.fieldError[c]));
     out_.baseFieldError = C ? prefixMax_[C - 1] : 0;
 
     target_ = opt_.firstChunkBytes;
