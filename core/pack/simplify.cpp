@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <cstdlib>
 #include <queue>
 #include <thread>
 
@@ -619,7 +620,170 @@ class Simplifier {
     sortUnique(tris);
   }
 
+  // The same condition without sorting (this runs once per collapse attempt): vertex sets by
+  // stamps, edge sets in a small stamped hash table, shared tet triangles through the face
+  // adjacency. linkConditionBySorting() is the reference it is checked against in tests.
   bool linkCondition(uint32_t i, uint32_t j) {
+#ifdef TETSTREAM_CHECK_LINK
+    const bool reference = linkConditionBySorting(i, j);
+#define TS_LINK_RESULT(x) do { bool r_ = (x); if (r_ != reference) std::abort(); return r_; } while (0)
+#else
+#define TS_LINK_RESULT(x) return (x)
+#endif
+    Lane& L = main_;
+    // Triangles (a, b, c) in both links: tets (i, a, b, c) and (j, a, b, c) share that face.
+    for (uint32_t t : star_[i]) {
+      if (tetHas(t, j)) continue;
+      const uint32_t* x = &out_.tets[4 * size_t(t)];
+      int si = 0;
+      while (x[si] != i) ++si;
+      uint32_t h = opp_[4 * t + si];
+      if (h != kNoNeighbor && tetHas(h >> 2, j)) TS_LINK_RESULT(false);
+    }
+    auto hasBoundaryFace = [&](uint32_t v) {
+      bool any = false;
+      forBoundaryFaces(v, [&](uint32_t, uint32_t) { any = true; });
+      return any;
+    };
+    const bool bothBoundary = boundary_[i] && boundary_[j] && hasBoundaryFace(i) && hasBoundaryFace(j);
+    // Boundary triangles (a, b, ω) in both links: boundary faces (i, a, b) and (j, a, b).
+    if (bothBoundary) {
+      linkEdges_.clear();  // edges (a, b) of the boundary faces at j
+      forBoundaryFaces(j, [&](uint32_t a, uint32_t b) { linkEdges_.push_back(makeEdge(a, b)); });
+      bool shared = false;
+      forBoundaryFaces(i, [&](uint32_t a, uint32_t b) {
+        shared |= std::find(linkEdges_.begin(), linkEdges_.end(), makeEdge(a, b)) != linkEdges_.end();
+      });
+      if (shared) TS_LINK_RESULT(false);
+    }
+    // Vertices: common neighbours of i and j (and ω when both are on the boundary) against the
+    // link of the edge.
+    uint32_t stampJ = ++L.stamp;
+    for (uint32_t t : star_[j])
+      for (int k = 0; k < 4; ++k) L.seen[out_.tets[4 * size_t(t) + k]] = stampJ;
+    uint32_t stampI = ++L.stamp;
+    size_t common = bothBoundary ? 1 : 0;
+    for (uint32_t t : star_[i])
+      for (int k = 0; k < 4; ++k) {
+        uint32_t w = out_.tets[4 * size_t(t) + k];
+        if (w == i || w == j || L.seen[w] == stampI) continue;
+        common += L.seen[w] == stampJ;
+        L.seen[w] = stampI;
+      }
+    // Link of the edge: the opposite edges of the tets around it, and the boundary faces at it.
+    size_t edgeVerts = 0, edgeEdges = 0;
+    bool boundaryEdge = false;
+    uint32_t stampE = ++L.stamp;
+    for (uint32_t t : star_[i]) {
+      if (!tetHas(t, j)) continue;
+      const uint32_t* x = &out_.tets[4 * size_t(t)];
+      uint32_t o[2];
+      int n = 0;
+      for (int k = 0; k < 4; ++k)
+        if (x[k] != i && x[k] != j) o[n++] = x[k];
+      for (uint32_t w : o)
+        if (L.seen[w] != stampE) { L.seen[w] = stampE; ++edgeVerts; }
+      ++edgeEdges;  // each tet around the edge has its own opposite edge
+      for (int f = 0; f < 4; ++f)
+        if (opp_[4 * t + f] == kNoNeighbor && x[f] != i && x[f] != j) {
+          boundaryEdge = true;
+          ++edgeEdges;  // (k, ω) for the boundary face (i, j, k): one per face
+        }
+    }
+    if (common != edgeVerts + (boundaryEdge ? 1 : 0)) TS_LINK_RESULT(false);
+    // Edges: those of Lk(j) in a table, then the distinct ones of Lk(i) found there.
+    edgeTable_.beginSet(++edgeTableStamp_);
+    auto linkEdgesOf = [&](uint32_t v, auto&& each) {
+      for (uint32_t t : star_[v]) {
+        const uint32_t* x = &out_.tets[4 * size_t(t)];
+        uint32_t o[3];
+        int n = 0;
+        for (int k = 0; k < 4; ++k)
+          if (x[k] != v) o[n++] = x[k];
+        each(makeEdge(o[0], o[1]));
+        each(makeEdge(o[0], o[2]));
+        each(makeEdge(o[1], o[2]));
+      }
+      forBoundaryFaces(v, [&](uint32_t a, uint32_t b) {
+        each(makeEdge(a, kOmega));
+        each(makeEdge(b, kOmega));
+      });
+    };
+    linkEdgesOf(j, [&](uint64_t e) { edgeTable_.mark(e, 1); });
+    size_t commonEdges = 0;
+    linkEdgesOf(i, [&](uint64_t e) {
+      if (edgeTable_.get(e) == 1) {
+        edgeTable_.mark(e, 2);  // count each shared edge once
+        ++commonEdges;
+      }
+    });
+    TS_LINK_RESULT(commonEdges == edgeEdges);
+#undef TS_LINK_RESULT
+  }
+
+  // Calls f(a, b) for every boundary face (v, a, b) around v.
+  template <typename F>
+  void forBoundaryFaces(uint32_t v, F f) const {
+    for (uint32_t t : star_[v]) {
+      const uint32_t* x = &out_.tets[4 * size_t(t)];
+      for (int face = 0; face < 4; ++face) {
+        if (x[face] == v || opp_[4 * t + face] != kNoNeighbor) continue;
+        uint32_t a = 0, b = 0;
+        int m = 0;
+        for (int k = 0; k < 4; ++k)
+          if (k != face && x[k] != v) (m++ == 0 ? a : b) = x[k];
+        f(a, b);
+      }
+    }
+  }
+
+  // A small open-addressing table of edge keys with a byte of state, emptied in O(1) by
+  // changing its stamp. Link edge sets have tens of entries; it grows if ever needed.
+  struct EdgeTable {
+    std::vector<uint64_t> keys;
+    std::vector<uint32_t> stamps;
+    std::vector<uint8_t> values;
+    uint32_t stamp = 0, count = 0;
+    void beginSet(uint32_t s) {
+      if (keys.empty()) { keys.resize(512); stamps.assign(512, 0); values.resize(512); }
+      stamp = s;
+      count = 0;
+    }
+    size_t slot(uint64_t key) const {
+      uint64_t h = key * 0x9e3779b97f4a7c15ull;
+      size_t mask = keys.size() - 1;
+      for (size_t k = size_t(h >> 40) & mask;; k = (k + 1) & mask)
+        if (stamps[k] != stamp || keys[k] == key) return k;
+    }
+    uint8_t get(uint64_t key) const {
+      size_t k = slot(key);
+      return stamps[k] == stamp ? values[k] : 0;
+    }
+    void mark(uint64_t key, uint8_t value) {
+      if (2 * (count + 1) > keys.size()) grow();
+      size_t k = slot(key);
+      if (stamps[k] != stamp) { stamps[k] = stamp; keys[k] = key; ++count; }
+      values[k] = value;
+    }
+    void grow() {
+      EdgeTable bigger;
+      bigger.keys.resize(2 * keys.size());
+      bigger.stamps.assign(2 * keys.size(), 0);
+      bigger.values.resize(2 * keys.size());
+      bigger.stamp = stamp;
+      for (size_t k = 0; k < keys.size(); ++k)
+        if (stamps[k] == stamp) {
+          size_t s = bigger.slot(keys[k]);
+          bigger.stamps[s] = stamp;
+          bigger.keys[s] = keys[k];
+          bigger.values[s] = values[k];
+          ++bigger.count;
+        }
+      *this = std::move(bigger);
+    }
+  };
+
+  bool linkConditionBySorting(uint32_t i, uint32_t j) {
     gatherLink(i, lvI_, leI_, ltI_);
     gatherLink(j, lvJ_, leJ_, ltJ_);
     if (intersectionSize(ltI_, ltJ_) != 0) return false;
@@ -747,6 +911,9 @@ class Simplifier {
   std::priority_queue<Entry, std::vector<Entry>, EntryAfter> heap_;
   // scratch, reused
   std::vector<uint32_t> touched_, lvI_, lvJ_, lvE_;
+  std::vector<uint64_t> linkEdges_;
+  EdgeTable edgeTable_;
+  uint32_t edgeTableStamp_ = 0;
   std::vector<uint64_t> leI_, leJ_, leE_;
   std::vector<Tri> ltI_, ltJ_;
 };
