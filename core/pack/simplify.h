@@ -47,6 +47,7 @@ struct SimplifyOptions {
   int field = 0;                // index of the field that steers the field error
   double minQuality = 0.02;     // 3/κ of every tet a collapse changes must stay at or above this
   std::function<void(uint32_t done, uint32_t planned)> progress;  // called now and then
+  bool verifyLinkCondition = false;  // tests: also run the slow reference link check, count mismatches
 };
 
 // One collapse as it happened, in original vertex and tet ids.
@@ -72,6 +73,7 @@ struct SimplifyResult {
   uint32_t flatTetsLeft = 0;
   uint64_t costEvaluations = 0, rejectedByLink = 0;
   uint64_t queuePops = 0, requeued = 0;  // pops of current entries, and those pushed back costlier
+  uint64_t linkMismatches = 0;           // with verifyLinkCondition: fast and reference disagreed
   std::string stopReason;          // "target reached", "no legal collapse left", "error bound"
 };
 

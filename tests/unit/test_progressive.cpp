@@ -284,6 +284,58 @@ TEST(Legality, LinkConditionProtectsTopology) {
   EXPECT_EQ(checkCollapse(m, 0, 1, o), CollapseVerdict::LinkCondition);
 }
 
+// A domain with a tunnel (genus 1 boundary) cannot shrink to a tet: the link condition must
+// refuse many collapses near the end. The fast link check agrees with the plain reference on
+// every one of them.
+TEST(Legality, LinkConditionOnATunnelMatchesTheReference) {
+  TetMesh g = harmonic(9);
+  TetMesh m;
+  m.fields.resize(1);
+  m.fields[0].name = "harmonic";
+  std::vector<uint32_t> remap(g.vertexCount(), ~0u);
+  for (uint32_t t = 0; t < g.tetCount(); ++t) {
+    const uint32_t* v = &g.tets[4 * t];
+    float c[3] = {0, 0, 0};
+    for (int k = 0; k < 4; ++k)
+      for (int a = 0; a < 3; ++a) c[a] += g.positions[3 * v[k] + a] / 4;
+    if (std::abs(c[0]) < 0.25f && std::abs(c[1]) < 0.25f) continue;  // the tunnel along z
+    for (int k = 0; k < 4; ++k) {
+      if (remap[v[k]] == ~0u) {
+        remap[v[k]] = m.vertexCount();
+        m.positions.insert(m.positions.end(), &g.positions[3 * v[k]], &g.positions[3 * v[k]] + 3);
+        m.fields[0].values.push_back(g.fields[0].values[v[k]]);
+      }
+      m.tets.push_back(remap[v[k]]);
+    }
+  }
+  SimplifyOptions o;
+  o.targetVertices = 4;
+  o.verifyLinkCondition = true;
+  SimplifyResult r;
+  ASSERT_TRUE(simplifyMesh(m, o, r));
+  EXPECT_GT(r.rejectedByLink, 0u);
+  EXPECT_EQ(r.linkMismatches, 0u);
+  EXPECT_EQ(r.stopReason, "no legal collapse left");
+  TetMesh base;
+  base.positions = m.positions;
+  for (uint32_t t = 0; t < m.tetCount(); ++t)
+    if (r.tetAlive[t]) base.tets.insert(base.tets.end(), &r.tets[4 * t], &r.tets[4 * t] + 4);
+  ValidationReport v = validateMesh(base);
+  EXPECT_EQ(v.nonManifoldFaces, 0u);
+  EXPECT_EQ(v.nonManifoldBoundaryEdges, 0u);
+  EXPECT_EQ(v.negativeTets + v.zeroVolumeTets, 0u);
+  // The boundary is still a torus: V - E + F = 0.
+  FaceAdjacency adj;
+  buildFaceAdjacency(base.tets, base.vertexCount(), adj);
+  std::vector<uint32_t> b;
+  extractBoundary(base.tets, adj, b);
+  std::vector<uint32_t> verts(b);
+  std::sort(verts.begin(), verts.end());
+  verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+  const long F = long(b.size() / 3);
+  EXPECT_EQ(long(verts.size()) - 3 * F / 2 + F, 0) << "genus 1";
+}
+
 TEST(Legality, FlatInputTetsAreRemovedNotCreated) {
   // A grid with one vertex pushed onto the layer below, flattening the tets between: the
   // simplifier must not fail, must not create flat tets, and gets rid of the flat ones (a
