@@ -26,55 +26,42 @@ constexpr double kFlat = 1e-7;            // |6V| <= kFlat * (longest edge)^3 co
 constexpr float kKappaCap = 1e4f;
 const int kFieldMode = std::getenv("TS_FIELD_MODE") ? std::atoi(std::getenv("TS_FIELD_MODE")) : 0;         // κ of flat tets, capped so averages stay finite
 
-struct Quadric {
-  double q[10] = {};  // xx xy xz xw yy yz yw zz zw ww
-  double area = 0;
-  void addPlane(double a, double b, double c, double d, double w) {
-    double p[4] = {a, b, c, d};
+// A symmetric quadric form x^T Q x on N-vectors whose last entry is 1 (homogeneous), stored as
+// its upper triangle, with the total weight of what was added. Sums of such forms are the error
+// quadrics of Garland & Heckbert (paper eq. 3-4).
+template <int N>
+struct SymmetricQuadric {
+  double q[N * (N + 1) / 2] = {};
+  double weight = 0;
+  // Adds w·(a·x)² for a plane or hyperplane a.
+  void addSquare(const double (&a)[N], double w) {
     int n = 0;
-    for (int r = 0; r < 4; ++r)
-      for (int s = r; s < 4; ++s) q[n++] += w * p[r] * p[s];
-    area += w;
+    for (int r = 0; r < N; ++r)
+      for (int k = r; k < N; ++k) q[n++] += w * a[r] * a[k];
+    weight += w;
   }
-  void add(const Quadric& o) {
-    for (int k = 0; k < 10; ++k) q[k] += o.q[k];
-    area += o.area;
+  void add(const SymmetricQuadric& o) {
+    for (int k = 0; k < N * (N + 1) / 2; ++k) q[k] += o.q[k];
+    weight += o.weight;
   }
-  double eval(const double* p) const {
-    double x = p[0], y = p[1], z = p[2];
-    return q[0] * x * x + 2 * q[1] * x * y + 2 * q[2] * x * z + 2 * q[3] * x + q[4] * y * y + 2 * q[5] * y * z +
-           2 * q[6] * y + q[7] * z * z + 2 * q[8] * z + q[9];
+  double eval(const double (&x)[N]) const {
+    double sum = 0;
+    int n = 0;
+    for (int r = 0; r < N; ++r)
+      for (int k = r; k < N; ++k) sum += (r == k ? 1.0 : 2.0) * q[n++] * x[r] * x[k];
+    return sum;
   }
 };
+
+// Boundary quadric: squared distances to the planes of the boundary faces, area weighted.
+using Quadric = SymmetricQuadric<4>;
 
 // Field quadric (Garland & Heckbert's attribute quadrics, applied to the scalar field): each tet
 // defines a linear field s(x) = g·x + c; its volume-weighted squared deviation (g·x + c − s)² at a
 // point (x, s) of 4D space is a quadric in (x, y, z, s, 1). Summed over the original tets around a
 // vertex, and summed again on every collapse, it measures how far a kept vertex and its value
 // stray from the original field over the whole region it now stands for.
-struct FieldQuadric {
-  double q[15] = {};  // upper triangle of the symmetric 5×5 matrix, row by row
-  double volume = 0;
-  void addTet(const double g[3], double c, double w) {
-    const double a[5] = {g[0], g[1], g[2], -1.0, c};
-    int n = 0;
-    for (int r = 0; r < 5; ++r)
-      for (int k = r; k < 5; ++k) q[n++] += w * a[r] * a[k];
-    volume += w;
-  }
-  void add(const FieldQuadric& o) {
-    for (int k = 0; k < 15; ++k) q[k] += o.q[k];
-    volume += o.volume;
-  }
-  double eval(const double* p, double s) const {
-    const double x[5] = {p[0], p[1], p[2], s, 1.0};
-    double sum = 0;
-    int n = 0;
-    for (int r = 0; r < 5; ++r)
-      for (int k = r; k < 5; ++k) sum += (r == k ? 1.0 : 2.0) * q[n++] * x[r] * x[k];
-    return sum;
-  }
-};
+using FieldQuadric = SymmetricQuadric<5>;
 
 struct Entry {
   float cost;
@@ -203,7 +190,8 @@ class Simplifier {
       if (len == 0) continue;
       for (double& x : n) x /= len;
       double d = -(n[0] * pa[0] + n[1] * pa[1] + n[2] * pa[2]);
-      for (uint32_t x : {a, b, c}) quadric_[x].addPlane(n[0], n[1], n[2], d, 0.5 * len);
+      const double plane[4] = {n[0], n[1], n[2], d};
+      for (uint32_t x : {a, b, c}) quadric_[x].addSquare(plane, 0.5 * len);
     }
     kappa_.resize(T_);
     kappaSum_.assign(V_, 0.0);
@@ -237,7 +225,8 @@ class Simplifier {
       }
       double c = field_[v[0]] - (g[0] * p0[0] + g[1] * p0[1] + g[2] * p0[2]);
       double w = std::abs(det) / 24.0;  // a quarter of the volume to each vertex
-      for (int k = 0; k < 4; ++k) fieldQuadric_[v[k]].addTet(g, c, w);
+      const double hyperplane[5] = {g[0], g[1], g[2], -1.0, c};
+      for (int k = 0; k < 4; ++k) fieldQuadric_[v[k]].addSquare(hyperplane, w);
     }
     version_.assign(V_, 0);
     lastCost_.assign(V_, float(kInf));
@@ -450,13 +439,15 @@ class Simplifier {
     double local = std::abs(double(field_[i]) - interp) / range_;
     FieldQuadric fq = fieldQuadric_[i];
     fq.add(fieldQuadric_[j]);
-    double region = fq.volume > 0 ? std::sqrt(std::max(0.0, fq.eval(P, field_[j])) / fq.volume) / range_ : 0.0;
+    const double x5[5] = {P[0], P[1], P[2], double(field_[j]), 1.0};
+    double region = fq.weight > 0 ? std::sqrt(std::max(0.0, fq.eval(x5)) / fq.weight) / range_ : 0.0;
     double ef = local + region;
     double eg = 0;
     if (boundary_[i]) {
       Quadric q = quadric_[i];
       q.add(quadric_[j]);
-      if (q.area > 0) eg = std::sqrt(std::max(0.0, q.eval(P)) / q.area) / diag_;
+      const double x4[4] = {P[0], P[1], P[2], 1.0};
+      if (q.weight > 0) eg = std::sqrt(std::max(0.0, q.eval(x4)) / q.weight) / diag_;
     }
     *fieldErr = float(ef);
     return opt_.weightGeometry * eg + opt_.weightField * ef;

@@ -31,9 +31,10 @@ namespace {
 std::string tempDir(const std::string& name) { return test::suiteDir("progressive", name); }
 TetMesh harmonic(uint32_t n) { return test::harmonicMesh(n); }
 
-// Drops the tets in the octant x, y, z > 0 (a non-convex domain with concave creases) and the
-// vertices no tet uses any more.
-TetMesh lShape(uint32_t n) {
+// Harmonic n³ without the tets whose centroid `drop` selects, and without the vertices no
+// tet uses any more.
+template <typename Drop>
+TetMesh carved(uint32_t n, Drop drop) {
   TetMesh g = harmonic(n);
   TetMesh m;
   m.fields.resize(g.fields.size());
@@ -44,7 +45,7 @@ TetMesh lShape(uint32_t n) {
     float c[3] = {0, 0, 0};
     for (int k = 0; k < 4; ++k)
       for (int a = 0; a < 3; ++a) c[a] += g.positions[3 * v[k] + a] / 4;
-    if (c[0] > 0 && c[1] > 0 && c[2] > 0) continue;
+    if (drop(c)) continue;
     for (int k = 0; k < 4; ++k) {
       if (remap[v[k]] == ~0u) {
         remap[v[k]] = m.vertexCount();
@@ -54,8 +55,26 @@ TetMesh lShape(uint32_t n) {
       m.tets.push_back(remap[v[k]]);
     }
   }
-  m.name = "lshape";
+  m.name = "carved";
   return m;
+}
+
+// The octant x, y, z > 0 removed: a non-convex domain with concave creases.
+TetMesh lShape(uint32_t n) {
+  return carved(n, [](const float* c) { return c[0] > 0 && c[1] > 0 && c[2] > 0; });
+}
+
+// V − E + F of the boundary surface: 2 for a ball-shaped domain, 0 for one with a tunnel.
+long boundaryEuler(const TetMesh& m) {
+  FaceAdjacency adj;
+  buildFaceAdjacency(m.tets, m.vertexCount(), adj);
+  std::vector<uint32_t> b;
+  extractBoundary(m.tets, adj, b);
+  std::vector<uint32_t> verts(b);
+  std::sort(verts.begin(), verts.end());
+  verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+  const long F = long(b.size() / 3);
+  return long(verts.size()) - 3 * F / 2 + F;
 }
 
 std::string pack(const std::string& name, const TetMesh& m, PackOptions o, PackSummary* summary = nullptr) {
@@ -84,16 +103,7 @@ void expectValidLevel(const TetMesh& m, const std::string& what) {
   EXPECT_EQ(r.nonManifoldFaces, 0u) << what;
   EXPECT_EQ(r.nonManifoldBoundaryEdges, 0u) << what;
   EXPECT_EQ(r.unusedVertices, 0u) << what;
-  // The boundary of a ball-shaped domain stays a sphere: V - E + F = 2.
-  FaceAdjacency adj;
-  buildFaceAdjacency(m.tets, m.vertexCount(), adj);
-  std::vector<uint32_t> b;
-  extractBoundary(m.tets, adj, b);
-  std::vector<uint32_t> verts(b);
-  std::sort(verts.begin(), verts.end());
-  verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
-  const long F = long(b.size() / 3), E = 3 * F / 2, V = long(verts.size());
-  EXPECT_EQ(V - E + F, 2) << what;
+  EXPECT_EQ(boundaryEuler(m), 2) << what << ": the boundary of a ball-shaped domain stays a sphere";
 }
 
 // Compares the fully refined mesh with the input: same vertex set (positions to within `tol`
@@ -288,26 +298,8 @@ TEST(Legality, LinkConditionProtectsTopology) {
 // refuse many collapses near the end. The fast link check agrees with the plain reference on
 // every one of them.
 TEST(Legality, LinkConditionOnATunnelMatchesTheReference) {
-  TetMesh g = harmonic(9);
-  TetMesh m;
-  m.fields.resize(1);
-  m.fields[0].name = "harmonic";
-  std::vector<uint32_t> remap(g.vertexCount(), ~0u);
-  for (uint32_t t = 0; t < g.tetCount(); ++t) {
-    const uint32_t* v = &g.tets[4 * t];
-    float c[3] = {0, 0, 0};
-    for (int k = 0; k < 4; ++k)
-      for (int a = 0; a < 3; ++a) c[a] += g.positions[3 * v[k] + a] / 4;
-    if (std::abs(c[0]) < 0.25f && std::abs(c[1]) < 0.25f) continue;  // the tunnel along z
-    for (int k = 0; k < 4; ++k) {
-      if (remap[v[k]] == ~0u) {
-        remap[v[k]] = m.vertexCount();
-        m.positions.insert(m.positions.end(), &g.positions[3 * v[k]], &g.positions[3 * v[k]] + 3);
-        m.fields[0].values.push_back(g.fields[0].values[v[k]]);
-      }
-      m.tets.push_back(remap[v[k]]);
-    }
-  }
+  TetMesh m = carved(9, [](const float* c) { return std::abs(c[0]) < 0.25f && std::abs(c[1]) < 0.25f; });
+  ASSERT_EQ(boundaryEuler(m), 0) << "a tunnel along z";
   SimplifyOptions o;
   o.targetVertices = 4;
   o.verifyLinkCondition = true;
@@ -324,16 +316,7 @@ TEST(Legality, LinkConditionOnATunnelMatchesTheReference) {
   EXPECT_EQ(v.nonManifoldFaces, 0u);
   EXPECT_EQ(v.nonManifoldBoundaryEdges, 0u);
   EXPECT_EQ(v.negativeTets + v.zeroVolumeTets, 0u);
-  // The boundary is still a torus: V - E + F = 0.
-  FaceAdjacency adj;
-  buildFaceAdjacency(base.tets, base.vertexCount(), adj);
-  std::vector<uint32_t> b;
-  extractBoundary(base.tets, adj, b);
-  std::vector<uint32_t> verts(b);
-  std::sort(verts.begin(), verts.end());
-  verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
-  const long F = long(b.size() / 3);
-  EXPECT_EQ(long(verts.size()) - 3 * F / 2 + F, 0) << "genus 1";
+  EXPECT_EQ(boundaryEuler(base), 0) << "the boundary is still a torus";
 }
 
 TEST(Legality, FlatInputTetsAreRemovedNotCreated) {
