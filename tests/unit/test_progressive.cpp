@@ -64,6 +64,15 @@ TetMesh lShape(uint32_t n) {
   return carved(n, [](const float* c) { return c[0] > 0 && c[1] > 0 && c[2] > 0; });
 }
 
+// The simplifier's result as a mesh (all input vertices kept, the surviving tets).
+TetMesh baseMeshOf(const TetMesh& m, const SimplifyResult& r) {
+  TetMesh base;
+  base.positions = m.positions;
+  for (uint32_t t = 0; t < m.tetCount(); ++t)
+    if (r.tetAlive[t]) base.tets.insert(base.tets.end(), &r.tets[4 * t], &r.tets[4 * t] + 4);
+  return base;
+}
+
 // V − E + F of the boundary surface: 2 for a ball-shaped domain, 0 for one with a tunnel.
 long boundaryEuler(const TetMesh& m) {
   FaceAdjacency adj;
@@ -308,10 +317,7 @@ TEST(Legality, LinkConditionOnATunnelMatchesTheReference) {
   EXPECT_GT(r.rejectedByLink, 0u);
   EXPECT_EQ(r.linkMismatches, 0u);
   EXPECT_EQ(r.stopReason, "no legal collapse left");
-  TetMesh base;
-  base.positions = m.positions;
-  for (uint32_t t = 0; t < m.tetCount(); ++t)
-    if (r.tetAlive[t]) base.tets.insert(base.tets.end(), &r.tets[4 * t], &r.tets[4 * t] + 4);
+  TetMesh base = baseMeshOf(m, r);
   ValidationReport v = validateMesh(base);
   EXPECT_EQ(v.nonManifoldFaces, 0u);
   EXPECT_EQ(v.nonManifoldBoundaryEdges, 0u);
@@ -334,10 +340,7 @@ TEST(Legality, FlatInputTetsAreRemovedNotCreated) {
   ASSERT_TRUE(simplifyMesh(m, o, r));
   EXPECT_EQ(r.flatTetsLeft, 0u);
   EXPECT_LE(r.flatTetsRemoved, before.zeroVolumeTets);
-  TetMesh base;
-  base.positions = m.positions;
-  for (uint32_t t = 0; t < m.tetCount(); ++t)
-    if (r.tetAlive[t]) base.tets.insert(base.tets.end(), &r.tets[4 * t], &r.tets[4 * t] + 4);
+  TetMesh base = baseMeshOf(m, r);
   ValidationReport after = validateMesh(base);
   EXPECT_EQ(after.zeroVolumeTets, 0u);
   EXPECT_EQ(after.negativeTets, 0u);
