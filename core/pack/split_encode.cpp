@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cassert>
+#include <deque>
+#include <future>
 
 #include "pack/chunk_encode.h"
 #include "progressive.h"
@@ -49,9 +51,12 @@ class Encoder {
       ++inChunk_;
       if (opt_.progress && (c & 4095) == 0) opt_.progress(C - c, C);
       if (records_.size() >= target_ * ratio_ || c == 0)
-        if (Result r = flushChunk(C - c); !r) return r;
+        if (Result r = flushChunk(C - c); !r) {
+          collect();
+          return r;
+        }
     }
-    return Result::success();
+    return collect();
   }
 
  private:
@@ -79,7 +84,6 @@ class Encoder {
   }
 
   void startChunk() {
-    raw_.clear();
     records_.clear();
     inChunk_ = 0;
     prevJ_ = 0;  // each chunk decodes on its own (FORMAT.md §4)
@@ -151,27 +155,60 @@ class Encoder {
     applySplit(pm_, SplitOp{js, moved_, newTets_, pi, fields_.data()}, changed_);
   }
 
+  // Closes the current chunk and compresses it on another thread while encoding goes on. The
+  // size aimed at by chunk n uses the compression ratio of chunk n−2 (known by then), so chunk
+  // boundaries never depend on thread timing.
   Result flushChunk(uint32_t splitsApplied) {
-    const uint32_t index = uint32_t(out_.chunks.size()) + 1;
-    beginChunk(raw_, ChunkKind::Splits, index);
-    putU32(raw_, inChunk_);
-    putU32(raw_, q_.lossless ? kSplitFlagLossless : 0);
-    raw_.insert(raw_.end(), records_.begin(), records_.end());
-    std::vector<uint8_t> file;
-    ChunkInfo info;
-    if (Result r = finishChunk(raw_, opt_.zstdLevel, file, info); !r) return r;
-    info.kind = ChunkKind::Splits;
-    info.vertices = pm_.vertexCount();
-    info.tets = pm_.tetCount();
-    info.splits = inChunk_;
+    Job& job = jobs_.emplace_back();
+    const uint32_t index = uint32_t(jobs_.size());
+    beginChunk(job.raw, ChunkKind::Splits, index);
+    putU32(job.raw, inChunk_);
+    putU32(job.raw, q_.lossless ? kSplitFlagLossless : 0);
+    job.raw.insert(job.raw.end(), records_.begin(), records_.end());
+    job.info.kind = ChunkKind::Splits;
+    job.info.vertices = pm_.vertexCount();
+    job.info.tets = pm_.tetCount();
+    job.info.splits = inChunk_;
     const uint32_t C = s_.log.size();
-    info.fieldError = splitsApplied < C ? prefixMax_[C - splitsApplied - 1] : 0.0;
-    // Aim the next chunk: observed compression ratio, target doubling up to chunkBytes.
-    if (info.bytes > 0) ratio_ = std::max(1.0, double(raw_.size()) / double(info.bytes));
+    job.info.fieldError = splitsApplied < C ? prefixMax_[C - splitsApplied - 1] : 0.0;
+    job.done = std::async(std::launch::async, [&job, level = opt_.zstdLevel] {
+      return finishChunk(job.raw, level, job.file, job.info);
+    });
+    if (jobs_.size() >= 2) {
+      Job& older = jobs_[jobs_.size() - 2];
+      if (Result r = wait(older); !r) return r;
+      if (older.info.bytes > 0) ratio_ = std::max(1.0, double(older.raw.size()) / double(older.info.bytes));
+    }
     target_ = std::min<uint64_t>(2 * target_, opt_.chunkBytes);
-    out_.files.push_back(std::move(file));
-    out_.chunks.push_back(info);
     startChunk();
+    return Result::success();
+  }
+
+  struct Job {
+    std::vector<uint8_t> raw, file;
+    ChunkInfo info;
+    std::future<Result> done;
+    bool waited = false;
+    Result result;
+  };
+
+  static Result wait(Job& job) {
+    if (!job.waited) {
+      job.result = job.done.get();
+      job.waited = true;
+    }
+    return job.result;
+  }
+
+  // Waits for every chunk and hands them over in order.
+  Result collect() {
+    for (Job& job : jobs_)
+      if (Result r = wait(job); !r) return r;
+    for (Job& job : jobs_) {
+      out_.files.push_back(std::move(job.file));
+      out_.chunks.push_back(job.info);
+    }
+    jobs_.clear();
     return Result::success();
   }
 
@@ -183,7 +220,8 @@ class Encoder {
   Quantizer q_;
   ProgressiveMesh pm_;
   std::vector<float> prefixMax_, fields_;
-  std::vector<uint8_t> raw_, records_;
+  std::vector<uint8_t> records_;
+  std::deque<Job> jobs_;  // chunks being compressed, in order (stable addresses)
   std::vector<uint32_t> star_, moved_, candidates_, newTets_, changed_;
   uint32_t prevJ_ = 0, inChunk_ = 0;
   uint64_t target_ = 0;
