@@ -23,8 +23,7 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr uint32_t kOmega = 0xfffffffeu;   // the virtual vertex the boundary is coned to
 constexpr double kFlat = 1e-7;            // |6V| <= kFlat * (longest edge)^3 counts as flat
-constexpr float kKappaCap = 1e4f;
-const int kFieldMode = std::getenv("TS_FIELD_MODE") ? std::atoi(std::getenv("TS_FIELD_MODE")) : 0;         // κ of flat tets, capped so averages stay finite
+constexpr float kKappaCap = 1e4f;         // κ of flat tets, capped so averages stay finite
 
 // A symmetric quadric form x^T Q x on N-vectors whose last entry is 1 (homogeneous), stored as
 // its upper triangle, with the total weight of what was added. Sums of such forms are the error
