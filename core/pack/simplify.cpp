@@ -820,7 +820,8 @@ class Simplifier {
     log.movedBegin.push_back(uint32_t(log.moved.size()));
     log.removedBegin.push_back(uint32_t(log.removed.size()));
 
-    const std::vector<uint32_t> around = star_[i];  // copy: star_ lists change below
+    around_.assign(star_[i].begin(), star_[i].end());  // star_ lists change below
+    const std::vector<uint32_t>& around = around_;
     for (uint32_t t : around) {
       uint32_t* v = &out_.tets[4 * size_t(t)];
       if (!tetHas(t, j)) continue;
@@ -903,7 +904,7 @@ class Simplifier {
   Lane main_, helper_;  // scratch of the queue loop, and of the second thread in init()
   std::priority_queue<Entry, std::vector<Entry>, EntryAfter> heap_;
   // scratch, reused
-  std::vector<uint32_t> touched_, lvI_, lvJ_, lvE_;
+  std::vector<uint32_t> touched_, around_, lvI_, lvJ_, lvE_;
   std::vector<uint64_t> linkEdges_;
   EdgeTable edgeTable_;
   uint32_t edgeTableStamp_ = 0;
