@@ -43,23 +43,44 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
     if (mask[k >> 3] >> (k & 7) & 1) r.moved.push_back(r.star[k]);
   if (r.star.size() % 8 && mask[r.star.size() / 8] >> (r.star.size() % 8)) return corrupt("mask bits beyond the star");
 
-  // T_new: (i, j, a, b), vertices a and b named by index into j's sorted neighbours, or past
-  // the end for an explicit vertex id; the order makes the tet positively oriented.
+  // T_new: (i, j, a, b), vertices named by index into j's sorted neighbours, or past the end
+  // for an explicit vertex id; listed as pairs or as the chain of the edge's link.
   neighboursOf(pm, j, r.candidates);
-  uint32_t m;
-  if (!r.in.varint(m)) return fail(Status::Truncated, "split chunk: record ends early");
+  uint32_t header;
+  if (!r.in.varint(header)) return fail(Status::Truncated, "split chunk: record ends early");
+  const uint32_t m = header >> 2, mode = header & 3;
   if (m > kMaxNewTetsPerSplit) return corrupt(std::to_string(m) + " new tets in one split");
+  if (mode > uint32_t(RingMode::Path)) return corrupt("unknown new-tet list mode");
   r.newTets.clear();
   const uint32_t nc = uint32_t(r.candidates.size());
-  auto resolve = [&](uint32_t x, uint32_t& v) {
+  auto read = [&](uint32_t& v) {
+    uint32_t x;
+    if (!r.in.varint(x)) return false;
     v = x < nc ? r.candidates[x] : x - nc;
-    return v < V && v != j;
+    return true;
   };
-  for (uint32_t n = 0; n < m; ++n) {
-    uint32_t x, y, a, b;
-    if (!r.in.varint(x) || !r.in.varint(y)) return fail(Status::Truncated, "split chunk: record ends early");
-    if (!resolve(x, a) || !resolve(y, b) || a == b) return fail(Status::OutOfRange, "split chunk: a new tet has an invalid vertex");
-    r.newTets.insert(r.newTets.end(), {i, j, a, b});
+  auto valid = [&](uint32_t v) { return v < V && v != j; };
+  if (RingMode(mode) == RingMode::Pairs) {
+    for (uint32_t n = 0; n < m; ++n) {
+      uint32_t a, b;
+      if (!read(a) || !read(b)) return fail(Status::Truncated, "split chunk: record ends early");
+      if (!valid(a) || !valid(b) || a == b) return fail(Status::OutOfRange, "split chunk: a new tet has an invalid vertex");
+      r.newTets.insert(r.newTets.end(), {i, j, a, b});
+    }
+  } else {
+    const bool cycle = RingMode(mode) == RingMode::Cycle;
+    if (cycle && m < 3) return corrupt("a link cycle of fewer than three vertices");
+    const uint32_t count = cycle ? m : m + 1;
+    r.ring.resize(count);
+    for (uint32_t& v : r.ring) {
+      if (!read(v)) return fail(Status::Truncated, "split chunk: record ends early");
+      if (!valid(v)) return fail(Status::OutOfRange, "split chunk: a new tet has an invalid vertex");
+    }
+    for (uint32_t n = 0; n < m; ++n) {
+      const uint32_t a = r.ring[n], b = r.ring[(n + 1) % count];
+      if (a == b) return fail(Status::OutOfRange, "split chunk: a new tet has an invalid vertex");
+      r.newTets.insert(r.newTets.end(), {i, j, a, b});
+    }
   }
 
   // Position and field values of p_i: raw floats, or grid steps relative to p_j.

@@ -15,6 +15,13 @@
 namespace tetstream {
 
 inline constexpr uint32_t kSplitFlagLossless = 1;
+
+// How a split record lists its recreated tets (i, j, a, b) (FORMAT.md §4).
+enum class RingMode : uint32_t {
+  Pairs = 0,  // m pairs (a, b)
+  Cycle = 1,  // m vertices v_k: tets (i, j, v_k, v_(k+1) mod m), the link of an interior edge
+  Path = 2,   // m + 1 vertices: tets (i, j, v_k, v_(k+1)), the link of a boundary edge
+};
 inline constexpr uint32_t kMaxNewTetsPerSplit = 4096;
 
 struct SplitReader {
@@ -23,7 +30,7 @@ struct SplitReader {
   uint32_t prevJ = 0;
   bool lossless = false;
   // scratch, reused across records
-  std::vector<uint32_t> star, candidates, moved, newTets;
+  std::vector<uint32_t> star, candidates, moved, newTets, ring;
   std::vector<float> fields;
 };
 

@@ -122,11 +122,12 @@ class Encoder {
         ++x;
       }
 
-    // New tets (i, j, a, b), ordered as an even permutation of the original tet.
+    // New tets (i, j, a, b), ordered as an even permutation of the original tet. Around an
+    // edge of a consistently oriented mesh the pairs (a, b) chain into the edge's link: a cycle
+    // (interior edge) or a path (boundary edge), written as its vertices; otherwise as pairs.
     neighboursOf(pm_, js, candidates_);
     const uint32_t first = log.removedBegin[c], count = log.removedBegin[c + 1] - first;
-    putVarint(records_, count);
-    newTets_.clear();
+    pairs_.clear();
     for (uint32_t n = 0; n < count; ++n) {
       const uint32_t* v = &log.removedVertices[4 * size_t(first + n)];
       int slot[4], others = 2;
@@ -136,11 +137,23 @@ class Encoder {
         else slot[others++] = k;
       }
       if (oddPermutation(slot)) std::swap(slot[2], slot[3]);
-      uint32_t a = out_.streamVertexOf[v[slot[2]]], b = out_.streamVertexOf[v[slot[3]]];
-      putVarint(records_, candidateIndex(a));
-      putVarint(records_, candidateIndex(b));
-      newTets_.insert(newTets_.end(), {is, js, a, b});
-      out_.streamTetOf[log.removed[first + n]] = pm_.tetCount() + n;
+      pairs_.push_back({out_.streamVertexOf[v[slot[2]]], out_.streamVertexOf[v[slot[3]]], log.removed[first + n]});
+    }
+    const RingMode mode = chainPairs();
+    putVarint(records_, count << 2 | uint32_t(mode));
+    if (mode == RingMode::Pairs) {
+      for (const Pair& p : pairs_) {
+        putVarint(records_, candidateIndex(p.a));
+        putVarint(records_, candidateIndex(p.b));
+      }
+    } else {
+      for (const Pair& p : pairs_) putVarint(records_, candidateIndex(p.a));
+      if (mode == RingMode::Path) putVarint(records_, candidateIndex(pairs_.back().b));
+    }
+    newTets_.clear();
+    for (uint32_t n = 0; n < count; ++n) {
+      newTets_.insert(newTets_.end(), {is, js, pairs_[n].a, pairs_[n].b});
+      out_.streamTetOf[pairs_[n].tet] = pm_.tetCount() + n;
     }
 
     const float* pi = &mesh_.positions[3 * size_t(i)];
@@ -158,6 +171,50 @@ class Encoder {
   // Closes the current chunk and compresses it on another thread while encoding goes on. The
   // size aimed at by chunk n uses the compression ratio of chunk n−2 (known by then), so chunk
   // boundaries never depend on thread timing.
+  struct Pair {
+    uint32_t a, b, tet;
+  };
+
+  // Orders pairs_ head to tail when they form one cycle or one path (FORMAT.md §4); leaves them
+  // as they are otherwise. Deterministic: a cycle starts at its smallest vertex.
+  RingMode chainPairs() {
+    const size_t m = pairs_.size();
+    if (m == 0) return RingMode::Pairs;
+    chain_.clear();
+    // Each a and each b must appear once for a chain.
+    for (size_t x = 0; x < m; ++x)
+      for (size_t y = x + 1; y < m; ++y)
+        if (pairs_[x].a == pairs_[y].a || pairs_[x].b == pairs_[y].b) return RingMode::Pairs;
+    auto next = [&](uint32_t b) -> int {
+      for (size_t y = 0; y < m; ++y)
+        if (pairs_[y].a == b) return int(y);
+      return -1;
+    };
+    // A path starts at the pair whose a is nobody's b; a cycle at its smallest a.
+    int start = -1;
+    for (size_t x = 0; x < m; ++x) {
+      bool hasPredecessor = false;
+      for (size_t y = 0; y < m; ++y) hasPredecessor |= pairs_[y].b == pairs_[x].a;
+      if (!hasPredecessor) {
+        if (start >= 0) return RingMode::Pairs;  // two paths
+        start = int(x);
+      }
+    }
+    const bool cycle = start < 0;
+    if (cycle) {
+      start = 0;
+      for (size_t x = 1; x < m; ++x)
+        if (pairs_[x].a < pairs_[size_t(start)].a) start = int(x);
+    }
+    for (int x = start; x >= 0 && chain_.size() < m; x = next(pairs_[size_t(x)].b)) chain_.push_back(pairs_[size_t(x)]);
+    if (chain_.size() != m) return RingMode::Pairs;
+    if (cycle && chain_.back().b != chain_.front().a) return RingMode::Pairs;
+    if (!cycle && next(chain_.back().b) >= 0) return RingMode::Pairs;
+    if (cycle && m < 3) return RingMode::Pairs;  // a "cycle" of two tets is degenerate: keep pairs
+    pairs_.swap(chain_);
+    return cycle ? RingMode::Cycle : RingMode::Path;
+  }
+
   Result flushChunk(uint32_t splitsApplied) {
     Job& job = jobs_.emplace_back();
     const uint32_t index = uint32_t(jobs_.size());
@@ -221,6 +278,7 @@ class Encoder {
   ProgressiveMesh pm_;
   std::vector<float> prefixMax_, fields_;
   std::vector<uint8_t> records_;
+  std::vector<Pair> pairs_, chain_;
   std::deque<Job> jobs_;  // chunks being compressed, in order (stable addresses)
   std::vector<uint32_t> star_, moved_, candidates_, newTets_, changed_;
   uint32_t prevJ_ = 0, inChunk_ = 0;

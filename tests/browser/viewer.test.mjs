@@ -45,6 +45,35 @@ function cliIso(value, { field, dir = pack, chunks, fraction } = {}) {
   return JSON.parse(cli(...args));
 }
 
+// Compares two PNG screenshots in the page (the browser decodes them): how many pixels differ,
+// how many by more than 8 levels, and the largest difference (per channel, 0-255).
+async function pictureDifference(page, pngA, pngB) {
+  return page.evaluate(async ([a, b]) => {
+    const load = (src) => new Promise((resolve, reject) => {
+      const im = new Image();
+      im.onload = () => resolve(im);
+      im.onerror = reject;
+      im.src = src;
+    });
+    const [ia, ib] = await Promise.all([load(a), load(b)]);
+    const canvas = new OffscreenCanvas(ia.width, ia.height);
+    const g = canvas.getContext('2d');
+    g.drawImage(ia, 0, 0);
+    const da = g.getImageData(0, 0, ia.width, ia.height).data;
+    g.clearRect(0, 0, ia.width, ia.height);
+    g.drawImage(ib, 0, 0);
+    const db = g.getImageData(0, 0, ib.width, ib.height).data;
+    let differing = 0, large = 0, maxDiff = 0;
+    for (let k = 0; k < da.length; k += 4) {
+      const d = Math.max(Math.abs(da[k] - db[k]), Math.abs(da[k + 1] - db[k + 1]), Math.abs(da[k + 2] - db[k + 2]));
+      if (d > 0) differing++;
+      if (d > 8) large++;
+      maxDiff = Math.max(maxDiff, d);
+    }
+    return { differing, large, pixels: da.length / 4, maxDiff };
+  }, [`data:image/png;base64,${pngA.toString('base64')}`, `data:image/png;base64,${pngB.toString('base64')}`]);
+}
+
 function readManifest(dir = pack) {
   return JSON.parse(fs.readFileSync(path.join(dir, 'manifest.json'), 'utf8'));
 }
@@ -194,15 +223,19 @@ test('streams a multi-chunk pack to complete, matches the CLI surface, and the i
   await frames(page);
   await page.screenshot({ path: path.join(outDir, 'viewer-complete.png') });
 
-  // The picture itself: the surface built by 32k local updates draws exactly like a surface
-  // extracted from scratch (selecting the field again rebuilds it), pixel for pixel.
+  // The picture itself: the surface built by 32k local updates draws like a surface extracted
+  // from scratch (selecting the field again rebuilds it). Same triangles; vertex normals were
+  // summed in a different order, and fragments at equal depth may resolve by draw order, so a
+  // few pixels may differ: at most 0.01% of them by more than 8 levels, 0.1% at all.
   const view = { x: 360, y: 0, width: 920, height: 700 }; // right of the panel, above the status line
   const streamed = await page.screenshot({ clip: view });
   await page.evaluate((f) => window.tetstream.setField(f), manifest.isoField);
   await frames(page, 6);
   const rebuilt = await page.evaluate(() => window.tetstream.stats());
   assert.equal(rebuilt.triangles, s.triangles);
-  assert.ok((await page.screenshot({ clip: view })).equals(streamed), 'streamed and rebuilt surfaces draw the same');
+  const diff = await pictureDifference(page, streamed, await page.screenshot({ clip: view }));
+  assert.ok(diff.differing <= 0.001 * diff.pixels && diff.large <= 0.0001 * diff.pixels,
+    `streamed and rebuilt surfaces draw the same: ${JSON.stringify(diff)}`);
 
   // Drag the ImGui isovalue slider from its middle to 85% of its width with the mouse.
   const r = s.sliderRect;
