@@ -667,22 +667,14 @@ class Simplifier {
     size_t edgeVerts = 0, edgeEdges = 0;
     bool boundaryEdge = false;
     uint32_t stampE = ++L.stamp;
-    for (uint32_t t : star_[i]) {
-      if (!tetHas(t, j)) continue;
-      const uint32_t* x = &out_.tets[4 * size_t(t)];
-      uint32_t o[2];
-      int n = 0;
-      for (int k = 0; k < 4; ++k)
-        if (x[k] != i && x[k] != j) o[n++] = x[k];
-      for (uint32_t w : o)
-        if (L.seen[w] != stampE) { L.seen[w] = stampE; ++edgeVerts; }
+    forEdgeLink(i, j, [&](const uint32_t o[2]) {
+      for (int k = 0; k < 2; ++k)
+        if (L.seen[o[k]] != stampE) { L.seen[o[k]] = stampE; ++edgeVerts; }
       ++edgeEdges;  // each tet around the edge has its own opposite edge
-      for (int f = 0; f < 4; ++f)
-        if (opp_[4 * t + f] == kNoNeighbor && x[f] != i && x[f] != j) {
-          boundaryEdge = true;
-          ++edgeEdges;  // (k, ω) for the boundary face (i, j, k): one per face
-        }
-    }
+    }, [&](uint32_t) {
+      boundaryEdge = true;
+      ++edgeEdges;  // (k, ω) for the boundary face (i, j, k): one per face
+    });
     if (common != edgeVerts + (boundaryEdge ? 1 : 0)) TS_LINK_RESULT(false);
     // Edges: those of Lk(j) in a table, then the distinct ones of Lk(i) found there.
     edgeTable_.beginSet(++edgeTableStamp_);
@@ -712,6 +704,23 @@ class Simplifier {
     });
     TS_LINK_RESULT(commonEdges == edgeEdges);
 #undef TS_LINK_RESULT
+  }
+
+  // The link of edge (i, j): calls edge(o) with the opposite edge o[2] of every tet around it,
+  // and face(k) for every boundary face (i, j, k).
+  template <typename Edge, typename Face>
+  void forEdgeLink(uint32_t i, uint32_t j, Edge edge, Face face) const {
+    for (uint32_t t : star_[i]) {
+      if (!tetHas(t, j)) continue;
+      const uint32_t* x = &out_.tets[4 * size_t(t)];
+      uint32_t o[2];
+      int n = 0;
+      for (int k = 0; k < 4; ++k)
+        if (x[k] != i && x[k] != j) o[n++] = x[k];
+      edge(o);
+      for (int f = 0; f < 4; ++f)
+        if (opp_[4 * t + f] == kNoNeighbor && x[f] != i && x[f] != j) face(o[0] == x[f] ? o[1] : o[0]);
+    }
   }
 
   // Calls f(a, b) for every boundary face (v, a, b) around v.
@@ -783,22 +792,13 @@ class Simplifier {
     // Link of the edge: the opposite edges of the tets around it, and the boundary faces at it.
     lvE_.clear();
     leE_.clear();
-    for (uint32_t t : star_[i]) {
-      if (!tetHas(t, j)) continue;
-      const uint32_t* x = &out_.tets[4 * size_t(t)];
-      uint32_t o[2];
-      int n = 0;
-      for (int k = 0; k < 4; ++k)
-        if (x[k] != i && x[k] != j) o[n++] = x[k];
+    forEdgeLink(i, j, [&](const uint32_t o[2]) {
       lvE_.insert(lvE_.end(), o, o + 2);
       leE_.push_back(makeEdge(o[0], o[1]));
-      for (int f = 0; f < 4; ++f)
-        if (opp_[4 * t + f] == kNoNeighbor && x[f] != i && x[f] != j) {
-          uint32_t k = o[0] == x[f] ? o[1] : o[0];  // the face is (i, j, k)
-          lvE_.push_back(kOmega);
-          leE_.push_back(makeEdge(k, kOmega));
-        }
-    }
+    }, [&](uint32_t k) {
+      lvE_.push_back(kOmega);
+      leE_.push_back(makeEdge(k, kOmega));
+    });
     sortUnique(lvE_);
     sortUnique(leE_);
     return intersectionSize(lvI_, lvJ_) == lvE_.size() && intersectionSize(leI_, leJ_) == leE_.size();
