@@ -14,4 +14,5 @@ echo "build: wasm ($BUILD_TYPE)"
 export NODE_PATH=/usr/share/nodejs   # Debian's emscripten needs this to find acorn
 emcmake cmake -S . -B build/wasm -DCMAKE_BUILD_TYPE="$BUILD_TYPE" >/dev/null
 cmake --build build/wasm -j"$JOBS"
+node server/precompress.mjs build/web   # X.gz / X.br beside the viewer's files (server/README.md)
 echo "build: ok (CLI: build/native/tetstream, web app: build/web/)"

@@ -13,6 +13,7 @@ APT_PACKAGES=(
   libglm-dev libzstd-dev zstd zlib1g-dev libxxhash-dev
   libpugixml-dev libcli11-dev nlohmann-json3-dev libgtest-dev libstb-dev
   chromium                         # headless browser tests
+  nginx wrk                        # tests against real nginx (server/nginx.conf); server load test
 )
 
 missing=()
@@ -44,6 +45,15 @@ fi
 if [ ${#missing[@]} -gt 0 ]; then
   echo "setup: installing ${missing[*]}"
   as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  # Debian's nginx package starts a system service on port 80 when installed. tetstream does
+  # not use it (tests start their own nginx on a free port): stop the one we just installed.
+  if [[ " ${missing[*]} " == *" nginx "* ]]; then
+    if command -v systemctl >/dev/null && systemctl is-active --quiet nginx 2>/dev/null; then
+      as_root systemctl disable --now nginx >/dev/null 2>&1 || true
+    elif [ -s /run/nginx.pid ]; then
+      as_root /usr/sbin/nginx -s quit 2>/dev/null || true
+    fi
+  fi
 fi
 
 fetch_src() { # fetch_src SRCPKG DESTNAME

@@ -1,84 +1,204 @@
 #!/usr/bin/env node
-// Static server for the viewer and packed datasets (development, demos, small deployments).
-// Built on serve-static (the file server behind Express): correct MIME types (application/wasm),
-// ETag/Last-Modified with conditional requests, Range support, no directory listings, no path
-// escape. We add CORS headers and caching suited to content-addressed chunks, and never
-// compress (chunks are already zstd).
-//
-//   node server/serve.mjs [--host 127.0.0.1] [--port 8080] [--mount /prefix=DIR ...] [DIR]
-import http from 'node:http';
-import path from 'node:path';
+// Static server for the viewer and packed datasets (development, demos, small deployments), with
+// a simulated slow link and fault injection for tests. `node server/serve.mjs --help` lists the
+// options; server/README.md explains them and how to deploy on nginx, object stores and CDNs.
+// In code: import { createServer } from './server/serve.mjs' (see app.mjs for the options).
 import fs from 'node:fs';
-import serveStatic from 'serve-static';
-import finalhandler from 'finalhandler';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { createServer } from './app.mjs';
+import { parseRate, parseMs } from './link.mjs';
+import { normalizeFaults } from './faults.mjs';
 
-export function createServer({ mounts }) {
-  const handlers = mounts.map(({ prefix, dir }) => ({
-    prefix: prefix.endsWith('/') ? prefix : prefix + '/',
-    serve: serveStatic(path.resolve(dir), {
-      index: ['index.html'],
-      dotfiles: 'deny',
-      fallthrough: false,
-      setHeaders(res, file) {
-        // Chunk names carry their content hash: cache forever. Everything else: revalidate.
-        const immutable = /[\\/]chunks[\\/][^\\/]+\.tsc$/.test(file);
-        res.setHeader('Cache-Control', immutable ? 'public, max-age=31536000, immutable' : 'no-cache');
-        if (file.endsWith('.tsc')) res.setHeader('Content-Type', 'application/octet-stream');
-      },
-    }),
-  }));
-  return http.createServer((req, res) => {
-    res.setHeader('Access-Control-Allow-Origin', '*');
-    res.setHeader('Access-Control-Expose-Headers', 'Content-Length, ETag');
-    if (req.method === 'OPTIONS') {
-      res.setHeader('Access-Control-Allow-Methods', 'GET, HEAD, OPTIONS');
-      res.setHeader('Access-Control-Allow-Headers', 'Range, If-None-Match, If-Modified-Since');
-      res.writeHead(204).end();
-      return;
-    }
-    const done = finalhandler(req, res);
-    const url = req.url || '/';
-    const h = handlers.find((m) => url === m.prefix.slice(0, -1) || url.startsWith(m.prefix));
-    if (!h) return done();
-    req.url = '/' + url.slice(h.prefix.length);
-    h.serve(req, res, done);
-  });
-}
+export { createServer };
 
-function parseArgs(argv) {
-  const opts = { host: '127.0.0.1', port: 8080, mounts: [] };
+const here = path.dirname(fileURLToPath(import.meta.url));
+const defaultViewer = path.resolve(here, '../build/web');
+
+const HELP = `usage: node server/serve.mjs [options] [DIR]
+       npm run serve -- [options] [DIR]
+
+Serves DIR (default: the current folder) at /, or the folders given with --mount.
+If DIR holds packed datasets (DIR/manifest.json or DIR/*/manifest.json) and no index.html,
+the viewer (build/web) is served at / and DIR at /data/, and a viewer URL is printed for each
+dataset.
+
+  --host HOST           address to listen on (default 127.0.0.1; 0.0.0.0 for every interface)
+  --port PORT           port (default 8080; 0 picks a free one)
+  --mount /PREFIX=DIR   serve DIR under /PREFIX/ (repeatable; the longest prefix wins)
+  --viewer DIR          the viewer folder used with a dataset DIR (default build/web)
+  --no-viewer           serve a dataset DIR alone, at /
+  --throttle RATE       cap the bandwidth of all responses together, like one shared link:
+                        10mbit, 500kbit, 10Mbps (bits) or 2MB, 1.5mbyte, 64KiB (bytes), per second
+  --latency MS          wait MS milliseconds before the first byte of every response (50, 50ms, 0.2s)
+  --fault JSON          make matching requests fail (repeatable; an object or an array), e.g.
+                        '{"match":"chunks/00003","kind":"status","status":503,"times":2}'
+                        kinds: status, truncate, corrupt, drop, slow; fields: match (substring of
+                        the path) or regexp, status, times, delayMs, afterBytes (server/README.md)
+  --max-connections N   sockets open at once (default 512; more are closed at once)
+  --log                 print one line per request
+  -h, --help            this text
+
+Every response has CORS headers (Access-Control-Allow-Origin: *); chunks/*.tsc are sent as
+application/octet-stream with Cache-Control immutable and never compressed; other files get
+Cache-Control no-cache and ETag/Last-Modified revalidation; X.br / X.gz next to a .wasm or .js
+(server/precompress.mjs writes them) are sent to clients that accept them.`;
+
+class UsageError extends Error {}
+
+export function parseArgs(argv) {
+  const opts = { host: '127.0.0.1', port: 8080, mounts: [], viewer: defaultViewer, faults: [], throttleBytesPerSec: 0, latencyMs: 0, maxConnections: 512, log: false };
+  const positional = [];
+  const value = (i, name) => {
+    if (i >= argv.length) throw new UsageError(`${name}: missing value`);
+    return argv[i];
+  };
   for (let i = 0; i < argv.length; i++) {
     const a = argv[i];
-    if (a === '--host') opts.host = argv[++i];
-    else if (a === '--port') opts.port = Number(argv[++i]);
-    else if (a === '--mount') {
-      const [prefix, dir] = argv[++i].split('=');
-      opts.mounts.push({ prefix, dir });
-    } else if (a === '-h' || a === '--help') {
-      console.log('usage: node server/serve.mjs [--host H] [--port P] [--mount /prefix=DIR ...] [DIR]');
-      process.exit(0);
-    } else opts.mounts.push({ prefix: '/', dir: a });
+    const wrap = (fn) => {
+      try { return fn(); } catch (e) { throw new UsageError(`${a}: ${e.message}`); }
+    };
+    if (a === '--host') opts.host = value(++i, a);
+    else if (a === '--port') {
+      const v = value(++i, a);
+      if (!/^\d+$/.test(v) || Number(v) > 65535) throw new UsageError(`--port: cannot read "${v}"; write a number from 0 to 65535`);
+      opts.port = Number(v);
+    } else if (a === '--mount') {
+      const v = value(++i, a);
+      const eq = v.indexOf('=');
+      if (eq < 1 || !v.startsWith('/')) throw new UsageError(`--mount: cannot read "${v}"; write /PREFIX=DIR, e.g. /data=build/data`);
+      opts.mounts.push({ prefix: v.slice(0, eq), dir: v.slice(eq + 1) });
+    } else if (a === '--viewer') opts.viewer = value(++i, a);
+    else if (a === '--no-viewer') opts.viewer = null;
+    else if (a === '--throttle') {
+      const v = value(++i, a);
+      opts.throttleBytesPerSec = wrap(() => parseRate(v));
+    } else if (a === '--latency') {
+      const v = value(++i, a);
+      opts.latencyMs = wrap(() => parseMs(v));
+    } else if (a === '--fault') {
+      const v = value(++i, a);
+      const parsed = wrap(() => JSON.parse(v));
+      opts.faults.push(...wrap(() => normalizeFaults(Array.isArray(parsed) ? parsed : [parsed])));
+    } else if (a === '--max-connections') {
+      const v = value(++i, a);
+      if (!/^[1-9]\d*$/.test(v)) throw new UsageError(`--max-connections: cannot read "${v}"; write a positive number`);
+      opts.maxConnections = Number(v);
+    } else if (a === '--log') opts.log = true;
+    else if (a === '-h' || a === '--help') opts.help = true;
+    else if (a.startsWith('-')) throw new UsageError(`unknown option ${a} (see --help)`);
+    else positional.push(a);
   }
-  if (!opts.mounts.length) opts.mounts.push({ prefix: '/', dir: '.' });
-  for (const m of opts.mounts) {
-    if (!fs.existsSync(m.dir)) throw new Error(`no such folder: ${m.dir}`);
+  if (positional.length > 1) throw new UsageError(`one DIR at most (got ${positional.join(' ')}); use --mount /PREFIX=DIR for more`);
+  for (const m of opts.mounts) checkFolder(m.dir, '--mount');
+
+  if (positional.length || !opts.mounts.length) {
+    const dir = positional[0] ?? '.';
+    checkFolder(dir, 'DIR');
+    const isData = !fs.existsSync(path.join(dir, 'index.html')) && findManifests(dir).length > 0;
+    if (isData && opts.viewer && !opts.mounts.some((m) => m.prefix === '/')) {
+      if (fs.existsSync(path.join(opts.viewer, 'index.html'))) {
+        opts.mounts.push({ prefix: '/', dir: opts.viewer }, { prefix: '/data', dir });
+      } else {
+        opts.notes = [`no viewer at ${opts.viewer} (run npm run build): serving the data alone`];
+        opts.mounts.push({ prefix: '/', dir });
+      }
+    } else opts.mounts.push({ prefix: '/', dir });
   }
-  // Longest prefix first, so /data/ wins over /.
-  opts.mounts.sort((a, b) => b.prefix.length - a.prefix.length);
   return opts;
 }
 
-if (import.meta.url === `file://${process.argv[1]}`) {
+function checkFolder(dir, what) {
+  let st;
+  try { st = fs.statSync(dir); } catch { throw new UsageError(`${what}: no such folder: ${dir}`); }
+  if (!st.isDirectory()) throw new UsageError(`${what}: not a folder: ${dir}`);
+}
+
+// DIR/manifest.json and DIR/*/manifest.json, sorted; enough to point people at their datasets.
+function findManifests(dir) {
+  const out = [];
+  if (fs.existsSync(path.join(dir, 'manifest.json'))) out.push('manifest.json');
+  let entries = [];
+  try { entries = fs.readdirSync(dir, { withFileTypes: true }); } catch { /* unreadable: none */ }
+  for (const e of entries.sort((a, b) => a.name.localeCompare(b.name))) {
+    if (e.name.startsWith('.')) continue;
+    if ((e.isDirectory() || e.isSymbolicLink()) && fs.existsSync(path.join(dir, e.name, 'manifest.json'))) {
+      out.push(`${e.name}/manifest.json`);
+    }
+  }
+  return out;
+}
+
+// Viewer URLs for the datasets of every mount, if some mount is a viewer.
+function viewerUrls(base, mounts, limit = 8) {
+  const viewer = mounts.find((m) => fs.existsSync(path.join(m.dir, 'index.html')));
+  if (!viewer) return [];
+  const vprefix = viewer.prefix.endsWith('/') ? viewer.prefix : viewer.prefix + '/';
+  const urls = [];
+  for (const m of mounts) {
+    if (m === viewer) continue;
+    const prefix = m.prefix.endsWith('/') ? m.prefix : m.prefix + '/';
+    for (const rel of findManifests(m.dir)) {
+      urls.push(`${base}${vprefix.slice(1)}index.html?data=${prefix}${rel}`);
+    }
+  }
+  if (urls.length > limit) return [...urls.slice(0, limit), `… and ${urls.length - limit} more`];
+  return urls;
+}
+
+function formatRate(bytesPerSec) {
+  const mbit = (bytesPerSec * 8) / 1e6;
+  return mbit >= 1 ? `${+mbit.toFixed(2)} Mbit/s` : `${+(mbit * 1000).toFixed(1)} kbit/s`;
+}
+
+function main() {
+  let opts;
   try {
-    const opts = parseArgs(process.argv.slice(2));
-    const server = createServer(opts);
-    server.listen(opts.port, opts.host, () => {
-      const { port } = server.address();
-      console.log(`serving on http://${opts.host}:${port}/`);
-      for (const m of opts.mounts) console.log(`  ${m.prefix} -> ${path.resolve(m.dir)}`);
-    });
+    opts = parseArgs(process.argv.slice(2));
   } catch (e) {
     console.error(`serve: ${e.message}`);
-    process.exit(1);
+    process.exit(e instanceof UsageError ? 2 : 1);
   }
+  if (opts.help) {
+    console.log(HELP);
+    return;
+  }
+  const server = createServer({
+    ...opts,
+    log: opts.log ? (e) => console.log(`${new Date(e.time).toISOString()} ${e.method} ${e.url} ${e.status}${e.fault ? ` (fault: ${e.fault})` : ''}${e.aborted ? ' aborted' : ''} ${e.ms} ms`) : null,
+  });
+  server.on('error', (e) => {
+    console.error(`serve: ${e.code === 'EADDRINUSE' ? `port ${opts.port} on ${opts.host} is in use; try --port 0` : e.message}`);
+    process.exit(1);
+  });
+  server.listen(opts.port, opts.host, () => {
+    const { port } = server.address();
+    const shown = ['0.0.0.0', '::'].includes(opts.host) ? 'localhost' : opts.host.includes(':') ? `[${opts.host}]` : opts.host;
+    const base = `http://${shown}:${port}/`;
+    console.log(`serving on ${base}`);
+    for (const m of [...opts.mounts].sort((a, b) => a.prefix.length - b.prefix.length)) {
+      console.log(`  ${m.prefix.padEnd(8)} -> ${path.resolve(m.dir)}`);
+    }
+    for (const n of opts.notes ?? []) console.log(`note: ${n}`);
+    if (opts.throttleBytesPerSec || opts.latencyMs) {
+      const parts = [];
+      if (opts.throttleBytesPerSec) parts.push(`${formatRate(opts.throttleBytesPerSec)} shared by all responses`);
+      if (opts.latencyMs) parts.push(`${opts.latencyMs} ms before each response`);
+      console.log(`simulated link: ${parts.join(', ')}`);
+    }
+    if (opts.faults.length) console.log(`fault injection: ${opts.faults.length} rule(s)`);
+    const urls = viewerUrls(base, opts.mounts);
+    if (urls.length) {
+      console.log('\nOpen in a browser (Ctrl-C stops the server):');
+      for (const u of urls) console.log(`  ${u}`);
+    }
+  });
+  const stop = () => {
+    server.close(() => process.exit(0));
+    server.closeAllConnections();
+  };
+  process.on('SIGINT', stop);
+  process.on('SIGTERM', stop);
 }
+
+if (process.argv[1] && fileURLToPath(import.meta.url) === fs.realpathSync(process.argv[1])) main();

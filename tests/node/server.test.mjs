@@ -1,0 +1,509 @@
+// The static server (server/serve.mjs) and the documented nginx config (server/nginx.conf):
+// no way out of the served folders, the headers the viewer and caches rely on, precompressed
+// viewer files, the simulated link and every kind of injected fault.
+import { test, describe, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import crypto from 'node:crypto';
+import fs from 'node:fs';
+import path from 'node:path';
+import zlib from 'node:zlib';
+import { spawn, spawnSync } from 'node:child_process';
+import { createServer } from '../../server/serve.mjs';
+import { parseRate } from '../../server/link.mjs';
+import { precompressDir } from '../../server/precompress.mjs';
+import { startNginx, startPythonHttpServer } from '../support/nginx.mjs';
+import { get, rawGet } from '../support/http.mjs';
+import { root, tempDir } from './helpers.mjs';
+
+const SECRET = `top-secret-${crypto.randomBytes(8).toString('hex')}`;
+const CHUNK = '00000-0123456789abcdef.tsc';
+const SMALL = '00001-fedcba9876543210.tsc';
+
+// tmp/secret.txt            outside every root
+// tmp/www/                  mounted at /      (viewer-like: index.html, app.js + .gz/.br, wasm)
+// tmp/data/ds/              mounted at /data/ (manifest.json, chunks/*.tsc)
+const fixtures = [];
+after(() => {
+  for (const dir of fixtures) fs.rmSync(dir, { recursive: true, force: true });
+});
+
+function makeFixture() {
+  const dir = tempDir('server');
+  fixtures.push(dir);
+  const www = path.join(dir, 'www');
+  const data = path.join(dir, 'data');
+  const ds = path.join(data, 'ds');
+  fs.mkdirSync(path.join(www, 'sub'), { recursive: true });
+  fs.mkdirSync(path.join(ds, 'chunks'), { recursive: true });
+  fs.writeFileSync(path.join(dir, 'secret.txt'), SECRET);
+  fs.writeFileSync(path.join(www, '.env'), SECRET);
+  fs.writeFileSync(path.join(www, 'index.html'), '<!doctype html><title>viewer</title>\n'.repeat(60));
+  fs.writeFileSync(path.join(www, 'app.js'), 'export const answer = 42; // compressible text\n'.repeat(200));
+  const wasm = Buffer.concat([Buffer.from([0, 0x61, 0x73, 0x6d, 1, 0, 0, 0]), Buffer.alloc(20000, 7)]);
+  fs.writeFileSync(path.join(www, 'tetstream.wasm'), wasm);
+  fs.writeFileSync(path.join(www, 'sub', 'file.txt'), 'in a subfolder\n');
+  fs.symlinkSync('../secret.txt', path.join(www, 'link-out'));
+  fs.symlinkSync('..', path.join(www, 'dirlink'));
+  fs.symlinkSync(path.join(dir, 'secret.txt'), path.join(www, 'abs-link-out'));
+  fs.symlinkSync('index.html', path.join(www, 'link-in'));
+  fs.symlinkSync(path.join(dir, 'secret.txt'), path.join(ds, 'chunks', '00009-0000000000000000.tsc'));
+  fs.writeFileSync(path.join(ds, 'manifest.json'), JSON.stringify({ formatVersion: 1, chunks: [CHUNK, SMALL] }));
+  const chunk = crypto.randomBytes(1 << 20); // 1 MiB, incompressible like zstd output
+  fs.writeFileSync(path.join(ds, 'chunks', CHUNK), chunk);
+  const small = crypto.randomBytes(5000);
+  fs.writeFileSync(path.join(ds, 'chunks', SMALL), small);
+  // A .gz next to a chunk must never be sent in its place: chunks are zstd and never encoded.
+  fs.writeFileSync(path.join(ds, 'chunks', SMALL + '.gz'), zlib.gzipSync(small));
+  return { dir, www, data, chunk, small, wasm };
+}
+
+// At least 20 ways out of the root; none may return the secret (or /etc/passwd).
+const TRAVERSALS = [
+  '/../secret.txt',
+  '/../../../../../../etc/passwd',
+  '/%2e%2e/secret.txt',
+  '/%2E%2E/%2E%2E/%2E%2E/etc/passwd',
+  '/.%2e/secret.txt',
+  '/%2e./secret.txt',
+  '/%252e%252e/secret.txt',
+  '/%25%32%65%25%32%65/secret.txt',
+  '/..%2fsecret.txt',
+  '/%2e%2e%2fsecret.txt',
+  '/..\\secret.txt',
+  '/..%5csecret.txt',
+  '/%5c..%5csecret.txt',
+  '/..%255csecret.txt',
+  '/index.html%00/../../secret.txt',
+  '/..%00/secret.txt',
+  '//etc/passwd',
+  '/%2fetc%2fpasswd',
+  '/data/../../secret.txt',
+  '/data/ds/../../../secret.txt',
+  '/sub/../../secret.txt',
+  '/index.html/../../secret.txt',
+  '/%c0%ae%c0%ae/secret.txt',
+  '/%u002e%u002e/secret.txt',
+  '/..;/secret.txt',
+  '/....//secret.txt',
+  '/.%2e/.%2e/.%2e/etc/passwd',
+  '/link-out',
+  '/abs-link-out',
+  '/dirlink/secret.txt',
+  '/dirlink/dirlink/secret.txt',
+  '/data/ds/chunks/00009-0000000000000000.tsc',
+  '/.env',
+  '/%2eenv',
+  '/sub/',
+  '/data/',
+  '/data/ds/chunks/',
+];
+
+function assertNoLeak(r, target) {
+  assert.ok([400, 403, 404].includes(r.status), `${target}: status ${r.status}`);
+  const text = r.body.toString('latin1');
+  assert.ok(!text.includes(SECRET), `${target}: the secret leaked`);
+  assert.ok(!text.includes('root:x:0:0'), `${target}: /etc/passwd leaked`);
+  assert.ok(!/<a href|Index of/i.test(text), `${target}: a folder listing`);
+}
+
+const mime = (r) => String(r.headers['content-type']).split(';')[0].trim();
+
+// Checks shared by our server and nginx with server/nginx.conf.
+function headerChecks(name, ctx) {
+  // ctx.base is set in before(); without a server (nginx not installed) the checks are skipped.
+  const check = (title, fn) => test(title, (t) => (ctx.base ? fn() : t.skip(ctx.skipReason)));
+  check(`${name}: MIME types`, async () => {
+    const { base, fx } = ctx;
+    assert.equal(mime(await get(base, '/tetstream.wasm')), 'application/wasm');
+    assert.equal(mime(await get(base, '/data/ds/manifest.json')), 'application/json');
+    assert.equal(mime(await get(base, `/data/ds/chunks/${CHUNK}`)), 'application/octet-stream');
+    assert.match(mime(await get(base, '/app.js')), /^(text|application)\/javascript$/);
+    assert.equal(mime(await get(base, '/index.html')), 'text/html');
+    const r = await get(base, `/data/ds/chunks/${CHUNK}`);
+    assert.ok(r.body.equals(fx.chunk), 'chunk bytes');
+  });
+
+  check(`${name}: CORS on GET, on errors and on preflight`, async () => {
+    const { base } = ctx;
+    const origin = { Origin: 'http://viewer.example' };
+    for (const t of ['/data/ds/manifest.json', `/data/ds/chunks/${CHUNK}`, '/data/ds/missing.tsc']) {
+      const r = await get(base, t, { headers: origin });
+      assert.equal(r.headers['access-control-allow-origin'], '*', t);
+    }
+    const pre = await get(base, `/data/ds/chunks/${CHUNK}`, {
+      method: 'OPTIONS',
+      headers: { ...origin, 'Access-Control-Request-Method': 'GET', 'Access-Control-Request-Headers': 'range, if-none-match' },
+    });
+    assert.ok([200, 204].includes(pre.status), `preflight ${pre.status}`);
+    assert.equal(pre.headers['access-control-allow-origin'], '*');
+    assert.match(pre.headers['access-control-allow-methods'], /GET/);
+    assert.match(pre.headers['access-control-allow-headers'], /range/i);
+    assert.equal(pre.body.length, 0);
+  });
+
+  check(`${name}: caching: chunks immutable, manifest and viewer revalidated, 304s`, async () => {
+    const { base } = ctx;
+    const chunk = await get(base, `/data/ds/chunks/${CHUNK}`);
+    assert.match(chunk.headers['cache-control'], /immutable/);
+    assert.match(chunk.headers['cache-control'], /max-age=31536000/);
+    for (const t of ['/data/ds/manifest.json', '/tetstream.wasm', '/index.html']) {
+      const r = await get(base, t);
+      assert.equal(r.headers['cache-control'], 'no-cache', t);
+      assert.ok(r.headers.etag && r.headers['last-modified'], `${t}: ETag and Last-Modified`);
+      const byEtag = await get(base, t, { headers: { 'If-None-Match': r.headers.etag } });
+      assert.equal(byEtag.status, 304, `${t}: If-None-Match`);
+      assert.equal(byEtag.body.length, 0);
+      const byDate = await get(base, t, { headers: { 'If-Modified-Since': r.headers['last-modified'] } });
+      assert.equal(byDate.status, 304, `${t}: If-Modified-Since`);
+      const other = await get(base, t, { headers: { 'If-None-Match': '"something-else"' } });
+      assert.equal(other.status, 200, `${t}: a different ETag gets the file`);
+    }
+    const missing = await get(base, '/data/ds/chunks/00042-0000000000000000.tsc');
+    assert.equal(missing.status, 404);
+    assert.doesNotMatch(String(missing.headers['cache-control'] ?? ''), /immutable/, 'a 404 is never cached for a year');
+  });
+
+  check(`${name}: Range requests and HEAD`, async () => {
+    const { base, fx } = ctx;
+    const t = `/data/ds/chunks/${SMALL}`;
+    const r = await get(base, t, { headers: { Range: 'bytes=100-199' } });
+    assert.equal(r.status, 206);
+    assert.equal(r.headers['content-range'], `bytes 100-199/${fx.small.length}`);
+    assert.ok(r.body.equals(fx.small.subarray(100, 200)));
+    const tail = await get(base, t, { headers: { Range: 'bytes=-10' } });
+    assert.equal(tail.status, 206);
+    assert.ok(tail.body.equals(fx.small.subarray(-10)));
+    const bad = await get(base, t, { headers: { Range: `bytes=${fx.small.length}-` } });
+    assert.equal(bad.status, 416);
+    assert.equal(bad.headers['content-range'], `bytes */${fx.small.length}`);
+    const head = await get(base, t, { method: 'HEAD' });
+    assert.equal(head.status, 200);
+    assert.equal(Number(head.headers['content-length']), fx.small.length);
+    assert.equal(head.body.length, 0);
+  });
+
+  check(`${name}: precompressed viewer files; chunks never encoded`, async () => {
+    const { base, fx, brotli } = ctx;
+    const original = fs.readFileSync(path.join(fx.www, 'tetstream.wasm'));
+    const gz = await get(base, '/tetstream.wasm', { headers: { 'Accept-Encoding': 'gzip' } });
+    assert.equal(gz.headers['content-encoding'], 'gzip');
+    assert.equal(mime(gz), 'application/wasm', 'the type of the original, not of the .gz');
+    assert.match(gz.headers.vary, /Accept-Encoding/i);
+    assert.ok(zlib.gunzipSync(gz.body).equals(original));
+    assert.ok(gz.body.length < original.length / 4);
+    if (brotli) {
+      const br = await get(base, '/app.js', { headers: { 'Accept-Encoding': 'gzip, deflate, br' } });
+      assert.equal(br.headers['content-encoding'], 'br');
+      assert.ok(zlib.brotliDecompressSync(br.body).equals(fs.readFileSync(path.join(fx.www, 'app.js'))));
+      const notBr = await get(base, '/app.js', { headers: { 'Accept-Encoding': 'br;q=0, gzip' } });
+      assert.equal(notBr.headers['content-encoding'], 'gzip');
+    }
+    const plain = await get(base, '/tetstream.wasm');
+    assert.equal(plain.headers['content-encoding'], undefined, 'no Accept-Encoding: identity');
+    assert.ok(plain.body.equals(original));
+    for (const t of [`/data/ds/chunks/${SMALL}`, `/data/ds/chunks/${CHUNK}`]) {
+      const c = await get(base, t, { headers: { 'Accept-Encoding': 'gzip, deflate, br' } });
+      assert.equal(c.headers['content-encoding'], undefined, t);
+    }
+    const c = await get(base, `/data/ds/chunks/${SMALL}`, { headers: { 'Accept-Encoding': 'gzip' } });
+    assert.ok(c.body.equals(fx.small));
+  });
+
+  check(`${name}: ${TRAVERSALS.length} path traversal forms never escape the root`, async () => {
+    const { base } = ctx;
+    for (const t of TRAVERSALS) assertNoLeak(await get(base, t), t);
+    for (const t of ['/\0../secret.txt', '/../secret.txt\0', '/..\0/..\0/etc/passwd']) assertNoLeak(await rawGet(base, t), JSON.stringify(t));
+    // A path that is fine still works.
+    assert.equal((await get(base, '/sub/file.txt')).status, 200);
+  });
+}
+
+describe('our server (server/serve.mjs)', () => {
+  const ctx = { brotli: true };
+  let server;
+  before(async () => {
+    ctx.fx = makeFixture();
+    await precompressDir(ctx.fx.www);
+    server = await listen({ mounts: [{ prefix: '/', dir: ctx.fx.www }, { prefix: '/data', dir: ctx.fx.data }] });
+    ctx.base = url(server);
+  });
+  after(() => close(server));
+
+  headerChecks('serve.mjs', ctx);
+
+  test('serve.mjs: more refusals: absolute-form target, methods, symlink inside the root', async () => {
+    const { base, fx } = ctx;
+    assert.equal((await rawGet(base, 'http://127.0.0.1/../secret.txt')).status, 400);
+    assert.equal((await rawGet(base, '*')).status, 400);
+    assert.equal((await get(base, '/index.html', { method: 'POST' })).status, 405);
+    assert.equal((await get(base, '/index.html', { method: 'DELETE' })).status, 405);
+    const inside = await get(base, '/link-in');
+    assert.equal(inside.status, 200, 'a symlink to a file inside the root is served');
+    assert.ok(inside.body.equals(fs.readFileSync(path.join(fx.www, 'index.html'))));
+    assert.equal((await get(base, '/')).status, 200, 'index.html of the root');
+    assert.equal((await get(base, '/sub')).status, 404, 'a folder is not a file');
+  });
+
+  test('serve.mjs: a precompressed file older than its original is not used', async () => {
+    const { base, fx } = ctx;
+    const js = path.join(fx.www, 'app.js');
+    const later = new Date(Date.now() + 60000);
+    fs.utimesSync(js, later, later);
+    try {
+      const r = await get(base, '/app.js', { headers: { 'Accept-Encoding': 'gzip, br' } });
+      assert.equal(r.headers['content-encoding'], undefined);
+      assert.ok(r.body.equals(fs.readFileSync(js)));
+    } finally {
+      fs.utimesSync(js, new Date(), new Date(Date.now() - 60000));
+    }
+  });
+
+  test('serve.mjs: requestLog records method, url and status', async () => {
+    const before = server.requestLog.length;
+    await get(ctx.base, '/data/ds/manifest.json');
+    await get(ctx.base, '/nothing-here');
+    const [a, b] = server.requestLog.slice(before);
+    assert.deepEqual([a.method, a.url, a.status, b.url, b.status], ['GET', '/data/ds/manifest.json', 200, '/nothing-here', 404]);
+    assert.ok(a.time > 0 && Number.isFinite(a.time));
+  });
+});
+
+describe('link simulation', () => {
+  let fx;
+  before(() => { fx = makeFixture(); });
+
+  test('rates are read as people write them', () => {
+    assert.equal(parseRate('10mbit'), 1.25e6);
+    assert.equal(parseRate('10Mbps'), 1.25e6);
+    assert.equal(parseRate('500kbit'), 62500);
+    assert.equal(parseRate('2MB'), 2e6);
+    assert.equal(parseRate('1.5mbyte'), 1.5e6);
+    assert.equal(parseRate('64KiB/s'), 65536);
+    assert.equal(parseRate('1000'), 1000);
+    assert.throws(() => parseRate('10 mbits'), /cannot read "10 mbits"; write e\.g\. 10mbit/);
+    assert.throws(() => parseRate('2mb'), /ambiguous/);
+    assert.throws(() => parseRate('fast'), /cannot read/);
+    assert.throws(() => parseRate('0'), /below/);
+  });
+
+  test('--throttle: 1 MiB at 2 MB/s takes at least 0.4 s; two responses share the rate', async () => {
+    const server = await listen({ mounts: [{ prefix: '/', dir: fx.data }], throttleBytesPerSec: 2e6 });
+    try {
+      const t = `/ds/chunks/${CHUNK}`;
+      const one = await get(url(server), t);
+      assert.ok(one.body.equals(fx.chunk));
+      assert.ok(one.totalMs >= 400, `1 MiB in ${one.totalMs.toFixed(0)} ms`);
+      // One link: two at once take as long as 2 MiB, not as long as 1 MiB.
+      const started = performance.now();
+      const both = await Promise.all([get(url(server), t), get(url(server), t)]);
+      const ms = performance.now() - started;
+      for (const r of both) assert.ok(r.body.equals(fx.chunk));
+      assert.ok(ms >= 900, `2 MiB in ${ms.toFixed(0)} ms`);
+    } finally {
+      await close(server);
+    }
+  });
+
+  test('--latency: the first byte waits', async () => {
+    const server = await listen({ mounts: [{ prefix: '/', dir: fx.data }], latencyMs: 200 });
+    try {
+      for (const t of ['/ds/manifest.json', '/ds/missing.json']) {
+        const r = await get(url(server), t);
+        assert.ok(r.headersMs >= 190, `${t}: first byte after ${r.headersMs.toFixed(0)} ms`);
+      }
+      const head = await get(url(server), '/ds/manifest.json', { method: 'HEAD' });
+      assert.ok(head.headersMs >= 190, 'an empty body waits too');
+    } finally {
+      await close(server);
+    }
+  });
+
+  test('npm run serve -- DATA: the viewer at /, the data at /data/, a URL per dataset', async () => {
+    const child = spawn(process.execPath, [path.join(root, 'server/serve.mjs'), '--port', '0', '--viewer', fx.www, fx.data],
+      { stdio: ['ignore', 'pipe', 'inherit'] });
+    try {
+      let out = '';
+      await new Promise((resolve, reject) => {
+        child.stdout.on('data', (d) => {
+          out += d;
+          if (out.includes('manifest.json')) resolve();
+        });
+        child.on('exit', () => reject(new Error(`serve exited: ${out}`)));
+      });
+      const viewerUrl = /(http:\/\/\S+\/index\.html\?data=(\S+))/.exec(out);
+      assert.ok(viewerUrl, out);
+      assert.equal(viewerUrl[2], '/data/ds/manifest.json');
+      const page = new URL(viewerUrl[1]);
+      assert.equal((await get(page.origin, '/index.html')).status, 200);
+      const manifest = await get(page.origin, viewerUrl[2]);
+      assert.equal(manifest.status, 200);
+      assert.equal(mime(manifest), 'application/json');
+    } finally {
+      child.kill();
+    }
+  });
+
+  test('the CLI refuses bad options with a clear message', () => {
+    const run = (...args) => spawnSync(process.execPath, [path.join(root, 'server/serve.mjs'), ...args], { encoding: 'utf8' });
+    const r = run('--throttle', '10 mbits');
+    assert.equal(r.status, 2);
+    assert.match(r.stderr, /^serve: --throttle: cannot read "10 mbits"; write e\.g\. 10mbit/);
+    assert.match(run('--latency', 'soon').stderr, /serve: --latency: cannot read "soon"/);
+    assert.match(run('--fault', '{"kind":"melt","match":"x"}').stderr, /serve: --fault: fault 1: "kind" must be one of/);
+    assert.match(run('--port', 'http').stderr, /serve: --port: cannot read "http"/);
+    assert.match(run('/no/such/folder').stderr, /serve: DIR: no such folder/);
+    assert.match(run('--frobnicate').stderr, /unknown option --frobnicate/);
+    const help = run('--help');
+    assert.equal(help.status, 0);
+    for (const o of ['--mount', '--throttle', '--latency', '--fault', '--max-connections', 'truncate', 'corrupt', 'drop', 'slow']) {
+      assert.ok(help.stdout.includes(o), `--help mentions ${o}`);
+    }
+  });
+});
+
+describe('fault injection', () => {
+  let fx;
+  let server;
+  let base;
+  const t = `/ds/chunks/${CHUNK}`;
+  before(async () => {
+    fx = makeFixture();
+    server = await listen({ mounts: [{ prefix: '/', dir: fx.data }] });
+    base = url(server);
+  });
+  after(() => close(server));
+
+  test('status: fails `times` times, then the file comes through', async () => {
+    server.setFaults([{ match: 'chunks/00000', kind: 'status', status: 503, times: 2 }]);
+    const statuses = [];
+    for (let i = 0; i < 3; i++) statuses.push((await get(base, t)).status);
+    assert.deepEqual(statuses, [503, 503, 200]);
+    assert.equal(server.faults[0].times, 0, 'times counted down');
+    assert.equal(server.faults[0].hits, 2);
+    assert.equal((await get(base, '/ds/manifest.json')).status, 200, 'other paths unaffected');
+    const log = server.requestLog.slice(-4);
+    assert.deepEqual(log.map((e) => e.status), [503, 503, 200, 200]);
+    assert.deepEqual(log.map((e) => e.fault), ['status', 'status', undefined, undefined]);
+  });
+
+  test('status 404 by RegExp, on every request when `times` is not given; HEAD unaffected', async () => {
+    server.setFaults([{ match: /chunks\/0000[01]-/, kind: 'status', status: 404 }]);
+    for (const c of [CHUNK, SMALL, CHUNK]) {
+      const r = await get(base, `/ds/chunks/${c}`);
+      assert.equal(r.status, 404);
+      assert.equal(r.headers['access-control-allow-origin'], '*', 'the viewer can read the status');
+    }
+    assert.equal((await get(base, t, { method: 'HEAD' })).status, 200);
+  });
+
+  test('truncate: half the body with a matching Content-Length', async () => {
+    server.setFaults([{ match: CHUNK, kind: 'truncate', times: 1 }]);
+    const r = await get(base, t);
+    assert.equal(r.status, 200);
+    assert.equal(r.error, null, 'a short but complete-looking response');
+    assert.equal(Number(r.headers['content-length']), fx.chunk.length / 2);
+    assert.ok(r.body.equals(fx.chunk.subarray(0, fx.chunk.length / 2)));
+    assert.ok((await get(base, t)).body.equals(fx.chunk), 'times: 1');
+  });
+
+  test('corrupt: same length, some bits flipped', async () => {
+    server.setFaults([{ match: CHUNK, kind: 'corrupt', times: 1 }]);
+    const r = await get(base, t);
+    assert.equal(r.status, 200);
+    assert.equal(r.body.length, fx.chunk.length);
+    assert.ok(!r.body.equals(fx.chunk));
+    let differing = 0;
+    for (let i = 0; i < r.body.length; i++) if (r.body[i] !== fx.chunk[i]) differing++;
+    assert.ok(differing >= 1 && differing < 1000, `${differing} bytes changed`);
+    // A small file is corrupted too (at least one bit).
+    server.setFaults([{ match: SMALL, kind: 'corrupt', times: 1 }]);
+    assert.ok(!(await get(base, `/ds/chunks/${SMALL}`)).body.equals(fx.small));
+  });
+
+  test('drop: the connection dies mid-body', async () => {
+    server.setFaults([{ match: CHUNK, kind: 'drop', times: 1 }]);
+    const r = await get(base, t);
+    assert.equal(r.status, 200);
+    assert.ok(r.error, 'the client sees an error');
+    assert.ok(r.body.length < fx.chunk.length, `${r.body.length} bytes arrived`);
+    assert.ok(r.body.equals(fx.chunk.subarray(0, r.body.length)));
+    server.setFaults([{ match: CHUNK, kind: 'drop', afterBytes: 1000, times: 1 }]);
+    const early = await get(base, t);
+    assert.ok(early.error);
+    assert.equal(early.body.length, 1000);
+    assert.ok(server.requestLog.at(-1).aborted, 'logged as aborted');
+    assert.ok((await get(base, t)).body.equals(fx.chunk), 'the next request is fine');
+  });
+
+  test('slow: the headers come, the body waits delayMs', async () => {
+    server.setFaults([{ match: CHUNK, kind: 'slow', delayMs: 400, times: 1 }]);
+    const r = await get(base, t);
+    assert.ok(r.body.equals(fx.chunk));
+    assert.ok(r.firstByteMs - r.headersMs >= 380, `body ${(r.firstByteMs - r.headersMs).toFixed(0)} ms after the headers`);
+  });
+
+  test('regexp given as a string (the --fault JSON form); drop after a delay', async () => {
+    server.setFaults([{ regexp: '/chunks/0000[1]-', kind: 'status', status: 500, times: 1 }]);
+    assert.equal((await get(base, `/ds/chunks/${SMALL}`)).status, 500);
+    assert.equal((await get(base, `/ds/chunks/${SMALL}`)).status, 200);
+    server.setFaults([{ match: SMALL, kind: 'drop', afterBytes: 10, delayMs: 300, times: 1 }]);
+    const r = await get(base, `/ds/chunks/${SMALL}`);
+    assert.ok(r.error && r.body.length === 10);
+    assert.ok(r.totalMs >= 290, `dropped after ${r.totalMs.toFixed(0)} ms`);
+  });
+
+  test('bad fault lists are refused', () => {
+    assert.throws(() => server.setFaults([{ match: 'x', kind: 'explode' }]), /"kind" must be one of/);
+    assert.throws(() => server.setFaults([{ kind: 'drop' }]), /"match" must be/);
+    assert.throws(() => server.setFaults([{ match: 'x', kind: 'status', status: 42 }]), /bad "status"/);
+    server.setFaults([]);
+  });
+});
+
+describe('nginx with server/nginx.conf', () => {
+  // Debian's nginx has no brotli module.
+  const ctx = { brotli: false, skipReason: 'nginx is not installed (apt-get install nginx): skipped' };
+  let nginx;
+  before(async () => {
+    ctx.fx = makeFixture();
+    await precompressDir(ctx.fx.www);
+    nginx = await startNginx({ mounts: [{ prefix: '/', dir: ctx.fx.www }, { prefix: '/data/', dir: ctx.fx.data }] });
+    ctx.base = nginx?.url;
+  });
+  after(() => nginx?.stop());
+
+  headerChecks('nginx', ctx);
+});
+
+describe('python3 -m http.server (no Range, no CORS)', () => {
+  test('serves a packed folder byte for byte', async (t) => {
+    const fx = makeFixture();
+    const py = await startPythonHttpServer({ dir: fx.data });
+    if (!py) return t.skip('python3 not installed');
+    try {
+      const m = await get(py.url, '/ds/manifest.json');
+      assert.equal(m.status, 200);
+      assert.equal(mime(m), 'application/json');
+      const c = await get(py.url, `/ds/chunks/${CHUNK}`, { headers: { Range: 'bytes=0-9' } });
+      assert.equal(c.status, 200, 'Range is ignored: the whole file');
+      assert.ok(c.body.equals(fx.chunk));
+      assert.equal(c.headers['access-control-allow-origin'], undefined, 'no CORS: same origin only');
+    } finally {
+      await py.stop();
+    }
+  });
+});
+
+function listen(options) {
+  const server = createServer(options);
+  return new Promise((resolve) => server.listen(0, '127.0.0.1', () => resolve(server)));
+}
+function url(server) {
+  return `http://127.0.0.1:${server.address().port}/`;
+}
+function close(server) {
+  return new Promise((resolve) => {
+    server.close(resolve);
+    server.closeAllConnections();
+  });
+}
