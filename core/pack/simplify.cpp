@@ -1,10 +1,17 @@
 // Half-edge-collapse simplification; see simplify.h for the cost and legality rules.
 //
-// State is flat per-vertex and per-tet arrays. The priority queue holds one entry per vertex
-// version: the cost of the vertex's cheapest outgoing half-edge. Every half-edge is evaluated
+// State is flat per-vertex and per-tet arrays. The priority queue holds at most one entry per
+// vertex: the last known cost of its cheapest outgoing half-edge. Every half-edge is evaluated
 // (both directions), but a vertex whose neighbourhood changed is only re-evaluated when its
-// entry reaches the top (lazy update): stale entries are recognised by a version stamp and
-// dropped, never searched for, so the queue is never rebuilt.
+// entry reaches the top (lazy update): every pop is evaluated afresh, so a changed vertex keeps
+// its entry, and only one that had none (no legal collapse last time) is queued again. Entries
+// of removed vertices are dropped when they reach the top; the queue is never rebuilt.
+//
+// Speculation on two threads: the next few entries of the queue are evaluated at once, then
+// processed in queue order on one thread. An evaluation is only used if nothing it read has
+// changed since (no collapse of the round touched the vertex or its neighbours) and nothing
+// queued meanwhile comes first; otherwise the entry goes back. The result is therefore exactly
+// that of the one-thread loop, whatever the timing (tests compare the two).
 #include "simplify.h"
 
 #include <algorithm>
@@ -13,6 +20,8 @@
 #include <cstdlib>
 #include <queue>
 #include <thread>
+
+#include "work_pool.h"
 
 #include "adjacency.h"
 #include "tet_quality.h"
@@ -64,7 +73,7 @@ using FieldQuadric = SymmetricQuadric<5>;
 
 struct Entry {
   float cost;
-  uint32_t vertex, version;
+  uint32_t vertex;
 };
 struct EntryAfter {  // min-heap by cost, ties by vertex id: deterministic
   bool operator()(const Entry& a, const Entry& b) const {
@@ -126,19 +135,43 @@ class Simplifier {
     const uint32_t planned = alive_ > target ? alive_ - target : 0;
     out_.stopReason = "target reached";
     tetsAlive_ = T_;
-    while (alive_ > target && tetsAlive_ > opt_.targetTets) {
-      if (heap_.empty()) { out_.stopReason = "no legal collapse left"; break; }
-      Entry e = heap_.top();
-      heap_.pop();
-      if (!out_.vertexAlive[e.vertex] || version_[e.vertex] != e.version) continue;
-      if (e.cost > opt_.maxError) { out_.stopReason = "error bound reached"; break; }
-      ++out_.queuePops;
-      tryCollapse(e.vertex);
-      if (opt_.progress && (out_.log.size() & 4095) == 0) opt_.progress(out_.log.size(), planned);
+    const bool parallel = opt_.threads > 1 && V_ >= opt_.parallelMinVertices;
+    const uint32_t roundSize = parallel ? kRoundSize : 1;
+    WorkPool pool(parallel ? 1 : 0);
+    auto evaluateTask = [this](uint32_t k) { evaluateVertex(lanes_[k], round_[k].vertex); };
+    auto goOn = [&] { return alive_ > target && tetsAlive_ > opt_.targetTets; };
+    while (goOn()) {
+      round_.clear();
+      Entry e;
+      while (round_.size() < roundSize && peekValid(e) && !(e.cost > opt_.maxError)) {
+        heap_.pop();
+        round_.push_back(e);
+      }
+      if (round_.empty()) {
+        out_.stopReason = heap_.empty() ? "no legal collapse left" : "error bound reached";
+        break;
+      }
+      pool.run(uint32_t(round_.size()), evaluateTask);
+      ++roundStamp_;
+      for (size_t k = 0; k < round_.size(); ++k) {
+        const Entry& r = round_[k];
+        Entry top;
+        const bool topValid = peekValid(top);
+        if (k > 0 && (!goOn() || (topValid && EntryAfter()(r, top)) || changedThisRound(lanes_[k], r.vertex))) {
+          for (size_t x = k; x < round_.size(); ++x) heap_.push(round_[x]);  // evaluated for nothing
+          break;
+        }
+        float next = topValid ? top.cost : float(kInf);
+        if (k + 1 < round_.size()) next = std::min(next, round_[k + 1].cost);
+        ++out_.queuePops;
+        queued_[r.vertex] = 0;
+        tryCollapse(r.vertex, lanes_[k], next);
+        if (opt_.progress && (out_.log.size() & 4095) == 0) opt_.progress(out_.log.size(), planned);
+      }
     }
     if (opt_.progress) opt_.progress(out_.log.size(), planned);
     out_.vertices = alive_;
-    out_.costEvaluations = main_.evaluations + helper_.evaluations;
+    for (const Lane& L : lanes_) out_.costEvaluations += L.evaluations;
     out_.tetCount = 0;
     for (uint32_t t = 0; t < T_; ++t) {
       out_.tetCount += out_.tetAlive[t];
@@ -227,21 +260,30 @@ class Simplifier {
       const double hyperplane[5] = {g[0], g[1], g[2], -1.0, c};
       for (int k = 0; k < 4; ++k) fieldQuadric_[v[k]].addSquare(hyperplane, w);
     }
-    version_.assign(V_, 0);
+    queued_.assign(V_, 0);
+    changed_.assign(V_, 0);
     lastCost_.assign(V_, float(kInf));
     // Every vertex's first cost, on two threads (each with its own scratch lane; the mesh is
     // only read), then queued in vertex order so the result does not depend on the threads.
     main_.seen.assign(V_, 0);
-    helper_.seen.assign(V_, 0);
+    lanes_.resize(kRoundSize);
+    for (Lane& L : lanes_) L.seen.assign(V_, 0);
     auto work = [this](Lane& L, uint32_t begin, uint32_t end) {
       for (uint32_t v = begin; v < end; ++v)
         if (out_.vertexAlive[v]) lastCost_[v] = bestCost(L, v);
     };
-    std::thread second(work, std::ref(helper_), V_ / 2, V_);
-    work(main_, 0, V_ / 2);
-    second.join();
+    if (opt_.threads > 1) {
+      std::thread second(work, std::ref(lanes_[1]), V_ / 2, V_);
+      work(lanes_[0], 0, V_ / 2);
+      second.join();
+    } else {
+      work(lanes_[0], 0, V_);
+    }
     for (uint32_t v = 0; v < V_; ++v)
-      if (lastCost_[v] < float(kInf)) heap_.push({lastCost_[v], v, version_[v]});
+      if (lastCost_[v] < float(kInf)) {
+        heap_.push({lastCost_[v], v});
+        queued_[v] = 1;
+      }
   }
 
   static constexpr uint8_t kFaces[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
@@ -544,19 +586,46 @@ class Simplifier {
     return best < 0 ? float(kInf) : float(L.candidates[size_t(best)].cost);
   }
 
-  // Pops are re-evaluated: the neighbourhood of the target may have changed since the push.
-  void tryCollapse(uint32_t i) {
-    Lane& L = main_;
-    neighbours(L, i, L.nbr);
-    prepareStar(L, i);
-    gatherCandidates(L, i);
+  // Pops are re-evaluated (the neighbourhood of the target may have changed since the push):
+  // the candidates of every out-edge of v in lane L, the cheapest one with its exact cost.
+  void evaluateVertex(Lane& L, uint32_t v) {
+    neighbours(L, v, L.nbr);
+    prepareStar(L, v);
+    gatherCandidates(L, v);
+    cheapestCandidate(L);  // finishes the winner here, on the lane's thread
+  }
+
+  // The top entry of the queue that is still current (stale ones are dropped on the way).
+  bool peekValid(Entry& e) {
+    while (!heap_.empty()) {
+      e = heap_.top();
+      if (out_.vertexAlive[e.vertex]) return true;
+      heap_.pop();
+    }
+    return false;
+  }
+
+  // Whether a collapse of this round changed anything evaluateVertex(L, v) read: v's star and,
+  // for the targets, their quadrics, κ sums and star sizes; all of these change only for the
+  // vertices a collapse touches.
+  bool changedThisRound(const Lane& L, uint32_t v) const {
+    if (changed_[v] == roundStamp_) return true;
+    for (uint32_t w : L.nbr)
+      if (changed_[w] == roundStamp_) return true;
+    return false;
+  }
+
+  // Collapses i along its cheapest legal out-edge (evaluated in L) unless that costs more than
+  // `next`, the key of the next entry: then i goes back into the queue under its new cost.
+  void tryCollapse(uint32_t i, Lane& L, float next) {
     bool first = true;
     for (int c; (c = cheapestCandidate(L)) >= 0;) {
       const Candidate cand = L.candidates[size_t(c)];
       if (first) lastCost_[i] = float(cand.cost);
       first = false;
-      if (!heap_.empty() && float(cand.cost) > heap_.top().cost) {
-        heap_.push({float(cand.cost), i, version_[i]});  // something else is cheaper now
+      if (float(cand.cost) > next) {
+        heap_.push({float(cand.cost), i});  // something else is cheaper now
+        queued_[i] = 1;
         ++out_.requeued;
         return;
       }
@@ -863,9 +932,9 @@ class Simplifier {
     quadric_[j].add(quadric_[i]);
     fieldQuadric_[j].add(fieldQuadric_[i]);
 
-    // Everything around j changed. Requeue j and its neighbours lazily: under their last known
-    // cost (the neighbourhood of a blocked vertex changed, so it gets another chance), to be
-    // re-evaluated only when they reach the top.
+    // Everything around j changed. j and its neighbours are re-evaluated lazily, when they reach
+    // the top: those already queued keep their entry; a blocked one (no legal collapse last
+    // time) is queued again under its last known cost, as its neighbourhood changed.
     Lane& L = main_;
     touched_.clear();
     ++L.stamp;
@@ -878,10 +947,13 @@ class Simplifier {
           touched_.push_back(w);
         }
       }
+    changed_[i] = roundStamp_;
     for (uint32_t v : touched_) {
-      ++version_[v];
+      changed_[v] = roundStamp_;
+      if (queued_[v]) continue;  // its entry stays: it is evaluated afresh when popped
       float key = std::isfinite(lastCost_[v]) ? lastCost_[v] : 0.0f;
-      heap_.push({key, v, version_[v]});
+      heap_.push({key, v});
+      queued_[v] = 1;
     }
   }
 
@@ -900,8 +972,13 @@ class Simplifier {
   std::vector<float> kappa_, lastCost_;
   std::vector<FieldQuadric> fieldQuadric_;
   std::vector<double> kappaSum_;  // per vertex: Σ κ over its star
-  std::vector<uint32_t> version_;
-  Lane main_, helper_;  // scratch of the queue loop, and of the second thread in init()
+  std::vector<uint8_t> queued_;  // per vertex: has an entry in the queue (or in the current round)
+  Lane main_;                // scratch of the one-thread parts (link condition, collapse)
+  std::vector<Lane> lanes_;  // one per entry of a round (and the two threads of init())
+  static constexpr uint32_t kRoundSize = 4;
+  std::vector<Entry> round_;
+  std::vector<uint32_t> changed_;  // per vertex: roundStamp_ of the last round that touched it
+  uint32_t roundStamp_ = 0;
   std::priority_queue<Entry, std::vector<Entry>, EntryAfter> heap_;
   // scratch, reused
   std::vector<uint32_t> touched_, around_, lvI_, lvJ_, lvE_;

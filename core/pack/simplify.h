@@ -48,6 +48,10 @@ struct SimplifyOptions {
   double minQuality = 0.02;     // 3/κ of every tet a collapse changes must stay at or above this
   std::function<void(uint32_t done, uint32_t planned)> progress;  // called now and then
   bool verifyLinkCondition = false;  // tests: also run the slow reference link check, count mismatches
+  // Threads for cost evaluation (1 or 2; the result is the same either way), used for meshes of
+  // at least parallelMinVertices vertices (below that, starting rounds costs more than it saves).
+  int threads = 2;
+  uint32_t parallelMinVertices = 20000;
 };
 
 // One collapse as it happened, in original vertex and tet ids.

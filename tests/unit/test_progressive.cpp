@@ -224,6 +224,26 @@ TEST(Progressive, PackingIsDeterministic) {
     EXPECT_EQ(test::loadFile(e.path().string()), test::loadFile(b + "/chunks/" + e.path().filename().string()));
 }
 
+// The two-thread loop evaluates queue entries speculatively and must give exactly the collapses
+// of the one-thread loop (every round size and interleaving, down to the last vertex).
+TEST(Progressive, TwoThreadsCollapseExactlyAsOne) {
+  TetMesh m = harmonic(14);
+  SimplifyResult one, two;
+  SimplifyOptions o;
+  o.targetVertices = 40;
+  o.threads = 1;
+  ASSERT_TRUE(simplifyMesh(m, o, one));
+  o.threads = 2;
+  o.parallelMinVertices = 0;
+  ASSERT_TRUE(simplifyMesh(m, o, two));
+  ASSERT_GT(one.log.size(), 2500u);
+  EXPECT_EQ(one.log.i, two.log.i);
+  EXPECT_EQ(one.log.j, two.log.j);
+  EXPECT_EQ(one.log.fieldError, two.log.fieldError);
+  EXPECT_EQ(one.tets, two.tets);
+  EXPECT_EQ(one.queuePops, two.queuePops);
+}
+
 // Planar boundary faces and creases carry zero quadric error, so with the default weights the
 // cube keeps its exact shape and volume at a 5% base; the L-shape keeps its volume (8 - 1).
 TEST(Progressive, BoundaryIsPreserved) {
