@@ -43,6 +43,10 @@ Result openChunk(ChunkDecoder& dec, const ChunkInfo& info, uint32_t index, std::
     return fail(Status::SizeMismatch, name + ": zstd frame declares " +
                                           (declared == ZSTD_CONTENTSIZE_UNKNOWN ? std::string("no size") : std::to_string(declared)) +
                                           ", manifest says " + std::to_string(info.rawBytes) + " bytes");
+  // The manifest parser enforces this too; checked again here because it guards an allocation.
+  if (info.rawBytes > maxRawBytesFor(info.bytes))
+    return fail(Status::TooLarge, name + ": declares " + std::to_string(info.rawBytes) + " bytes after decompression, more than " +
+                                      std::to_string(maxRawBytesFor(info.bytes)) + " allowed for its size");
   if (!dec.dctx) dec.dctx = ZSTD_createDCtx();
   if (!dec.dctx) return fail(Status::TooLarge, name + ": out of memory for the zstd context");
   dec.raw.resize(info.rawBytes);

@@ -16,7 +16,7 @@ constexpr int kMaxDepth = 32;
 constexpr size_t kMaxChunks = 65536;
 constexpr size_t kMaxFields = 64;
 constexpr uint64_t kMaxChunkBytes = 256ull << 20;
-constexpr uint64_t kMaxRawBytes = 1ull << 30;
+constexpr uint64_t kMaxRawBytes = kMaxChunkRawBytes;
 constexpr uint64_t kMaxCount = (1ull << 31) - 1;
 
 // nlohmann's DOM destructor and our walk would recurse on absurd nesting; refuse it up front.
@@ -222,6 +222,10 @@ Result parseManifest(std::string_view text, Manifest& m) {
     ci.tets = uint32_t(t);
     ci.splits = uint32_t(s);
     if (i == 0 && s != 0) return bad("'chunks[0].splits' must be 0");
+    // A chunk may not claim to inflate far beyond what zstd does on real mesh data (2-5x), so
+    // a hostile 100-byte file cannot make the reader set aside a gigabyte before decoding.
+    if (ci.rawBytes > maxRawBytesFor(ci.bytes))
+      return bad("'" + path + "rawBytes' claims more than 64 times 'bytes' (+1 MiB)");
     if (i > 0) {
       const ChunkInfo& prev = m.chunks.back();
       if (uint64_t(prev.vertices) + s != v) return bad("'" + path + "vertices' must equal the previous count plus 'splits'");

@@ -14,6 +14,15 @@ namespace tetstream {
 inline constexpr uint32_t kFormatVersion = 1;
 inline constexpr const char* kLibraryVersion = "0.2.0";
 
+// The most a chunk of `bytes` compressed bytes may declare after decompression: zstd on mesh
+// data gives 2-5x, so 64x (+1 MiB for tiny chunks), and never more than 1 GiB. Guards the
+// decompression buffer against a hostile manifest or frame.
+inline constexpr uint64_t kMaxChunkRawBytes = 1ull << 30;
+inline constexpr uint64_t maxRawBytesFor(uint64_t bytes) {
+  const uint64_t byRatio = 64 * bytes + (1u << 20);
+  return byRatio < kMaxChunkRawBytes ? byRatio : kMaxChunkRawBytes;
+}
+
 enum class ChunkKind : uint8_t { Base = 1, Splits = 2 };
 
 struct FieldInfo {

@@ -64,7 +64,7 @@ Runner addPack(CLI::App& app) {
   struct Opts {
     std::string input, out, field, name;
     std::vector<double> weights;
-    double baseFraction = 0.01, maxError = -1;
+    double baseFraction = 0.01, maxError = -1, maxMemoryGb = 0;
     uint32_t baseVertices = 0, baseTets = 0, chunkKb = 256;
     int level = 19;
     bool lossless = false, json = false;
@@ -90,6 +90,8 @@ Runner addPack(CLI::App& app) {
   sub->add_option("--chunk-kb", o->chunkKb, "largest split chunk in KB; the first chunks are smaller")
       ->check(CLI::Range(1u, 65536u))->capture_default_str();
   sub->add_option("--zstd-level", o->level, "zstd compression level")->check(CLI::Range(1, 22))->capture_default_str();
+  sub->add_option("--max-memory", o->maxMemoryGb, "refuse meshes that need more memory than this, in GB (default: 90% of RAM)")
+      ->check(CLI::PositiveNumber);
   sub->add_flag("--json", o->json, "print the result as JSON on stdout");
   return [o, me, bv, bt] {
     Stopwatch total;
@@ -119,6 +121,7 @@ Runner addPack(CLI::App& app) {
     }
     opt.lossless = o->lossless;
     opt.chunkKb = o->chunkKb;
+    opt.maxMemoryBytes = o->maxMemoryGb * 1e9;
     opt.progress = [&bar](const char* phase, uint64_t done, uint64_t planned) { bar.update(phase, done, planned); };
     PackSummary s;
     Result r = packMesh(std::move(in.mesh), o->out, opt, s);

@@ -26,6 +26,7 @@ struct PackOptions {
   double maxError = std::numeric_limits<double>::infinity();  // stop simplifying at this cost
   bool lossless = false;                  // keep float32 values in split records
   uint32_t chunkKb = 256;                 // largest split chunk, compressed
+  double maxMemoryBytes = 0;              // refuse meshes that need more (0: 90% of physical memory)
   // Progress for displays: phase ("validate", "simplify", "encode", "write"), items done and
   // planned in that phase (collapses, splits; 0 planned when not countable).
   std::function<void(const char* phase, uint64_t done, uint64_t planned)> progress;

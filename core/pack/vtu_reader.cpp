@@ -48,6 +48,7 @@ class ByteSource {
 
   // Copies the next n bytes to dst. On failure returns false with error() set.
   bool read(uint8_t* dst, size_t n) {
+    if (n == 0) return true;  // dst may be null for an empty array (memcpy must not see it)
     if (!b64_) {
       if (data_.size() - pos_ < n) {
         error_ = "data ends " + std::to_string(n - (data_.size() - pos_)) + " bytes early";

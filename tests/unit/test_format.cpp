@@ -102,6 +102,12 @@ TEST(Format, PackRefusesUnusableMeshes) {
   TetMesh bad = harmonic(3);
   bad.tets[5] = 1000;
   EXPECT_EQ(packMesh(bad, tempDir("badidx"), {}, s).status, Status::OutOfRange);
+  // Too big for the memory allowed: refused before any work, with the figures.
+  PackOptions small;
+  small.maxMemoryBytes = 1000;
+  r = packMesh(harmonic(3), tempDir("toobig"), small, s);
+  EXPECT_EQ(r.status, Status::TooLarge);
+  EXPECT_NE(r.message.find("--max-memory"), std::string::npos) << r.message;
 }
 
 TEST(Format, ManifestRoundTrip) {
@@ -159,6 +165,13 @@ TEST(Format, HostileManifestsAreRefused) {
     EXPECT_FALSE(r.ok()) << "accepted: " << c.substr(0, 200);
     EXPECT_FALSE(r.message.empty());
   }
+  // A small chunk that claims to inflate to a gigabyte: refused before any buffer is sized.
+  Manifest inflated = s.manifest;
+  inflated.chunks[0].rawBytes = 1000000000;
+  Manifest m;
+  Result r = parseManifest(writeManifest(inflated), m);
+  EXPECT_FALSE(r.ok());
+  EXPECT_NE(r.message.find("rawBytes"), std::string::npos) << r.message;
 }
 
 TEST(Format, CorruptTruncatedAndWrongChunksAreNeverApplied) {

@@ -1,0 +1,257 @@
+#include "harness.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <memory>
+#include <string_view>
+#include <unistd.h>
+
+#include <zstd.h>
+
+#include "chunk.h"
+#include "dataset.h"
+#include "hash.h"
+#include "manifest.h"
+#include "pack/chunk_encode.h"
+#include "pack/generators.h"
+#include "pack/mesh_io.h"
+#include "pack/packer.h"
+#include "validate.h"
+
+namespace tetstream::fuzz {
+namespace {
+
+// A small real dataset, packed once per process: a base and several split chunks.
+struct Context {
+  std::string manifestJson;
+  std::vector<std::vector<uint8_t>> files;  // chunk files in manifest order
+};
+
+std::vector<uint8_t> readAll(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+const Context& context() {
+  static const Context ctx = [] {
+    TetMesh mesh = makeGridMesh(6);
+    addHarmonicField(mesh);
+    mesh.name = "fuzz";
+    PackOptions o;
+    o.zstdLevel = 1;
+    o.baseVertices = 24;
+    o.minBaseVertices = 8;
+    o.chunkKb = 1;
+    const auto dir = std::filesystem::temp_directory_path() / ("tetstream-fuzz-" + std::to_string(getpid()));
+    PackSummary summary;
+    if (!packMesh(mesh, dir.string(), o, summary)) fuzzCheckFailed("packing the fuzz dataset", __FILE__, __LINE__);
+    Context c;
+    std::vector<uint8_t> json = readAll(dir / "manifest.json");
+    c.manifestJson.assign(json.begin(), json.end());
+    for (const ChunkInfo& info : summary.manifest.chunks) c.files.push_back(readAll(dir / info.file));
+    std::filesystem::remove_all(dir);
+    if (c.files.size() < 3) fuzzCheckFailed("the fuzz dataset needs two split chunks", __FILE__, __LINE__);
+    return c;
+  }();
+  return ctx;
+}
+
+// Copies every member but the (uncopyable, stateless between chunks) zstd context.
+void copyState(Dataset& to, const Dataset& from) {
+  to.manifest = from.manifest;
+  to.quant = from.quant;
+  to.pm = from.pm;
+  to.chunksReceived = from.chunksReceived;
+  to.bytesReceived = from.bytesReceived;
+  to.payloads = from.payloads;
+  to.chunkFirstSplit = from.chunkFirstSplit;
+  to.recordStart = from.recordStart;
+  to.splitsDecoded = from.splitsDecoded;
+  to.reader = from.reader;
+}
+
+// ds with the real chunks before `index` received and applied. Prepared once per index and
+// copied for each input: replaying the real chunks every time made the fuzzer ten times slower.
+void openAt(Dataset& ds, uint32_t index) {
+  static std::vector<std::unique_ptr<Dataset>> prepared;
+  const Context& ctx = context();
+  if (prepared.size() <= index) prepared.resize(index + 1);
+  if (!prepared[index]) {
+    auto p = std::make_unique<Dataset>();
+    FUZZ_CHECK(openDataset(*p, ctx.manifestJson));
+    std::vector<uint32_t> changed;
+    for (uint32_t c = 0; c < index; ++c) {
+      FUZZ_CHECK(receiveChunk(*p, c, ctx.files[c]));
+      bool reached = false;
+      FUZZ_CHECK(stepTowards(*p, p->splitsReceived(), ~0u, changed, &reached) && reached);
+    }
+    prepared[index] = std::move(p);
+  }
+  copyState(ds, *prepared[index]);
+}
+
+// The chunk file for a payload, with the manifest entry made to match it.
+std::vector<uint8_t> chunkFromPayload(ChunkKind kind, uint32_t index, const uint8_t* data, size_t size,
+                                      ChunkInfo& info) {
+  static ZSTD_CCtx* cctx = ZSTD_createCCtx();  // one context for every input: much faster
+  std::vector<uint8_t> raw;
+  beginChunk(raw, kind, index);
+  raw.insert(raw.end(), data, data + size);
+  std::vector<uint8_t> file(ZSTD_compressBound(raw.size()));
+  const size_t n = ZSTD_compressCCtx(cctx, file.data(), file.size(), raw.data(), raw.size(), 1);
+  FUZZ_CHECK(!ZSTD_isError(n));
+  file.resize(n);
+  info.bytes = n;
+  info.rawBytes = raw.size();
+  info.hash = contentHash(file);
+  return file;
+}
+
+// The manifest entry made to match a chunk file given as it is.
+void matchFile(std::span<const uint8_t> file, ChunkInfo& info) {
+  info.bytes = file.size();
+  info.hash = contentHash(file);
+  unsigned long long declared = ZSTD_getFrameContentSize(file.data(), file.size());
+  if (declared != ZSTD_CONTENTSIZE_ERROR && declared != ZSTD_CONTENTSIZE_UNKNOWN) info.rawBytes = declared;
+}
+
+void checkStructure(const TetMesh& m) {
+  const ValidationReport v = validateMesh(m);
+  FUZZ_CHECK(!v.fatal());
+  FUZZ_CHECK(m.positions.size() == 3 * size_t(m.vertexCount()));
+  for (const ScalarField& f : m.fields) FUZZ_CHECK(f.values.size() == m.vertexCount());
+}
+
+std::span<const uint8_t> payloadOf(ChunkDecoder& dec, const ChunkInfo& info, uint32_t index,
+                                   const std::vector<uint8_t>& file) {
+  std::span<const uint8_t> payload;
+  FUZZ_CHECK(openChunk(dec, info, index, file, payload));
+  return payload;
+}
+
+}  // namespace
+
+void fuzzCheckFailed(const char* what, const char* file, int line) {
+  std::fprintf(stderr, "fuzz check failed: %s (%s:%d)\n", what, file, line);
+  std::abort();
+}
+
+void manifest(const uint8_t* data, size_t size) {
+  Manifest m;
+  if (!parseManifest(std::string_view(reinterpret_cast<const char*>(data), size), m)) return;
+  const std::string once = writeManifest(m);
+  Manifest again;
+  FUZZ_CHECK(parseManifest(once, again));
+  FUZZ_CHECK(writeManifest(again) == once);
+}
+
+void splitChunk(const uint8_t* data, size_t size) {
+  if (size < 1) return;
+  const Context& ctx = context();
+  const uint32_t splitChunks = uint32_t(ctx.files.size() - 1);
+  const uint32_t index = 1 + (data[0] >> 1) % splitChunks;
+  Dataset ds;
+  openAt(ds, index);
+  const uint32_t splitsBefore = ds.splitsApplied(), tetsBefore = ds.pm.mesh.tetCount();
+  const uint32_t verticesBefore = ds.pm.mesh.vertexCount();
+  const std::vector<uint32_t> tetsCopy = ds.pm.mesh.tets;
+
+  std::vector<uint8_t> file;
+  ChunkInfo& info = ds.manifest.chunks[index];
+  if (data[0] & 1) {
+    file.assign(data + 1, data + size);
+    matchFile(file, info);
+  } else {
+    file = chunkFromPayload(ChunkKind::Splits, index, data + 1, size - 1, info);
+  }
+  std::vector<uint32_t> changed;
+  bool reached = false;
+  if (!receiveChunk(ds, index, file)) {
+    FUZZ_CHECK(ds.chunksReceived == index && ds.splitsApplied() == splitsBefore);
+    return;
+  }
+  if (!stepTowards(ds, ds.splitsReceived(), ~0u, changed, &reached)) {
+    // A bad record undoes its whole chunk: back to exactly the level before it.
+    FUZZ_CHECK(ds.chunksReceived == index && ds.splitsApplied() == splitsBefore);
+    FUZZ_CHECK(ds.pm.mesh.tetCount() == tetsBefore && ds.pm.mesh.vertexCount() == verticesBefore);
+    FUZZ_CHECK(ds.pm.mesh.tets == tetsCopy);
+    return;
+  }
+  FUZZ_CHECK(reached);
+  checkStructure(ds.pm.mesh);
+  // Whatever the chunk did, the level slider can take it back exactly.
+  FUZZ_CHECK(stepTowards(ds, splitsBefore, ~0u, changed, &reached) && reached);
+  FUZZ_CHECK(ds.pm.mesh.tetCount() == tetsBefore && ds.pm.mesh.vertexCount() == verticesBefore);
+}
+
+void baseChunk(const uint8_t* data, size_t size) {
+  const Context& ctx = context();
+  Dataset ds;
+  FUZZ_CHECK(openDataset(ds, ctx.manifestJson));
+  std::vector<uint8_t> file = chunkFromPayload(ChunkKind::Base, 0, data, size, ds.manifest.chunks[0]);
+  if (!receiveChunk(ds, 0, file)) {
+    FUZZ_CHECK(ds.chunksReceived == 0);
+    return;
+  }
+  checkStructure(ds.pm.mesh);
+  // The real first split chunk on top of whatever base this was: it may fail, never crash.
+  if (!receiveChunk(ds, 1, ctx.files[1])) return;
+  std::vector<uint32_t> changed;
+  bool reached = false;
+  if (stepTowards(ds, ds.splitsReceived(), ~0u, changed, &reached)) checkStructure(ds.pm.mesh);
+  else FUZZ_CHECK(ds.splitsApplied() == 0);
+}
+
+void meshFile(const char* extension, const uint8_t* data, size_t size) {
+  TetMesh m;
+  ReadReport report;
+  const std::string_view bytes(reinterpret_cast<const char*>(data), size);
+  if (!readMeshBytes(bytes, std::string("fuzz") + extension, m, report)) return;
+  // What a reader promises (mesh_io.h); flaws such as a tet with a repeated vertex are the
+  // packer's to report, so they may pass here.
+  FUZZ_CHECK(m.tetCount() > 0);
+  for (uint32_t v : m.tets) FUZZ_CHECK(v < m.vertexCount());
+  for (float x : m.positions) FUZZ_CHECK(std::isfinite(x));
+  FUZZ_CHECK(m.positions.size() == 3 * size_t(m.vertexCount()));
+  for (const ScalarField& f : m.fields) FUZZ_CHECK(f.values.size() == m.vertexCount());
+}
+
+bool runTarget(const std::string& name, const uint8_t* data, size_t size) {
+  if (name == "manifest") manifest(data, size);
+  else if (name == "split-chunk") splitChunk(data, size);
+  else if (name == "base-chunk") baseChunk(data, size);
+  else if (name.starts_with("mesh-") && name.size() > 5) meshFile(("." + name.substr(5)).c_str(), data, size);
+  else return false;
+  return true;
+}
+
+std::vector<std::pair<std::string, std::vector<uint8_t>>> seeds(const std::string& target) {
+  const Context& ctx = context();
+  std::vector<std::pair<std::string, std::vector<uint8_t>>> out;
+  Manifest m;
+  FUZZ_CHECK(parseManifest(ctx.manifestJson, m));
+  ChunkDecoder dec;
+  if (target == "manifest") {
+    out.push_back({"packed", std::vector<uint8_t>(ctx.manifestJson.begin(), ctx.manifestJson.end())});
+  } else if (target == "base-chunk") {
+    std::span<const uint8_t> p = payloadOf(dec, m.chunks[0], 0, ctx.files[0]);
+    out.push_back({"base", std::vector<uint8_t>(p.begin(), p.end())});
+  } else if (target == "split-chunk") {
+    for (uint32_t c = 1; c < ctx.files.size(); ++c) {
+      std::span<const uint8_t> p = payloadOf(dec, m.chunks[c], c, ctx.files[c]);
+      std::vector<uint8_t> payload{uint8_t((c - 1) << 1)};
+      payload.insert(payload.end(), p.begin(), p.end());
+      out.push_back({"payload-" + std::to_string(c), payload});
+      std::vector<uint8_t> file{uint8_t((c - 1) << 1 | 1)};
+      file.insert(file.end(), ctx.files[c].begin(), ctx.files[c].end());
+      out.push_back({"file-" + std::to_string(c), file});
+    }
+  }
+  return out;
+}
+
+}  // namespace tetstream::fuzz

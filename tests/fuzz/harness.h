@@ -1,0 +1,48 @@
+// What the fuzz targets run, one function per parser of untrusted bytes. The same functions are
+// called by libFuzzer (tests/fuzz/fuzz_*.cpp, clang -fsanitize=fuzzer) and by an ordinary unit
+// test that replays the committed corpus (tests/unit/test_fuzz_corpus.cpp, plain g++), so every
+// input the fuzzers found interesting, and every past finding, is checked on each `npm test`.
+//
+// Each function returns normally for any input; a broken invariant calls fuzzCheckFailed(),
+// which aborts (the fuzzer records a crash, the replay test dies with the message).
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace tetstream::fuzz {
+
+// manifest.json: parse; what parses must write and parse back to the same manifest.
+void manifest(const uint8_t* data, size_t size);
+
+// A split chunk against a real small dataset. data[0] picks the chunk that is replaced and
+// how: bit 0 clear, the rest of the input is the chunk's decompressed payload (compressed and
+// hashed here, so the fuzzer reaches the record decoder); set, it is the chunk file itself
+// (zstd frame and header). Either way the manifest's size and hash are made to match, so only
+// the decoder stands between the bytes and the mesh. A chunk that fails must leave the dataset
+// exactly at the level before it; one that succeeds must leave a structurally valid mesh.
+void splitChunk(const uint8_t* data, size_t size);
+
+// The base-mesh chunk's payload (decompressed), with matching manifest counts where possible.
+void baseChunk(const uint8_t* data, size_t size);
+
+// A mesh file of the given extension (".vtu", ".vtk", ...) through readMeshBytes; what reads
+// must be a mesh whose tets reference existing vertices and whose fields have one value each.
+void meshFile(const char* extension, const uint8_t* data, size_t size);
+
+// Runs the target of that name ("manifest", "split-chunk", "base-chunk", "mesh-vtu" for
+// meshFile(".vtu"), ...). False for an unknown name.
+bool runTarget(const std::string& name, const uint8_t* data, size_t size);
+
+// Real inputs to start fuzzing from (for tests/fuzz/run.sh): name -> bytes, per target.
+std::vector<std::pair<std::string, std::vector<uint8_t>>> seeds(const std::string& target);
+
+[[noreturn]] void fuzzCheckFailed(const char* what, const char* file, int line);
+
+}  // namespace tetstream::fuzz
+
+#define FUZZ_CHECK(x) \
+  do {                \
+    if (!(x)) ::tetstream::fuzz::fuzzCheckFailed(#x, __FILE__, __LINE__); \
+  } while (0)

@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (clang, ASan + UBSan) and fuzzes each for SECONDS (default 300),
+# starting from real inputs, then merges what raised coverage into tests/fuzz/corpus/TARGET
+# (committed; tests/unit/test_fuzz_corpus.cpp replays it on every npm test).
+#   bash tests/fuzz/run.sh [SECONDS] [TARGET ...]
+# Findings are written to build/fuzz/findings/TARGET/; fix them, then copy each input into the
+# target's corpus folder as a regression input (name it regress-WHAT).
+# Needs clang and libFuzzer: apt-get install clang libclang-rt-14-dev (installed here if missing).
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+SECONDS_EACH=${1:-300}
+shift || true
+if ! command -v clang++ >/dev/null || ! ls /usr/lib/llvm-*/lib/clang/*/lib/linux/libclang_rt.fuzzer-x86_64.a >/dev/null 2>&1; then
+  as_root() { if [ "$(id -u)" = 0 ]; then "$@"; else sudo "$@"; fi; }
+  as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends clang libclang-rt-14-dev >/dev/null
+fi
+cmake --preset fuzz >/dev/null
+cmake --build build/fuzz -j2 >/dev/null
+TARGETS=("$@")
+[ ${#TARGETS[@]} -gt 0 ] || TARGETS=(manifest split-chunk base-chunk mesh-vtu mesh-vtk)
+
+for t in "${TARGETS[@]}"; do
+  work=build/fuzz/work/$t seeds=build/fuzz/seeds/$t found=build/fuzz/findings/$t corpus=tests/fuzz/corpus/$t
+  mkdir -p "$work" "$seeds" "$found" "$corpus"
+  case $t in
+    mesh-*) cp tests/fixtures/*."${t#mesh-}" "$seeds"/ 2>/dev/null || true ;;
+    *) build/fuzz/write_seeds "$t" "$seeds" ;;
+  esac
+  echo "fuzz: $t for ${SECONDS_EACH}s"
+  # -rss_limit_mb: a parser that allocates more than this on a small input is a finding.
+  build/fuzz/fuzz-"$t" "$work" "$corpus" "$seeds" -max_total_time="$SECONDS_EACH" -rss_limit_mb=1024 \
+    -max_len="${MAX_LEN:-8192}" -timeout=10 -artifact_prefix="$found/" -print_final_stats=1 2>build/fuzz/$t.log || true
+  grep -E "stat::number_of_executed_units|stat::peak_rss_mb" build/fuzz/$t.log | sed "s/^/  /"
+  ls "$found" | sed "s/^/  finding: /"
+  # Keep a minimal set that covers what the whole work folder covers.
+  mkdir -p "$corpus.new"
+  build/fuzz/fuzz-"$t" -merge=1 "$corpus.new" "$corpus" "$work" "$seeds" 2>/dev/null >/dev/null
+  rm -rf "$corpus" && mv "$corpus.new" "$corpus"
+  # The corpus is committed: keep the smallest inputs up to CORPUS_KB (regression inputs always).
+  budget=$(( ${CORPUS_KB:-400} * 1024 )) used=0
+  while read -r f; do
+    size=$(stat -c %s "$f")
+    if [ $((used + size)) -gt $budget ] && [[ $(basename "$f") != regress-* ]]; then rm "$f"; else used=$((used + size)); fi
+  done < <(ls -1Sr "$corpus"/* 2>/dev/null)
+  echo "  corpus: $(ls "$corpus" | wc -l) inputs, $(( $(cat "$corpus"/* | wc -c) / 1024 )) KB"
+done
