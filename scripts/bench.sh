@@ -4,7 +4,10 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh
-if ! /usr/bin/python3 -c "import vtk" 2>/dev/null; then
-  if [ "$(id -u)" = 0 ]; then DEBIAN_FRONTEND=noninteractive apt-get install -y -qq python3-vtk9 >/dev/null || true; fi
-fi
-python3 tests/bench/run_bench.py "$@"
+# VTK for the comparison columns, matplotlib for the plots (Debian packages, for /usr/bin/python3).
+for mod_pkg in vtk:python3-vtk9 matplotlib:python3-matplotlib; do
+  if ! /usr/bin/python3 -c "import ${mod_pkg%%:*}" 2>/dev/null && [ "$(id -u)" = 0 ]; then
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${mod_pkg#*:}" >/dev/null || true
+  fi
+done
+/usr/bin/python3 tests/bench/run_bench.py "$@"

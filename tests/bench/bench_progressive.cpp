@@ -4,6 +4,9 @@
 //       and boundary preservation (volume ratio, bounding box)
 //   tetstream_bench raw MESH.vtu OUT.bin
 //       the mesh as raw arrays, for the `zstd -19` baseline
+//   tetstream_bench isodist ORIGINAL.vtu APPROX.vtu --field F --value V
+//       distance between the isosurfaces of the two meshes (area-weighted mean and max over
+//       triangle centroids and vertices, both directions, relative to ORIGINAL's diagonal)
 // (Streaming rates are measured by tests/node/core_check.cpp --stream, natively and in wasm.)
 #include <algorithm>
 #include <chrono>
@@ -14,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "isosurface.h"
 #include "pack/mesh_io.h"
 
 using namespace tetstream;
@@ -130,6 +134,149 @@ int cmdError(int argc, char** argv) {
   return 0;
 }
 
+// Nearest-triangle queries over an isosurface: triangles bucketed in a uniform grid, searched
+// ring by ring until the ring is farther than the best distance found.
+struct TriangleGrid {
+  const IsoSurface& s;
+  Bounds b;
+  int n = 1;
+  float cell = 1;
+  std::vector<uint32_t> start, items;
+
+  explicit TriangleGrid(const IsoSurface& surface) : s(surface), b(computeBounds(surface.positions)) {
+    const uint32_t t = s.triangleCount();
+    float ext = std::max({b.max[0] - b.min[0], b.max[1] - b.min[1], b.max[2] - b.min[2], 1e-12f});
+    n = std::clamp(int(std::cbrt(double(t) / 2)), 1, 256);
+    cell = ext / float(n);
+    std::vector<uint32_t> count(size_t(n) * n * n + 1, 0);
+    forEach([&](uint32_t, size_t c) { ++count[c + 1]; });
+    for (size_t c = 1; c < count.size(); ++c) count[c] += count[c - 1];
+    start = count;
+    items.resize(count.back());
+    forEach([&](uint32_t tri, size_t c) { items[count[c]++] = tri; });
+  }
+  int cellOf(float x, int k) const { return std::clamp(int((x - b.min[k]) / cell), 0, n - 1); }
+  template <typename F>
+  void forEach(F f) const {
+    for (uint32_t t = 0; t < s.triangleCount(); ++t) {
+      int lo[3] = {n, n, n}, hi[3] = {0, 0, 0};
+      for (int v = 0; v < 3; ++v)
+        for (int k = 0; k < 3; ++k) {
+          int c = cellOf(s.positions[3 * size_t(s.indices[3 * size_t(t) + v]) + k], k);
+          lo[k] = std::min(lo[k], c);
+          hi[k] = std::max(hi[k], c);
+        }
+      for (int z = lo[2]; z <= hi[2]; ++z)
+        for (int y = lo[1]; y <= hi[1]; ++y)
+          for (int x = lo[0]; x <= hi[0]; ++x) f(t, size_t(x) + size_t(n) * (y + size_t(n) * z));
+    }
+  }
+  // Squared distance from p to triangle t (closest point on a triangle, Ericson §5.1.5).
+  double dist2(const double* p, uint32_t t) const {
+    double a[3], bb[3], c[3];
+    for (int k = 0; k < 3; ++k) {
+      a[k] = s.positions[3 * size_t(s.indices[3 * size_t(t)]) + k];
+      bb[k] = s.positions[3 * size_t(s.indices[3 * size_t(t) + 1]) + k];
+      c[k] = s.positions[3 * size_t(s.indices[3 * size_t(t) + 2]) + k];
+    }
+    auto dot = [](const double* u, const double* v) { return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]; };
+    double ab[3], ac[3], ap[3], q[3];
+    for (int k = 0; k < 3; ++k) { ab[k] = bb[k] - a[k]; ac[k] = c[k] - a[k]; ap[k] = p[k] - a[k]; }
+    double d1 = dot(ab, ap), d2 = dot(ac, ap);
+    auto at = [&](double u, double v) {  // a + u ab + v ac
+      for (int k = 0; k < 3; ++k) q[k] = a[k] + u * ab[k] + v * ac[k];
+      double e = 0;
+      for (int k = 0; k < 3; ++k) e += (p[k] - q[k]) * (p[k] - q[k]);
+      return e;
+    };
+    if (d1 <= 0 && d2 <= 0) return at(0, 0);
+    double bp[3];
+    for (int k = 0; k < 3; ++k) bp[k] = p[k] - bb[k];
+    double d3 = dot(ab, bp), d4 = dot(ac, bp);
+    if (d3 >= 0 && d4 <= d3) return at(1, 0);
+    double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) return at(d1 / (d1 - d3), 0);
+    double cp[3];
+    for (int k = 0; k < 3; ++k) cp[k] = p[k] - c[k];
+    double d5 = dot(ab, cp), d6 = dot(ac, cp);
+    if (d6 >= 0 && d5 <= d6) return at(0, 1);
+    double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) return at(0, d2 / (d2 - d6));
+    double va = d3 * d6 - d5 * d4;
+    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+      double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+      return at(1 - w, w);
+    }
+    double den = 1 / (va + vb + vc);
+    return at(vb * den, vc * den);
+  }
+  double distance(const double* p) const {
+    int c[3] = {cellOf(float(p[0]), 0), cellOf(float(p[1]), 1), cellOf(float(p[2]), 2)};
+    double best = 1e300;
+    for (int ring = 0; ring < n; ++ring) {
+      for (int z = c[2] - ring; z <= c[2] + ring; ++z)
+        for (int y = c[1] - ring; y <= c[1] + ring; ++y)
+          for (int x = c[0] - ring; x <= c[0] + ring; ++x) {
+            if (x < 0 || y < 0 || z < 0 || x >= n || y >= n || z >= n) continue;
+            if (std::max({std::abs(x - c[0]), std::abs(y - c[1]), std::abs(z - c[2])}) != ring) continue;
+            size_t cc = size_t(x) + size_t(n) * (y + size_t(n) * z);
+            for (uint32_t k = start[cc]; k < start[cc + 1]; ++k) best = std::min(best, dist2(p, items[k]));
+          }
+      // Cells of ring r+1 are at least r·cell away from p's cell.
+      if (best < 1e300 && std::sqrt(best) <= ring * double(cell)) break;
+    }
+    return std::sqrt(best);
+  }
+};
+
+// Area-weighted mean and max distance from the triangles of `from` (centroid and vertices) to `to`.
+void oneWay(const IsoSurface& from, const TriangleGrid& to, double& sum, double& weight, double& maxD) {
+  for (uint32_t t = 0; t < from.triangleCount(); ++t) {
+    const float* v[3];
+    for (int k = 0; k < 3; ++k) v[k] = &from.positions[3 * size_t(from.indices[3 * size_t(t) + k])];
+    double u[3], w[3];
+    for (int k = 0; k < 3; ++k) { u[k] = v[1][k] - v[0][k]; w[k] = v[2][k] - v[0][k]; }
+    double area = 0.5 * std::sqrt(std::pow(u[1] * w[2] - u[2] * w[1], 2) + std::pow(u[2] * w[0] - u[0] * w[2], 2) +
+                                  std::pow(u[0] * w[1] - u[1] * w[0], 2));
+    double centroid[3];
+    for (int k = 0; k < 3; ++k) centroid[k] = (v[0][k] + v[1][k] + v[2][k]) / 3.0;
+    double d = to.distance(centroid);
+    sum += d * area;
+    weight += area;
+    maxD = std::max(maxD, d);
+    for (int k = 0; k < 3; ++k) {
+      double q[3] = {v[k][0], v[k][1], v[k][2]};
+      maxD = std::max(maxD, to.distance(q));
+    }
+  }
+}
+
+int cmdIsoDistance(int argc, char** argv) {
+  TetMesh orig, approx;
+  ReadReport rep;
+  if (Result r = readMesh(argv[2], orig, rep); !r) { std::fprintf(stderr, "%s\n", r.message.c_str()); return 1; }
+  if (Result r = readMesh(argv[3], approx, rep); !r) { std::fprintf(stderr, "%s\n", r.message.c_str()); return 1; }
+  const std::string field = arg(argc, argv, "--field", orig.fields[0].name.c_str());
+  const float value = float(std::atof(arg(argc, argv, "--value", "0")));
+  int fo = orig.findField(field), fa = approx.findField(field);
+  if (fa < 0 && approx.fields.size() == 1) fa = 0;  // VTK's decimation renames it "scalars"
+  if (fo < 0 || fa < 0) { std::fprintf(stderr, "field %s missing\n", field.c_str()); return 1; }
+  IsoExtractor scratch;
+  IsoSurface a, b;
+  extractIsosurface(orig, orig.fields[size_t(fo)].values, value, scratch, a);
+  extractIsosurface(approx, approx.fields[size_t(fa)].values, value, scratch, b);
+  const double diag = computeBounds(orig.positions).diagonal();
+  double sum = 0, weight = 0, maxD = 0;
+  if (a.triangleCount() && b.triangleCount()) {
+    TriangleGrid ga(a), gb(b);
+    oneWay(a, gb, sum, weight, maxD);
+    oneWay(b, ga, sum, weight, maxD);
+  }
+  std::printf("{\"trianglesOriginal\": %u, \"trianglesApprox\": %u, \"meanRelative\": %.6g, \"maxRelative\": %.6g}\n",
+              a.triangleCount(), b.triangleCount(), weight > 0 ? sum / weight / diag : 0.0, maxD / diag);
+  return 0;
+}
+
 // Raw little-endian arrays (positions f32, fields f32, tets u32): what `zstd -19` is run on to
 // compare against the packed size.
 int cmdRaw(char** argv) {
@@ -149,7 +296,9 @@ int cmdRaw(char** argv) {
 
 int main(int argc, char** argv) {
   if (argc >= 4 && !std::strcmp(argv[1], "error")) return cmdError(argc, argv);
+  if (argc >= 4 && !std::strcmp(argv[1], "isodist")) return cmdIsoDistance(argc, argv);
   if (argc >= 4 && !std::strcmp(argv[1], "raw")) return cmdRaw(argv);
-  std::fprintf(stderr, "usage: tetstream_bench error ORIG.vtu APPROX.vtu [--field F] | raw MESH.vtu OUT.bin\n");
+  std::fprintf(stderr, "usage: tetstream_bench error ORIG.vtu APPROX.vtu [--field F] | raw MESH.vtu OUT.bin | "
+                       "isodist ORIG.vtu APPROX.vtu [--field F] [--value V]\n");
   return 2;
 }

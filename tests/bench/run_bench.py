@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Progressive-engine benchmarks (issue 3 figures), side by side with VTK where it is installed.
 
-   python3 tests/bench/run_bench.py [--n 64] [--quick]   (scripts/bench.sh builds first)
+   python3 tests/bench/run_bench.py [--n 64] [--quick] [--repeat 3]   (scripts/bench.sh builds first)
 
 For Harmonic N³ and for the real meshes in ../shared/datasets that have a point field:
   - pack time to 5% of the tets (whole pack, stream written) vs VTK 9.1's
@@ -11,8 +11,12 @@ For Harmonic N³ and for the real meshes in ../shared/datasets that have a point
   - default pack: bits per tet and bytes per split vs zstd -19 of the raw arrays
   - decode + apply + local isosurface update, splits per second, native and wasm (node)
   - isovalue re-extraction, interval tree vs scan, at several levels (paper Table 1)
-Writes build/bench/results.json and build/bench/results.md. Timings are single runs on this
-machine (noted in the output); nothing here is asserted.
+  - isosurface extraction on the full mesh, ours vs VTK's vtkContourFilter
+  - rate-distortion: field RMS error and isosurface distance against bytes received, at every
+    chunk boundary of the default pack, and VTK's decimation at the same tet counts (its size:
+    zstd -19 of the decimated mesh's raw arrays); plotted to build/bench/rate_distortion.png
+Writes build/bench/results.json and build/bench/results.md. Times are medians of --repeat runs
+(default 3) on this machine (noted in the output); nothing here is asserted.
 """
 import json
 import os
@@ -28,6 +32,7 @@ BENCH = os.path.join(ROOT, "build/native/tetstream_bench")
 CHECK = os.path.join(ROOT, "build/native/tetstream_core_check")
 CHECK_WASM = os.path.join(ROOT, "build/wasm/tetstream_core_check.js")
 VTK_SCRIPT = os.path.join(ROOT, "tests/bench/vtk_decimate.py")
+VTK_CONTOUR = os.path.join(ROOT, "tests/bench/vtk_contour.py")
 DATASETS = os.path.join(ROOT, "..", "shared", "datasets", "vtk-data")
 OUT = os.path.join(ROOT, "build", "bench")
 
@@ -47,6 +52,47 @@ def have_vtk():
     return subprocess.run(["/usr/bin/python3", "-c", "import vtk"], capture_output=True).returncode == 0
 
 
+def median(xs):
+    xs = sorted(xs)
+    return xs[len(xs) // 2] if len(xs) % 2 else 0.5 * (xs[len(xs) // 2 - 1] + xs[len(xs) // 2])
+
+
+def zstd19_bytes(mesh, tmp):
+    """Bytes of `zstd -19` on the mesh's raw arrays (float32 positions and fields, uint32 tets)."""
+    raw = os.path.join(tmp, "raw.bin")
+    run([BENCH, "raw", mesh, raw])
+    run(["zstd", "-19", "-q", "-f", raw, "-o", raw + ".zst"])
+    return os.path.getsize(raw + ".zst")
+
+
+def rate_distortion(mesh, field, iso, full, tmp, with_vtk, points):
+    """Field error and isosurface distance against bytes received, ours at chunk boundaries and
+    VTK's decimation at the same tet counts."""
+    with open(os.path.join(full, "manifest.json")) as f:
+        chunks = json.load(f)["chunks"]
+    total_tets = chunks[-1]["tets"]
+    # Chunk counts spread over the stream (the base, then geometrically), up to 60% of the tets.
+    ks = sorted({1} | {max(1, round(len(chunks) ** (i / (points - 1)))) for i in range(points)})
+    rows = []
+    for k in ks:
+        c = chunks[k - 1]
+        if k > 1 and c["tets"] > 0.6 * total_tets:
+            break
+        out = os.path.join(tmp, f"rd-{k}.vtu")
+        run([CLI, "unpack", full, "--chunks", str(k), "-o", out])
+        row = {"chunks": k, "tets": c["tets"], "bytes": sum(x["bytes"] for x in chunks[:k]),
+               "ours": run_json([BENCH, "error", mesh, out, "--field", field]),
+               "oursIso": run_json([BENCH, "isodist", mesh, out, "--field", field, "--value", str(iso)])}
+        if with_vtk:
+            v = os.path.join(tmp, f"rd-vtk-{k}.vtu")
+            run_json(["/usr/bin/python3", VTK_SCRIPT, mesh, v, str(c["tets"]), field])
+            row["vtkBytes"] = zstd19_bytes(v, tmp)
+            row["vtk"] = run_json([BENCH, "error", mesh, v, "--field", field])
+            row["vtkIso"] = run_json([BENCH, "isodist", mesh, v, "--field", field, "--value", str(iso)])
+        rows.append(row)
+    return rows
+
+
 def our_level(mesh, tmp, tets, field):
     """Our mesh with `tets` tetrahedra: the base of a pack stopped there (the collapse order does
     not depend on the target, so this is the stream's level with that many tets)."""
@@ -57,14 +103,16 @@ def our_level(mesh, tmp, tets, field):
     return r, out
 
 
-def bench_mesh(name, mesh, field, iso, tmp, with_vtk, quick):
+def bench_mesh(name, mesh, field, iso, tmp, with_vtk, quick, repeat):
     info = run_json([CLI, "info", mesh, "--json"])
     tets = info["tets"]
-    res = {"name": name, "vertices": info["vertices"], "tets": tets, "field": field}
-    # Pack time to 5% of the tets, and VTK's decimation to the same count.
+    res = {"name": name, "vertices": info["vertices"], "tets": tets, "field": field, "repeat": repeat}
+    # Pack time to 5% of the tets (median of `repeat` packs), and VTK's decimation to the same count.
     target = int(0.05 * tets)
-    pack5, ours5 = our_level(mesh, tmp, target, field)
-    res["pack5"] = {"ms": pack5["ms"], "simplifyMs": pack5["simplifyMs"], "peakMemoryMB": pack5["peakMemoryMB"],
+    packs = [our_level(mesh, tmp, target, field) for _ in range(repeat)]
+    pack5, ours5 = packs[0]
+    res["pack5"] = {"ms": median([p["ms"] for p, _ in packs]), "runsMs": [p["ms"] for p, _ in packs],
+                    "simplifyMs": median([p["simplifyMs"] for p, _ in packs]), "peakMemoryMB": pack5["peakMemoryMB"],
                     "bytesPerInputTet": pack5["peakMemoryMB"] * 1048576 / tets, "tets": pack5["baseTets"]}
     levels = [0.05] if quick else [0.05, 0.10, 0.30]
     res["error"] = []
@@ -74,19 +122,25 @@ def bench_mesh(name, mesh, field, iso, tmp, with_vtk, quick):
         row = {"fraction": frac, "ours": run_json([BENCH, "error", mesh, ours, "--field", field])}
         if with_vtk:
             vtk_out = os.path.join(tmp, f"vtk-{n}.vtu")
-            v = run_json(["/usr/bin/python3", VTK_SCRIPT, mesh, vtk_out, str(n), field])
+            runs = [run_json(["/usr/bin/python3", VTK_SCRIPT, mesh, vtk_out, str(n), field])
+                    for _ in range(repeat if frac == 0.05 else 1)]
             row["vtk"] = run_json([BENCH, "error", mesh, vtk_out, "--field", field])
-            row["vtkSeconds"] = v["seconds"]
+            row["vtkSeconds"] = median([v["seconds"] for v in runs])
         res["error"].append(row)
     # The default pack: sizes against zstd -19 of the raw arrays.
     full = os.path.join(tmp, "full")
     p = run_json([CLI, "pack", mesh, "-o", full, "--field", field, "--json"])
-    raw = os.path.join(tmp, "raw.bin")
-    run([BENCH, "raw", mesh, raw])
-    run(["zstd", "-19", "-q", "-f", raw, "-o", raw + ".zst"])
     res["size"] = {"bytes": p["bytes"], "bitsPerTet": p["bitsPerTet"], "bytesPerSplit": p["bytesPerSplit"],
                    "baseBytes": p["baseBytes"], "baseVertices": p["baseVertices"], "chunks": p["chunks"],
-                   "zstd19RawBitsPerTet": 8 * os.path.getsize(raw + ".zst") / tets, "packMs": p["ms"]}
+                   "zstd19RawBitsPerTet": 8 * zstd19_bytes(mesh, tmp) / tets, "packMs": p["ms"]}
+    # Isosurface on the full mesh: ours (in-process extraction time of `tetstream iso`) and VTK.
+    ours_iso = [run_json([CLI, "iso", mesh, "--field", field, "--value", str(iso), "--json"]) for _ in range(repeat)]
+    res["iso"] = {"isovalue": iso, "triangles": ours_iso[0]["triangles"], "ms": median([r["ms"] for r in ours_iso])}
+    if with_vtk:
+        v = run_json(["/usr/bin/python3", VTK_CONTOUR, mesh, field, str(iso), str(repeat)])
+        res["iso"]["vtkMs"] = 1000 * median(v["seconds"])
+        res["iso"]["vtkTriangles"] = v["triangles"]
+    res["rateDistortion"] = rate_distortion(mesh, field, iso, full, tmp, with_vtk, 4 if quick else 8)
     # Streaming rates and re-extraction, native and wasm.
     res["stream"] = {"native": run_json([CHECK, "--stream", full, str(iso)])}
     if os.path.exists(CHECK_WASM):
@@ -95,13 +149,14 @@ def bench_mesh(name, mesh, field, iso, tmp, with_vtk, quick):
 
 
 def markdown(results, machine):
-    lines = [f"Machine: {machine}. Single runs; times in ms unless noted.", ""]
+    lines = [f"Machine: {machine}. Times are medians of {results[0]['repeat']} runs, in ms unless noted.", ""]
     lines.append("| dataset | tets | pack to 5% (ms) | VTK decimation to 5% (ms) | ratio | peak memory / input tet |")
     lines.append("|---|---|---|---|---|---|")
     for r in results:
         vtk = next((e.get("vtkSeconds") for e in r["error"] if e["fraction"] == 0.05), None)
         vtk_ms = f"{vtk * 1000:.0f}" if vtk is not None else "n/a"
-        ratio = f"{vtk * 1000 / r['pack5']['ms']:.2f}× {'faster' if vtk * 1000 > r['pack5']['ms'] else 'slower'}" if vtk else "n/a"
+        ours = r["pack5"]["ms"]
+        ratio = "n/a" if not vtk else (f"{vtk * 1000 / ours:.1f}× faster" if vtk * 1000 > ours else f"{ours / (vtk * 1000):.1f}× slower")
         lines.append(f"| {r['name']} | {r['tets']:,} | {r['pack5']['ms']:.0f} | {vtk_ms} | {ratio} | {r['pack5']['bytesPerInputTet']:.0f} B |")
     lines += ["", "| dataset | level (tets) | ours RMS / max (rel. to range) | VTK RMS / max | ours volume ratio | VTK volume ratio |",
               "|---|---|---|---|---|---|"]
@@ -115,6 +170,21 @@ def markdown(results, machine):
     for r in results:
         s = r["size"]
         lines.append(f"| {r['name']} | {s['bitsPerTet']:.1f} | {s['bytesPerSplit']:.1f} | {s['zstd19RawBitsPerTet']:.1f} | {s['baseVertices']:,} vertices, {s['baseBytes'] / 1024:.0f} KB | {s['chunks']} |")
+    lines += ["", "| dataset | isosurface on the full mesh: triangles | tetstream (ms) | VTK vtkContourFilter (ms) | ratio |", "|---|---|---|---|---|"]
+    for r in results:
+        i = r["iso"]
+        vtk = f"{i['vtkMs']:.1f}" if "vtkMs" in i else "n/a"
+        ratio = f"{i['vtkMs'] / i['ms']:.1f}× faster" if "vtkMs" in i else "n/a"
+        lines.append(f"| {r['name']} | {i['triangles']:,} | {i['ms']:.1f} | {vtk} | {ratio} |")
+    lines += ["", "Rate–distortion (default pack; error relative to the field range, isosurface distance to the diagonal):", "",
+              "| dataset | chunks | tets | KB received | field RMS | iso distance mean / max | VTK KB (zstd -19) | VTK field RMS | VTK iso distance mean / max |",
+              "|---|---|---|---|---|---|---|---|---|"]
+    for r in results:
+        for x in r["rateDistortion"]:
+            v = (f"{x['vtkBytes'] / 1024:.0f} | {x['vtk']['rmsRelative']:.5f} | {x['vtkIso']['meanRelative']:.5f} / {x['vtkIso']['maxRelative']:.4f}"
+                 if "vtk" in x else "n/a | n/a | n/a")
+            lines.append(f"| {r['name']} | {x['chunks']} | {x['tets']:,} | {x['bytes'] / 1024:.0f} | {x['ours']['rmsRelative']:.5f} | "
+                         f"{x['oursIso']['meanRelative']:.5f} / {x['oursIso']['maxRelative']:.4f} | {v} |")
     lines += ["", "| dataset | splits/s native (apply + local update) | wasm | undo splits/s native | wasm |", "|---|---|---|---|---|"]
     for r in results:
         n, w = r["stream"]["native"], r["stream"].get("wasm")
@@ -132,11 +202,44 @@ def markdown(results, machine):
     return "\n".join(lines) + "\n"
 
 
+def plot(results, path):
+    """Field error and isosurface distance against KB received, ours and VTK, one colour a dataset."""
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        print("bench: matplotlib missing (apt-get install python3-matplotlib): no plot")
+        return
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    for r, colour in zip(results, ["tab:blue", "tab:orange", "tab:green", "tab:red"]):
+        rd = r["rateDistortion"]
+        kb = [x["bytes"] / 1024 for x in rd]
+        axes[0].plot(kb, [x["ours"]["rmsRelative"] for x in rd], "o-", color=colour, label=f"tetstream, {r['name']}")
+        axes[1].plot(kb, [x["oursIso"]["meanRelative"] for x in rd], "o-", color=colour, label=f"tetstream, {r['name']}")
+        vt = [x for x in rd if "vtk" in x]
+        if vt:
+            vkb = [x["vtkBytes"] / 1024 for x in vt]
+            axes[0].plot(vkb, [x["vtk"]["rmsRelative"] for x in vt], "s--", color=colour, alpha=0.6, label=f"VTK decimation, {r['name']}")
+            axes[1].plot(vkb, [x["vtkIso"]["meanRelative"] for x in vt], "s--", color=colour, alpha=0.6, label=f"VTK decimation, {r['name']}")
+    for ax, title in zip(axes, ["field RMS error (relative to range)", "isosurface distance, mean (relative to diagonal)"]):
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("KB received (VTK: zstd -19 of the decimated mesh)")
+        ax.set_title(title, fontsize=10)
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    print(f"bench: wrote {path}")
+
+
 def main():
     n = 64
     quick = "--quick" in sys.argv
     if "--n" in sys.argv:
         n = int(sys.argv[sys.argv.index("--n") + 1])
+    repeat = int(sys.argv[sys.argv.index("--repeat") + 1]) if "--repeat" in sys.argv else (1 if quick else 3)
     os.makedirs(OUT, exist_ok=True)
     with_vtk = have_vtk()
     if not with_vtk:
@@ -154,9 +257,10 @@ def main():
             print(f"bench: {name}", flush=True)
             sub = os.path.join(tmp, name.split()[0])
             os.makedirs(sub, exist_ok=True)
-            results.append(bench_mesh(name, mesh, field, iso, sub, with_vtk, quick))
+            results.append(bench_mesh(name, mesh, field, iso, sub, with_vtk, quick, repeat))
     with open(os.path.join(OUT, "results.json"), "w") as f:
         json.dump({"machine": machine, "results": results}, f, indent=1)
+    plot(results, os.path.join(OUT, "rate_distortion.png"))
     md = markdown(results, machine)
     with open(os.path.join(OUT, "results.md"), "w") as f:
         f.write(md)
