@@ -342,6 +342,7 @@ class Simplifier {
     std::vector<StarTet> star;
     bool shapeReady = false;
     double flatBound = 0;  // see prepareStar
+    double qualityFloor = 0;  // the least 3/κ a changed tet may have (see prepareStar)
     std::vector<uint32_t> nbr;
     std::vector<Candidate> candidates;
     std::vector<uint32_t> seen;  // neighbour stamps
@@ -375,6 +376,12 @@ class Simplifier {
     const double diam2 = (hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]);
     L.flatBound = kFlat * diam2 * std::sqrt(diam2);
     const double* pi = p(i);
+    // A changed tet must reach the minimum quality, or else be no worse than the worst tet of
+    // the star now: real meshes (boundary layers of CFD grids) start with tets far below any
+    // fixed minimum, and a collapse that does not make their region worse is allowed.
+    float worstKappa = 0;
+    for (uint32_t t : star_[i]) worstKappa = std::max(worstKappa, kappa_[t]);
+    L.qualityFloor = std::min(opt_.minQuality, 3.0 / double(worstKappa));
     for (uint32_t t : star_[i]) {
       const uint32_t* v = &out_.tets[4 * size_t(t)];
       StarTet st;
@@ -516,7 +523,7 @@ class Simplifier {
         faces += c0 * c0 + c1 * c1 + c2 * c2;
       }
       const double kappa = std::sqrt(edges * 0.25 * faces) / det;
-      if (3.0 / kappa < opt_.minQuality) return *verdict = CollapseVerdict::LowQuality, kInf;
+      if (3.0 / kappa < L.qualityFloor) return *verdict = CollapseVerdict::LowQuality, kInf;
       kappaSum += std::min<double>(kappa, kKappaCap);
       ++count;
     }

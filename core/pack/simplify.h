@@ -21,7 +21,8 @@
 //   - the link condition Lk(i) ∩ Lk(j) = Lk(ij), with the boundary coned to a virtual vertex,
 //     so the mesh and its boundary keep their topology and stay manifold;
 //   - no tet that moves from p_i to p_j may become inverted or flat (eq. 1, relative tolerance)
-//     or fall below the minimum quality 3/κ ≥ minQuality.
+//     or fall below the minimum quality 3/κ ≥ minQuality (where the star already has worse
+//     tets, as boundary layers of CFD grids do: below the worst of them).
 // Consequences: no collapse creates an inverted or flat tet; flat tets of the input only ever
 // disappear (when they contain the collapsed edge) or become proper.
 //
@@ -46,6 +47,7 @@ struct SimplifyOptions {
   double maxError = std::numeric_limits<double>::infinity();  // stop when the cheapest cost exceeds it
   int field = 0;                // index of the field that steers the field error
   double minQuality = 0.02;     // 3/κ of every tet a collapse changes must stay at or above this
+                                // (or at the worst 3/κ of the star before it, when that is lower)
   std::function<void(uint32_t done, uint32_t planned)> progress;  // called now and then
   bool verifyLinkCondition = false;  // tests: also run the slow reference link check, count mismatches
   // Threads for cost evaluation (1 or 2; the result is the same either way), used for meshes of

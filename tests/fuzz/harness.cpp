@@ -20,6 +20,7 @@
 #include "pack/generators.h"
 #include "pack/mesh_io.h"
 #include "pack/packer.h"
+#include "pack/readers.h"
 #include "validate.h"
 
 namespace tetstream::fuzz {
@@ -126,6 +127,16 @@ void checkStructure(const TetMesh& m) {
   for (const ScalarField& f : m.fields) FUZZ_CHECK(f.values.size() == m.vertexCount());
 }
 
+// What a reader promises (mesh_io.h); flaws such as a tet with a repeated vertex are the
+// packer's to report, so they may pass here.
+void checkReaderPromise(const TetMesh& m) {
+  FUZZ_CHECK(m.tetCount() > 0);
+  for (uint32_t v : m.tets) FUZZ_CHECK(v < m.vertexCount());
+  for (float x : m.positions) FUZZ_CHECK(std::isfinite(x));
+  FUZZ_CHECK(m.positions.size() == 3 * size_t(m.vertexCount()));
+  for (const ScalarField& f : m.fields) FUZZ_CHECK(f.values.size() == m.vertexCount());
+}
+
 std::span<const uint8_t> payloadOf(ChunkDecoder& dec, const ChunkInfo& info, uint32_t index,
                                    const std::vector<uint8_t>& file) {
   std::span<const uint8_t> payload;
@@ -210,14 +221,22 @@ void meshFile(const char* extension, const uint8_t* data, size_t size) {
   TetMesh m;
   ReadReport report;
   const std::string_view bytes(reinterpret_cast<const char*>(data), size);
-  if (!readMeshBytes(bytes, std::string("fuzz") + extension, m, report)) return;
-  // What a reader promises (mesh_io.h); flaws such as a tet with a repeated vertex are the
-  // packer's to report, so they may pass here.
-  FUZZ_CHECK(m.tetCount() > 0);
-  for (uint32_t v : m.tets) FUZZ_CHECK(v < m.vertexCount());
-  for (float x : m.positions) FUZZ_CHECK(std::isfinite(x));
-  FUZZ_CHECK(m.positions.size() == 3 * size_t(m.vertexCount()));
-  for (const ScalarField& f : m.fields) FUZZ_CHECK(f.values.size() == m.vertexCount());
+  if (readMeshBytes(bytes, std::string("fuzz") + extension, m, report)) checkReaderPromise(m);
+}
+
+void twoFiles(const char* format, const uint8_t* data, size_t size) {
+  if (size < 4) return;
+  const size_t first = std::min<size_t>(size - 4, size_t(data[0]) | size_t(data[1]) << 8 | size_t(data[2]) << 16 |
+                                                      size_t(data[3]) << 24);
+  const std::string_view a(reinterpret_cast<const char*>(data + 4), first);
+  const std::string_view b(reinterpret_cast<const char*>(data + 4 + first), size - 4 - first);
+  TetMesh m;
+  ReadReport report;
+  const std::string f = format;
+  Result r = f == "tetgen" ? readTetgen(a, "fuzz.node", b, "fuzz.ele", m, report)
+             : f == "medit" ? readMedit(a, "fuzz.mesh", b, "fuzz.sol", m, report)
+                            : readPlot3d(a, "fuzz.xyz", b, "fuzz.q", m, report);
+  if (r) checkReaderPromise(m);
 }
 
 bool runTarget(const std::string& name, const uint8_t* data, size_t size) {
@@ -225,6 +244,7 @@ bool runTarget(const std::string& name, const uint8_t* data, size_t size) {
   else if (name == "split-chunk") splitChunk(data, size);
   else if (name == "base-chunk") baseChunk(data, size);
   else if (name.starts_with("mesh-") && name.size() > 5) meshFile(("." + name.substr(5)).c_str(), data, size);
+  else if (name == "pair-tetgen" || name == "pair-medit" || name == "pair-plot3d") twoFiles(name.c_str() + 5, data, size);
   else return false;
   return true;
 }
