@@ -253,6 +253,15 @@ def main():
         post = os.path.join(DATASETS, "post.vtk")
         if os.path.exists(post):
             cases.append(("post.vtk (real)", post, "Pressure", 1.0))
+        fin = os.path.join(DATASETS, "bluntfinxyz.bin")
+        if os.path.exists(fin):
+            # PLOT3D: read by our reader, written out as .vtu (a lossless pack, unpacked) so that
+            # VTK's decimation gets the very same tetrahedra.
+            packed = os.path.join(tmp, "bluntfin-lossless")
+            run([CLI, "pack", fin, "-o", packed, "--lossless", "--json"])
+            fin_vtu = os.path.join(tmp, "bluntfin.vtu")
+            run([CLI, "unpack", packed, "-o", fin_vtu])
+            cases.append(("Blunt Fin (real, PLOT3D)", fin_vtu, "density", 1.2))
         for name, mesh, field, iso in cases:
             print(f"bench: {name}", flush=True)
             sub = os.path.join(tmp, name.split()[0])
