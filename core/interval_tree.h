@@ -75,6 +75,8 @@ class IntervalTree {
   void build(const TetMesh& mesh, std::span<const float> field);
   // Forgets everything, keeps the memory.
   void clear();
+  // Room for ids 0 .. ids-1 without growing the per-id array.
+  void reserve(uint32_t ids) { intervals_.reserve(ids); }
 
   // A new id (T_new). id may be >= idCount() (the id space grows; ids skipped over are absent)
   // or an id that was removed. Precondition (asserted): id is absent, iv as for build().

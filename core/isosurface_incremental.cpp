@@ -124,6 +124,7 @@ struct IncrementalIsosurface::Context {
   const float* field;
   const uint32_t* tets;
   float iso;
+  const float* colour;  // the colour field, or nullptr (colours 0)
 };
 
 void IncrementalIsosurface::reset() {
@@ -131,7 +132,30 @@ void IncrementalIsosurface::reset() {
   tetRecord_.clear();
   tree_.clear();
   treeBuilt_ = false;
+  coverage_ = 0;
   fullUpload_ = false;
+}
+
+void IncrementalIsosurface::setTreeDeferred(bool deferred) { deferred_ = deferred; }
+
+void IncrementalIsosurface::reserveTets(uint32_t tets) {
+  tetRecord_.reserve(tets);
+  tree_.reserve(tets);
+}
+
+bool IncrementalIsosurface::extendTree(const TetMesh& mesh, std::span<const float> field, uint32_t maxTets) {
+  assert(field.size() == mesh.vertexCount());
+  const uint32_t n = mesh.tetCount();
+  if (coverage_ >= n) return true;
+  if (coverage_ == 0 && maxTets >= n) {
+    tree_.build(mesh, field);  // in one go: faster than inserting one by one
+    coverage_ = n;
+  } else {
+    const uint32_t end = n - coverage_ > maxTets ? coverage_ + maxTets : n;
+    for (uint32_t t = coverage_; t < end; ++t) tree_.insert(t, tetInterval(mesh, field, t));
+    coverage_ = end;
+  }
+  return coverage_ == n;
 }
 
 void IncrementalIsosurface::clearSurface() {
@@ -146,6 +170,7 @@ void IncrementalIsosurface::clearSurface() {
   triangleCount_ = 0;
   positions_.clear();
   normals_.clear();
+  colours_.clear();
   vertices_.clear();
   freeVertices_.clear();
   map_.clear();
@@ -155,21 +180,34 @@ void IncrementalIsosurface::clearSurface() {
   changedTriangles_.clear();
 }
 
-void IncrementalIsosurface::rebuild(const TetMesh& mesh, std::span<const float> field, float isovalue) {
+void IncrementalIsosurface::rebuild(const TetMesh& mesh, std::span<const float> field, float isovalue,
+                                    std::span<const float> colour) {
   assert(field.size() == mesh.vertexCount());
+  assert(colour.empty() || colour.size() == mesh.vertexCount());
   clearSurface();
   isovalue_ = isovalue;
-  // A tree of another tet count means the mesh changed behind updateTets' back; building it
-  // again is the safe answer (the field cannot be checked that cheaply: see reset()).
-  if (!treeBuilt_ || tree_.idCount() != mesh.tetCount()) {
-    tree_.build(mesh, field);
+  const uint32_t n = mesh.tetCount();
+  // Not deferred, a tree of another tet count means the mesh changed behind updateTets' back;
+  // building it again is the safe answer (the field cannot be checked that cheaply: see reset()).
+  if (!treeBuilt_ || (!deferred_ && (coverage_ != n || tree_.idCount() != n))) {
+    if (deferred_) {
+      tree_.clear();
+      coverage_ = 0;
+    } else {
+      tree_.build(mesh, field);
+      coverage_ = n;
+    }
     treeBuilt_ = true;
   }
-  tetRecord_.resize(mesh.tetCount(), kNone);
+  tetRecord_.resize(n, kNone);
 
+  // The tree's tets, then every tet past its coverage tested on its own.
   cutTets_.clear();
-  tree_.query(isovalue, cutTets_);
-  const Context c{mesh.positions.data(), field.data(), mesh.tets.data(), isovalue};
+  if (coverage_ > 0) tree_.query(isovalue, cutTets_);
+  for (uint32_t t = coverage_; t < n; ++t)
+    if (stabs(tetInterval(mesh, field, t), isovalue)) cutTets_.push_back(t);
+  const Context c{mesh.positions.data(), field.data(), mesh.tets.data(), isovalue,
+                  colour.empty() ? nullptr : colour.data()};
   bulk_ = true;
   // The query returns tets in interval order, which is random in space; visiting them in id
   // order instead keeps neighbouring tets and their shared surface vertices close in memory.
@@ -188,10 +226,12 @@ void IncrementalIsosurface::rebuild(const TetMesh& mesh, std::span<const float> 
 }
 
 void IncrementalIsosurface::updateTets(const TetMesh& mesh, std::span<const float> field,
-                                       std::span<const uint32_t> changedTets) {
+                                       std::span<const uint32_t> changedTets, std::span<const float> colour) {
   assert(treeBuilt_ && "rebuild() first");
   assert(field.size() == mesh.vertexCount());
-  const Context c{mesh.positions.data(), field.data(), mesh.tets.data(), isovalue_};
+  assert(colour.empty() || colour.size() == mesh.vertexCount());
+  const Context c{mesh.positions.data(), field.data(), mesh.tets.data(), isovalue_,
+                  colour.empty() ? nullptr : colour.data()};
   const uint32_t n = mesh.tetCount();
   const uint32_t old = uint32_t(tetRecord_.size());
 
@@ -201,15 +241,20 @@ void IncrementalIsosurface::updateTets(const TetMesh& mesh, std::span<const floa
     for (uint32_t t = n; t < old; ++t) removeTet(t);
     tetRecord_.resize(n);
     tree_.truncate(n);
+    coverage_ = std::min(coverage_, n);
   }
   for (uint32_t t : changedTets)
     if (t < std::min(n, old)) removeTet(t);
   if (n > old) tetRecord_.resize(n, kNone);
 
   // T_new into the tree, T_moved updated in it (paper §4.3), and their triangles made again.
+  // Deferred, only tets the tree covers (new tets come after it: coverage_ <= old).
+  const uint32_t tracked = deferred_ ? coverage_ : n;
   auto refresh = [&](uint32_t t) {
     Interval iv = tetInterval(mesh, field, t);
-    if (tree_.contains(t))
+    if (t >= tracked)
+      ;
+    else if (tree_.contains(t))
       tree_.update(t, iv);
     else
       tree_.insert(t, iv);
@@ -224,6 +269,7 @@ void IncrementalIsosurface::updateTets(const TetMesh& mesh, std::span<const floa
     finishNormal(v);
   }
   touched_.clear();
+  if (!deferred_) coverage_ = n;
 }
 
 void IncrementalIsosurface::addTet(const Context& c, uint32_t t) {
@@ -312,6 +358,7 @@ uint32_t IncrementalIsosurface::acquireVertex(const Context& c, uint32_t a, uint
   if (freeVertices_.empty()) {
     positions_.resize(positions_.size() + 3);
     normals_.resize(normals_.size() + 3);
+    colours_.push_back(0.f);
     vertices_.emplace_back();
   } else {
     freeVertices_.pop_back();
@@ -321,7 +368,10 @@ uint32_t IncrementalIsosurface::acquireVertex(const Context& c, uint32_t a, uint
     q[k] = s0 == c.iso ? p0[k] : w0 * p0[k] + w1 * p1[k];
     normals_[3 * size_t(v) + k] = 0;
   }
-  vertices_[v] = Vertex{{0, 0, 0}, key, 0, 0, 0};
+  // The weight of the key's second vertex (the larger id), so recolour() can interpolate again.
+  const float tHigh = s0 == c.iso ? 0.f : (hi == uint32_t(key) ? w1 : w0);
+  colours_[v] = !c.colour ? 0.f : s0 == c.iso ? c.colour[lo] : w0 * c.colour[lo] + w1 * c.colour[hi];
+  vertices_[v] = Vertex{{0, 0, 0}, key, 0, 0, 0, tHigh};
   touchVertex(v);
   return v;
 }
@@ -447,6 +497,7 @@ void IncrementalIsosurface::compact() {
     if (w != v) {
       std::copy_n(&positions_[3 * size_t(v)], 3, &positions_[3 * size_t(w)]);
       std::copy_n(&normals_[3 * size_t(v)], 3, &normals_[3 * size_t(w)]);
+      colours_[w] = colours_[v];
       vertices_[w] = vertices_[v];
     }
     vertices_[w].flags = 0;
@@ -454,6 +505,7 @@ void IncrementalIsosurface::compact() {
   }
   positions_.resize(3 * size_t(w));
   normals_.resize(3 * size_t(w));
+  colours_.resize(w);
   vertices_.resize(w);
   freeVertices_.clear();
   map_.remapValues(remap);
@@ -466,6 +518,19 @@ void IncrementalIsosurface::compact() {
   for (uint32_t& v : indices_) v = remap[v];
   changedVertices_.clear();
   changedTriangles_.clear();
+  fullUpload_ = true;
+}
+
+void IncrementalIsosurface::recolour(std::span<const float> colour) {
+  for (uint32_t v = 0; v < vertexSlotCount(); ++v) {
+    const Vertex& x = vertices_[v];
+    if (x.refs == 0) continue;
+    const uint32_t a = uint32_t(x.key >> 32), b = uint32_t(x.key);
+    if (colour.empty() || std::max(a, b) >= colour.size())
+      colours_[v] = 0.f;
+    else
+      colours_[v] = a == b ? colour[a] : (1.f - x.tHigh) * colour[a] + x.tHigh * colour[b];
+  }
   fullUpload_ = true;
 }
 
@@ -487,7 +552,7 @@ void IncrementalIsosurface::toIsoSurface(IsoSurface& out) const {
 size_t IncrementalIsosurface::memoryBytes() const {
   auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   return tree_.memoryBytes() + map_.memoryBytes() + bytes(tetRecord_) + bytes(records_) + bytes(freeRecords_) +
-         bytes(indices_) + bytes(triangleOwner_) + bytes(triangleChanged_) + bytes(positions_) + bytes(normals_) +
+         bytes(indices_) + bytes(triangleOwner_) + bytes(triangleChanged_) + bytes(positions_) + bytes(normals_) + bytes(colours_) +
          bytes(vertices_) + bytes(freeVertices_) + bytes(touched_) + bytes(changedVertices_) +
          bytes(changedTriangles_) + bytes(cutTets_) + bytes(cutBits_);
 }
@@ -544,7 +609,9 @@ bool IncrementalIsosurface::validate() const {
     if (map_.find(x.key) != v) return false;
   }
   if (live != map_.size() || live + freeVertices_.size() != slots) return false;
-  return tree_.validate() && tree_.idCount() == tetRecord_.size();
+  // The tree holds exactly the covered tets; not deferred, that is every tet.
+  return tree_.validate() && tree_.idCount() == coverage_ &&
+         (deferred_ ? coverage_ <= tetRecord_.size() : coverage_ == tetRecord_.size());
 }
 
 }  // namespace tetstream

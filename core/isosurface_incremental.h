@@ -13,6 +13,8 @@
 //   vertex no triangle uses). Vertex slots have holes: a freed slot keeps stale data and no live
 //   triangle refers to it, so the arrays can be drawn as they are (vertexSlotCount() vertices).
 //   compact() closes the holes when wanted.
+//   colours(): 1 float per vertex slot, the colour field (any point field, optional) interpolated
+//   along the vertex's cut edge with the same weights as its position (0 without one).
 //   indices(): 3 uint32 per triangle, dense: triangles 0 .. triangleCount()-1 are all live (a
 //   removed triangle's slot is refilled with the last one).
 // Change tracking for sub-range GPU uploads: changedVertices()/changedTriangles() list the slots
@@ -31,7 +33,7 @@
 //
 // Memory: per tet 4 bytes (record index) + 1 bit (rebuild's ordering bitmap) + the interval
 // tree (18-28 bytes); per cut tet a 28-byte record; per triangle 17 bytes; per surface vertex
-// about 100 bytes (position, normal, double normal sum, key, counts, hash slots). Measured on
+// about 104 bytes (position, normal, colour, double normal sum, key, counts, hash slots). Measured on
 // Harmonic 64 at λ = 0.1 after 20000 simulated splits: 49 bytes per tet in all.
 // Measured speed there (wasm, node 20, -O3; native in brackets): updateTets 9.7 us per split of
 // 11.6 changed tets (5.7 us), its undo 7.4 us (4.2 us); rebuild 1.0-12.5 ms for 8k-86k triangles
@@ -92,16 +94,43 @@ class IncrementalIsosurface {
   // Extracts the whole surface at `isovalue` (the isovalue slider). Builds the interval tree when
   // there is none yet (first call, after reset()) or its tet count differs from the mesh's,
   // otherwise only queries it. Precondition (asserted): field.size() == mesh.vertexCount().
-  void rebuild(const TetMesh& mesh, std::span<const float> field, float isovalue);
+  // `colour` (empty, or one value per mesh vertex) is interpolated at each surface vertex.
+  void rebuild(const TetMesh& mesh, std::span<const float> field, float isovalue,
+               std::span<const float> colour = {});
 
   // Recomputes the triangles of the listed tets (T_new and T_moved of a split or its undo; see the
   // contract above), updates the interval tree for them, releases unused surface vertices and
   // renormalises the touched vertices' normals. No allocation once the arrays are warm.
   // Precondition (asserted): rebuild() was called since the last reset().
-  void updateTets(const TetMesh& mesh, std::span<const float> field, std::span<const uint32_t> changedTets);
+  // `colour` as for rebuild() (the same field every time, or recolour() after switching).
+  void updateTets(const TetMesh& mesh, std::span<const float> field, std::span<const uint32_t> changedTets,
+                  std::span<const float> colour = {});
+
+  // Another colour field (or none: empty) for the current surface: every live vertex's colour
+  // interpolated again along its edge, no geometry touched; sets fullUploadNeeded().
+  void recolour(std::span<const float> colour);
 
   // Renumbers vertex slots densely (no holes); sets fullUploadNeeded().
   void compact();
+
+  // Deferred interval tree, for a mesh that is being refined fast (a level streaming in). The
+  // tree covers tets [0, treeCoverage()): rebuild() queries it for those and tests every other
+  // tet's interval itself; updateTets keeps it up to date for those only. Keeping it up to date
+  // costs ~1 us per changed tet, a third of a split's refinement time, which is wasted while
+  // hundreds of thousands of splits stream in and the isovalue does not change. By default
+  // (deferred off) rebuild() builds the tree over the whole mesh and updateTets keeps it whole.
+  // Deferred, rebuild() never builds it at once (156 ms at 1.5M tets in wasm: a frozen frame);
+  // extendTree() grows it by at most maxTets tets per call, for idle time in short slices, and
+  // returns true once it covers the mesh. Tets added by updateTets later are not covered until
+  // extendTree() is called again. setTreeDeferred(true) keeps what is covered.
+  void setTreeDeferred(bool deferred);
+  bool extendTree(const TetMesh& mesh, std::span<const float> field, uint32_t maxTets);
+  uint32_t treeCoverage() const { return coverage_; }
+
+  // Sizes the per-tet arrays (the record index and the tree's intervals) for `tets` tets, so
+  // that streaming up to that count copies no array (a doubling copy of a 1.5M-tet array takes
+  // several ms inside one refinement slice).
+  void reserveTets(uint32_t tets);
 
   // The surface as a compact IsoSurface (vertices in slot order), equal to extractIsosurface's
   // output up to the order of vertices and triangles.
@@ -110,6 +139,7 @@ class IncrementalIsosurface {
   float isovalue() const { return isovalue_; }
   std::span<const float> positions() const { return {positions_.data(), 3 * size_t(vertexSlotCount())}; }
   std::span<const float> normals() const { return {normals_.data(), 3 * size_t(vertexSlotCount())}; }
+  std::span<const float> colours() const { return {colours_.data(), size_t(vertexSlotCount())}; }
   std::span<const uint32_t> indices() const { return {indices_.data(), 3 * size_t(triangleCount())}; }
   uint32_t vertexSlotCount() const { return uint32_t(vertices_.size()); }
   uint32_t vertexCount() const { return uint32_t(map_.size()); }  // live vertices
@@ -148,7 +178,9 @@ class IncrementalIsosurface {
   void finishNormal(uint32_t v);
 
   float isovalue_ = 0;
-  bool treeBuilt_ = false;
+  bool treeBuilt_ = false;  // rebuild() has run since reset()
+  bool deferred_ = false;   // see setTreeDeferred
+  uint32_t coverage_ = 0;   // the tree holds tets [0, coverage_)
   bool bulk_ = false;  // inside rebuild(): no per-slot change tracking
   IntervalTree tree_;
   SurfaceVertexMap map_;
@@ -167,6 +199,7 @@ class IncrementalIsosurface {
     uint32_t refs;       // records using the vertex; 0 for a free slot
     uint32_t triangles;  // live triangles using the vertex
     uint32_t flags;
+    float tHigh;  // interpolation weight of the key's larger vertex id (colours)
   };
 
   std::vector<uint32_t> tetRecord_;  // per tet: its record, or kNone
@@ -181,6 +214,7 @@ class IncrementalIsosurface {
 
   // Vertex slots.
   std::vector<float> positions_, normals_;  // 3 per slot
+  std::vector<float> colours_;              // 1 per slot
   std::vector<Vertex> vertices_;
   std::vector<uint32_t> freeVertices_;
   double area_ = 0;

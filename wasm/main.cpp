@@ -4,7 +4,9 @@
 // ---------------------------------------------------------------------------------------------
 // JS surface (the module is built with -sMODULARIZE -sEXPORT_NAME=createTetstream):
 //
-//   const Module = await createTetstream({ canvas, onPauseChange(paused) { ... } });
+//   const Module = await createTetstream({ canvas, onPauseChange(paused) { ... }, softwareGl });
+//   softwareGl (optional boolean): whether WebGL renders in software (SwiftShader, llvmpipe), if
+//   the page found out already; otherwise main() asks a throwaway context itself.
 //   Module.callMain([]);   // once: creates the WebGL2 context, ImGui and the frame loop
 //   Built with -sINVOKE_RUN=0 so the shell can validate the manifest and start the chunk
 //   downloads first; the functions below work before main() has run. Setting up WebGL on a
@@ -16,6 +18,10 @@
 //   _ts_chunk_file(i) -> const char*
 //       The validated "file" of chunk i (relative to the manifest's URL), "" when out of range.
 //       Valid until the next manifest. Chunk count: stats().chunksTotal.
+//   _ts_check_chunk(i, ptr, len) -> 1 ok | 2 wrong size | 3 wrong hash | 0 no such chunk
+//       Compares downloaded bytes of chunk i with the manifest's size and content hash and
+//       changes nothing: the shell checks every chunk as it arrives, in any order, and fetches
+//       a damaged one again (2, 3) instead of handing it over.
 //   _ts_add_chunk(i, ptr, len) -> 1 | 0
 //       The complete bytes of chunk i, which must be the next one: hand each over as soon as it
 //       (and every chunk before it) has arrived. JS copies each file into wasm memory once
@@ -23,6 +29,13 @@
 //       into it. Verifies (size, hash, zstd, header) and keeps the chunk: cheap, ~1 ms for
 //       256 KB. The base chunk is shown at once; split chunks are applied by the frame loop
 //       within its per-frame budget. 0 = rejected (or the viewer is in "error"): stop sending.
+//       1 with stats().state "error" = accepted, and it was the last chunk that fits in memory.
+//   _ts_set_memory_limit(megabytes)    (double) before _ts_open_manifest: the most memory the
+//                                      dataset may take (?maxMemoryMB=); default and upper bound
+//                                      the wasm maximum (4 GB - 64 KB). The viewer streams up to
+//                                      the last level whose estimate fits (viewer_memory.h).
+//   _ts_set_notice(message)            (C string) what the network side is doing, shown in the
+//                                      panel as is ("" clears): retries, waiting for the network
 //   _ts_download_progress(networkBytes, datasetBytes)   (doubles, cumulative)
 //       Bytes off the wire (aborted requests included) and bytes of the dataset in hand
 //       (verified chunks plus partial downloads): the panel's rate, progress and time left.
@@ -34,6 +47,21 @@
 //                                      following new data
 //   _ts_set_isovalue(value)            (float) re-extracts at once
 //   _ts_set_field(name) -> 1 | 0       (C string) selects a field; isovalue -> middle of its range
+//   _ts_set_colour_field(name) -> 1 | 0  (C string) colour the isosurface by this field ("" or
+//                                      "none": no colouring); the range becomes its range
+//   _ts_set_colour_map(name) -> 1 | 0  viridis, magma, turbo, coolwarm, grey
+//   _ts_set_colour_range(lo, hi)       (doubles) the values mapped to the map's two ends
+//   _ts_set_slice(on, nx, ny, nz, offset)  the slice plane n·p = offset (world units; n need not
+//                                      be unit length, a zero n keeps the plane) on or off
+//   _ts_camera_get(i) -> double        camera: target x, y, z, distance, yaw, pitch (i = 0..5)
+//   _ts_camera_set(tx, ty, tz, distance, yaw, pitch)   sets it and keeps it when the dataset's
+//                                      bounds arrive (a shared link's view)
+//   _ts_camera_gesture(kind, dx, dy)   touch: 0 orbit / 1 pan by CSS pixels, 2 zoom by dx steps
+//   _ts_request_capture()              draws a frame and calls Module.onCapture() right after it,
+//                                      while the canvas still holds it (screenshots)
+//   _ts_set_view_option(name, 0|1)     "boundary", "help"
+//   _ts_set_link_note(text)            a line under the link button ("link copied")
+//   Module.onCopyLink(), Module.onScreenshot(): called by the panel's buttons and the keys
 //   _ts_fail(message)                  (C string) a failure JS saw (HTTP status, network) in
 //                                      plain words; state "error", the shown level stays
 //   _ts_stats_json() -> const char*    JSON described in viewer_state.h (statsJson); the buffer
@@ -43,22 +71,26 @@
 // Runtime methods exported for the shell: callMain, ccall, cwrap, UTF8ToString, HEAPU8 (memory
 // view; re-read it after every call, memory can grow).
 //
-// Frame loop: every animation frame first spends up to its refinement budget applying or undoing
-// splits toward the level target (measured with emscripten_get_now, checked every kStepBatch
-// splits), with the isosurface and hull updated from the changed tets only, then uploads the
-// changed buffer ranges and draws. A frame with nothing to apply and nothing changed draws
-// nothing.
+// Refinement and frames: splits are applied or undone toward the level target in slices of
+// 8 ms (4 ms while the user drags) queued one after another as their own tasks while there is
+// work (ts_work, below), with the isosurface and hull updated from the changed tets only. Every
+// animation frame then uploads the changed buffer ranges and draws, but only when something
+// changed and the GPU has finished the previous frame.
 // ---------------------------------------------------------------------------------------------
 #include <emscripten.h>
+#include <emscripten/heap.h>
 #include <emscripten/html5.h>
+#include <unistd.h>
 
 #include <GLES3/gl3.h>
 #include <GLFW/glfw3.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -90,20 +122,31 @@ struct App {
 
   int dragButton = -1;  // mouse button that started a camera drag, -1 when none
   bool cameraMoved = false;  // by the user since the last framing; if not, a resize re-frames
+  bool cameraPinned = false; // set by the shell (a shared link): the framing keeps it
+  bool captureRequested = false;  // the shell wants the next drawn frame (screenshot)
+  bool dragSlice = false;         // the current drag moves the slice (shift + left drag)
   double lastX = 0, lastY = 0;
 
   int redrawFrames = 2;        // frames still to draw; 0 = idle, nothing changed
   GLsync gpuFence = nullptr;   // after the last drawn frame: signalled once the GPU has done it
   double fenceSince = 0;
   double lastFrameStart = -1;  // emscripten_get_now() of the previous frame callback
+  double lastDrawStart = -1;   // ... of the previous frame that drew
+  bool workQueued = false;     // a refinement slice is queued (see work())
   std::string statsBuffer;
 };
 
-// Refinement work per frame. While the user drags (the view or a slider) 8 ms, half of a 60 Hz
-// frame, so interaction stays smooth; otherwise 16 ms, which still keeps every frame well under
-// 30 ms and doubles how fast a level fills in.
-constexpr double kInteractiveBudgetMs = 8.0;
-constexpr double kIdleBudgetMs = 16.0;
+// Refinement runs in slices of its own between frames (a MessageChannel task loop), not inside
+// the frame callback: on a software or slow GPU a drawn frame takes 100-200 ms to come back
+// (SwiftShader with the hull), and refining only inside frames left the main thread idle most
+// of that time (~11k splits/s on Harmonic 64 in SwiftShader). A slice is short enough that
+// input and network callbacks wait at most that long, and a frame callback is delayed by at
+// most one slice: 8 ms, 4 ms while the user drags the view or a slider.
+constexpr double kSliceMs = 8.0;
+constexpr double kInteractiveSliceMs = 4.0;
+// Download progress alone (no new level) redraws the panel at most this often: each drawn frame
+// costs a software GPU tens of ms that the first surface and refinement need more.
+constexpr double kProgressRedrawMs = 250.0;
 
 App g_app;
 
@@ -138,13 +181,19 @@ void syncCanvasSize() {
 // ---------------------------------------------------------------- mouse -> camera
 // Installed before ImGui's GLFW backend, which chains to them. Camera input only when ImGui
 // does not want the mouse; a drag that started on the canvas keeps going over the panel.
-void onMouseButton(GLFWwindow*, int button, int action, int) {
+// Shift + left drag moves the slice along its normal (up = forward): the whole range over the
+// canvas height.
+void onMouseButton(GLFWwindow* w, int button, int action, int mods) {
   requestRedraw();
   if (action == GLFW_PRESS && g_app.dragButton < 0 && !ImGui::GetIO().WantCaptureMouse) {
     g_app.dragButton = button;
+    const bool shift = (mods & GLFW_MOD_SHIFT) || glfwGetKey(w, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS ||
+                       glfwGetKey(w, GLFW_KEY_RIGHT_SHIFT) == GLFW_PRESS;
+    g_app.dragSlice = button == GLFW_MOUSE_BUTTON_LEFT && shift && g_app.state.sliceOn;
     glfwGetCursorPos(g_app.window, &g_app.lastX, &g_app.lastY);
   } else if (action == GLFW_RELEASE && button == g_app.dragButton) {
     g_app.dragButton = -1;
+    g_app.dragSlice = false;
   }
 }
 
@@ -154,6 +203,14 @@ void onCursorPos(GLFWwindow*, double x, double y) {
   float dx = float(x - g_app.lastX), dy = float(y - g_app.lastY);
   g_app.lastX = x;
   g_app.lastY = y;
+  if (g_app.dragSlice) {
+    ViewerState& s = g_app.state;
+    float lo = 0, hi = 0;
+    sliceOffsetRange(s, lo, hi);
+    const float offset = s.slice.offset() - dy * (hi - lo) / float(std::max(g_app.height, 1));
+    setSlicePlane(s, s.slice.normal(), std::clamp(offset, lo, hi));
+    return;
+  }
   g_app.cameraMoved = true;
   if (g_app.dragButton == GLFW_MOUSE_BUTTON_LEFT)
     g_app.camera.orbit(dx, dy, float(g_app.height));
@@ -181,7 +238,64 @@ EM_BOOL onWheel(int, const EmscriptenWheelEvent* e, void*) {
 
 void ignoreScroll(GLFWwindow*, double, double) {}
 
-void onKey(GLFWwindow*, int, int, int, int) { requestRedraw(); }
+void resetView() {
+  g_app.camera.reset(aspect());
+  g_app.cameraMoved = false;
+  g_app.cameraPinned = false;
+}
+
+// Moves the slice by a fiftieth of its range (sign: forward / back).
+void nudgeSlice(float sign) {
+  ViewerState& s = g_app.state;
+  float lo = 0, hi = 0;
+  sliceOffsetRange(s, lo, hi);
+  setSlicePlane(s, s.slice.normal(), std::clamp(s.slice.offset() + sign * (hi - lo) / 50.f, lo, hi));
+}
+
+// Keyboard shortcuts (panel.cpp lists them in the help panel). Printable ones come as
+// characters (layout-independent: '?' is whatever the keyboard makes it), the others as keys.
+// None while ImGui edits text.
+bool keysForUs() { return !(ImGui::GetCurrentContext() && ImGui::GetIO().WantTextInput); }
+
+void onChar(GLFWwindow*, unsigned int c) {
+  requestRedraw();
+  if (!keysForUs()) return;
+  ViewerState& s = g_app.state;
+  const Manifest& m = s.dataset.manifest;
+  switch (c) {
+    case '?': s.showHelp = !s.showHelp; break;
+    case 'r': case 'R': resetView(); break;
+    case 'b': case 'B': s.showBoundary = !s.showBoundary; break;
+    case 'p': case 'P': setSliceEnabled(s, !s.sliceOn); break;
+    case 'x': case 'X': case 'y': case 'Y': case 'z': case 'Z': {
+      const int k = (c | 0x20) - 'x';
+      std::array<float, 3> axis{0, 0, 0};
+      axis[size_t(k)] = 1;
+      setSlicePlane(s, axis, 0.5f * (m.bounds.min[k] + m.bounds.max[k]));
+      setSliceEnabled(s, true);
+      break;
+    }
+    case '[': nudgeSlice(-1); break;
+    case ']': nudgeSlice(1); break;
+    case 'c': case 'C':
+      if (!m.fields.empty()) setColourField(s, s.colourField + 1 >= int(m.fields.size()) ? -1 : s.colourField + 1);
+      break;
+    case 'm': case 'M': setColourMap(s, ColourMap((int(s.colourMap) + 1) % kColourMapCount)); break;
+    case 'l': case 'L': EM_ASM({ if (Module.onCopyLink) Module.onCopyLink(); }); break;
+    case 's': case 'S': EM_ASM({ if (Module.onScreenshot) Module.onScreenshot(); }); break;
+    case ' ':
+      if (downloading(s) || s.paused) setPaused(s, !s.paused);
+      break;
+    default: break;
+  }
+}
+
+void onKey(GLFWwindow*, int key, int, int action, int) {
+  requestRedraw();
+  if (action != GLFW_PRESS || !keysForUs()) return;
+  if (key == GLFW_KEY_F1) g_app.state.showHelp = !g_app.state.showHelp;
+  if (key == GLFW_KEY_ESCAPE) g_app.state.showHelp = false;
+}
 
 // Tells the shell that downloading was paused or resumed (it owns the fetches).
 void notifyPause() {
@@ -196,8 +310,15 @@ void drawFrame() {
   App& a = g_app;
   ViewerState& s = a.state;
   if (s.frameRequested) {
+    const OrbitCamera pinned = a.camera;
     a.camera.setBounds(s.dataset.manifest.bounds.min, s.dataset.manifest.bounds.max, aspect());
-    a.cameraMoved = false;
+    if (a.cameraPinned) {  // a view from a link: the bounds change, the view does not
+      a.camera.target = pinned.target;
+      a.camera.distance = pinned.distance;
+      a.camera.yaw = pinned.yaw;
+      a.camera.pitch = pinned.pitch;
+    }
+    a.cameraMoved = a.cameraPinned;
     s.frameRequested = false;
   }
 
@@ -205,11 +326,16 @@ void drawFrame() {
   ImGui_ImplGlfw_NewFrame();
   ImGui::NewFrame();
   PanelActions actions = drawPanel(s, a.uiScale, float(a.pixelRatio));
-  if (actions.layoutChanged) requestRedraw();
-  if (actions.resetView) {
-    a.camera.reset(aspect());
-    a.cameraMoved = false;
+  const bool helpWasOpen = s.showHelp;
+  drawHelp(s.showHelp, a.uiScale);
+  if (actions.layoutChanged || helpWasOpen != s.showHelp) requestRedraw();
+  if (actions.resetView) resetView();
+  if (actions.toggleHelp) {
+    s.showHelp = !s.showHelp;
+    requestRedraw();
   }
+  if (actions.copyLink) EM_ASM({ if (Module.onCopyLink) Module.onCopyLink(); });
+  if (actions.screenshot) EM_ASM({ if (Module.onScreenshot) Module.onScreenshot(); });
   ImGui::Render();
 
   if (s.surfaceDirty) {
@@ -217,22 +343,39 @@ void drawFrame() {
     s.surface.clearChanges();
     s.surfaceDirty = false;
   }
+  if (s.sliceDirty) {
+    uploadSlice(a.renderer, s.slice.surface());
+    s.slice.surface().clearChanges();
+    s.sliceDirty = false;
+  }
   if (s.hullDirty) {
     uploadHull(a.renderer, s.hull);
     s.hull.clearChanges();
     s.hullDirty = false;
   }
+  s.gpuBytes = gpuBufferBytes(a.renderer);
   s.uploadBytes = a.renderer.uploads.bytes;
   s.fullUploads = a.renderer.uploads.full;
   s.partialUploads = a.renderer.uploads.partial;
+  s.grownUploads = a.renderer.uploads.grown;
   FrameParams p;
   p.view = a.camera.view();
   p.projection = a.camera.projection(aspect());
   p.framebufferWidth = a.width;
   p.framebufferHeight = a.height;
   p.showBoundary = s.showBoundary;
+  p.colourBy = s.colourField >= 0;
+  p.colourMin = s.colourMin;
+  p.colourMax = s.colourMax;
+  p.showSlice = s.sliceOn;
+  setColourMap(a.renderer, s.colourMap);
   drawScene(a.renderer, p);
   ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+  if (a.captureRequested) {
+    // Read back in the same task as the drawing (the drawing buffer is not preserved after).
+    a.captureRequested = false;
+    EM_ASM({ if (Module.onCapture) Module.onCapture(); });
+  }
 
   // The surface's draw calls are submitted; the browser presents them when this callback returns.
   const double now = emscripten_get_now();
@@ -259,6 +402,49 @@ bool gpuBusy(double now) {
   return false;
 }
 
+// ---------------------------------------------------------------- refinement between frames
+void noteComplete(ViewerState& s) {
+  if (s.state == LoadState::Complete && s.completeMs < 0) s.completeMs = emscripten_get_now();
+}
+
+bool interacting() {
+  return g_app.dragButton >= 0 || (ImGui::GetCurrentContext() && ImGui::IsAnyItemActive());
+}
+
+void queueWork() {
+  if (g_app.workQueued) return;
+  g_app.workQueued = true;
+  // A message to a MessageChannel port runs as its own task soon after, without setTimeout's
+  // 4 ms clamp; rendering, input and network callbacks get their turns in between.
+  EM_ASM({
+    if (!Module.tsWorkChannel) {
+      Module.tsWorkChannel = new MessageChannel();
+      Module.tsWorkChannel.port1.onmessage = () => Module._ts_work();
+    }
+    Module.tsWorkChannel.port2.postMessage(0);
+  });
+}
+
+}  // namespace
+
+// One refinement slice (called from the MessageChannel task queued above; not for the shell).
+extern "C" EMSCRIPTEN_KEEPALIVE void ts_work() {
+  App& a = g_app;
+  ViewerState& s = a.state;
+  a.workQueued = false;
+  const double start = emscripten_get_now();
+  const double deadline = start + (interacting() ? kInteractiveSliceMs : kSliceMs);
+  if (refining(s)) {
+    if (advance(s, deadline, emscripten_get_now)) requestRedraw();
+  } else {
+    growTree(s, deadline, emscripten_get_now);
+  }
+  noteComplete(s);
+  if (refining(s) || treePending(s)) queueWork();
+}
+
+namespace {
+
 // ---------------------------------------------------------------- frame
 void frame() {
   App& a = g_app;
@@ -273,19 +459,23 @@ void frame() {
   a.lastFrameStart = start;
   syncCanvasSize();
   tick(s, start);
-  const bool interacting = a.dragButton >= 0 || (ImGui::GetCurrentContext() && ImGui::IsAnyItemActive());
-  const double budget = interacting ? kInteractiveBudgetMs : kIdleBudgetMs;
-  if (advance(s, start + budget, emscripten_get_now)) requestRedraw();
-  if (s.state == LoadState::Complete && s.completeMs < 0) s.completeMs = emscripten_get_now();
-  if (downloading(s)) requestRedraw(1);  // progress and rate move
+  noteComplete(s);
+  if (refining(s) || treePending(s)) queueWork();
+  if (downloading(s) && start - a.lastDrawStart >= kProgressRedrawMs) requestRedraw(1);  // progress and rate move
   // Draw only when something changed: on a software GL (SwiftShader) or a slow GPU a frame can
   // take tens of milliseconds of main-thread time that downloading and decoding need more.
-  if (s.surfaceDirty || s.hullDirty || s.frameRequested || a.dragButton >= 0) requestRedraw();
-  if (a.redrawFrames > 0 && !gpuBusy(start)) {
+  if (s.surfaceDirty || s.hullDirty || s.sliceDirty || s.frameRequested || a.dragButton >= 0) requestRedraw();
+  // The first surface is drawn at once, even behind a frame the GPU has not finished.
+  const bool firstSurface = s.surfaceReady && s.firstSurfaceMs < 0;
+  if (a.redrawFrames > 0 && (firstSurface || !gpuBusy(start))) {
     --a.redrawFrames;
+    a.lastDrawStart = start;
     drawFrame();
+    if (a.gpuFence) glDeleteSync(a.gpuFence);
     a.gpuFence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
     a.fenceSince = start;
+    s.drawMs = emscripten_get_now() - start;
+    if (measuring) s.maxDrawMs = std::max(s.maxDrawMs, s.drawMs);
   }
   notifyPause();
   const double end = emscripten_get_now();
@@ -302,8 +492,11 @@ bool initPlatform(std::string& error) {
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 0);
   // A software rasterizer (SwiftShader or llvmpipe: also Chrome's fallback when the GPU is
   // unusable) pays for 4x multisampling with 2-3x the frame time, hardware hardly notices it.
-  // The renderer's name is only visible through a context, so a throwaway one is asked first.
+  // The renderer's name is only visible through a context, so a throwaway one is asked first;
+  // the shell may have asked already while the program downloaded (Module.softwareGl), which
+  // takes this 30-300 ms (on SwiftShader) off the way to the first picture.
   g_app.softwareGl = EM_ASM_INT({
+    if (typeof Module.softwareGl === 'boolean') return Module.softwareGl ? 1 : 0;
     try {
       const gl = document.createElement('canvas').getContext('webgl2');
       if (!gl) return 0;
@@ -332,6 +525,7 @@ bool initPlatform(std::string& error) {
   glfwSetCursorPosCallback(g_app.window, onCursorPos);
   emscripten_set_wheel_callback("#canvas", nullptr, EM_TRUE, onWheel);
   glfwSetKeyCallback(g_app.window, onKey);
+  glfwSetCharCallback(g_app.window, onChar);
 
   std::string info;
   if (!initRenderer(g_app.renderer, info, error)) {
@@ -368,13 +562,52 @@ bool initPlatform(std::string& error) {
 
 }  // namespace
 
+// Grows the wasm memory now to hold `bytes`, so that a refusal (past the 4 GB maximum, or the
+// browser short of memory) is an answer here rather than a failed allocation deep inside a
+// vector, which would abort the module.
+bool reserveHeap(uint64_t bytes) {
+  if (bytes > emscripten_get_heap_max()) return false;
+  if (bytes <= emscripten_get_heap_size()) return true;
+  return emscripten_resize_heap(size_t(bytes)) != 0;
+}
+
+// Heap in use before a dataset, plus what the UI and the shell's chunk copies take later.
+constexpr uint64_t kUiAndTransferBytes = 16u << 20;
+
 // ---------------------------------------------------------------- the JS boundary
 extern "C" {
+
+EMSCRIPTEN_KEEPALIVE void ts_set_memory_limit(double megabytes) {
+  const uint64_t max = emscripten_get_heap_max();
+  g_app.state.memoryLimitBytes =
+      megabytes > 0 && megabytes * (1 << 20) < double(max) ? uint64_t(megabytes * (1 << 20)) : max;
+}
+
+EMSCRIPTEN_KEEPALIVE int ts_check_chunk(int index, const uint8_t* bytes, int len) {
+  if (index < 0 || len < 0 || (!bytes && len > 0)) return 0;
+  switch (checkChunk(g_app.state, uint32_t(index), std::span<const uint8_t>(bytes, size_t(len)))) {
+    case ChunkCheck::Ok: return 1;
+    case ChunkCheck::WrongSize: return 2;
+    case ChunkCheck::WrongHash: return 3;
+    case ChunkCheck::NoSuchChunk: return 0;
+  }
+  return 0;
+}
+
+EMSCRIPTEN_KEEPALIVE void ts_set_notice(const char* message) {
+  requestRedraw();
+  setNotice(g_app.state, message ? message : "");
+}
 
 EMSCRIPTEN_KEEPALIVE int ts_open_manifest(const char* json, int len) {
   requestRedraw();
   if (!g_app.platformError.empty()) return 0;  // nothing could be shown; keep that error visible
+  g_app.cameraPinned = false;  // a new dataset is framed unless the shell sets a view again
   if (!json || len < 0) return 0;
+  ViewerState& s = g_app.state;
+  if (!s.memoryLimitBytes) ts_set_memory_limit(0);
+  s.memoryBaseBytes = uint64_t(reinterpret_cast<uintptr_t>(sbrk(0))) + kUiAndTransferBytes;
+  s.reserveHeap = reserveHeap;
   return openManifest(g_app.state, std::string_view(json, size_t(len))).ok() ? 1 : 0;
 }
 
@@ -418,6 +651,83 @@ EMSCRIPTEN_KEEPALIVE int ts_set_field(const char* name) {
   return name && setField(g_app.state, std::string_view(name)) ? 1 : 0;
 }
 
+EMSCRIPTEN_KEEPALIVE int ts_set_colour_field(const char* name) {
+  requestRedraw();
+  return name && setColourField(g_app.state, std::string_view(name)) ? 1 : 0;
+}
+
+EMSCRIPTEN_KEEPALIVE int ts_set_colour_map(const char* name) {
+  requestRedraw();
+  std::optional<ColourMap> m = name ? parseColourMap(name) : std::nullopt;
+  if (m) setColourMap(g_app.state, *m);
+  return m ? 1 : 0;
+}
+
+EMSCRIPTEN_KEEPALIVE void ts_set_colour_range(double lo, double hi) {
+  requestRedraw();
+  setColourRange(g_app.state, float(lo), float(hi));
+}
+
+EMSCRIPTEN_KEEPALIVE void ts_set_slice(int on, double nx, double ny, double nz, double offset) {
+  requestRedraw();
+  setSlicePlane(g_app.state, {float(nx), float(ny), float(nz)}, float(offset));
+  setSliceEnabled(g_app.state, on != 0);
+}
+
+// The camera as six numbers: target x, y, z, distance, yaw, pitch (camera.h).
+EMSCRIPTEN_KEEPALIVE double ts_camera_get(int i) {
+  const OrbitCamera& c = g_app.camera;
+  const double v[6] = {c.target.x, c.target.y, c.target.z, c.distance, c.yaw, c.pitch};
+  return i >= 0 && i < 6 ? v[i] : 0;
+}
+
+EMSCRIPTEN_KEEPALIVE void ts_camera_set(double tx, double ty, double tz, double distance, double yaw, double pitch) {
+  const double v[6] = {tx, ty, tz, distance, yaw, pitch};
+  for (double x : v)
+    if (!std::isfinite(x)) return;
+  if (!(distance > 0)) return;
+  OrbitCamera& c = g_app.camera;
+  c.target = glm::vec3(float(tx), float(ty), float(tz));
+  c.distance = float(distance);
+  c.yaw = float(yaw);
+  c.pitch = std::clamp(float(pitch), -1.55f, 1.55f);
+  g_app.cameraMoved = g_app.cameraPinned = true;
+  requestRedraw();
+}
+
+// Touch gestures from the shell (pointer events, CSS pixels): 0 orbit, 1 pan by (dx, dy);
+// 2 zoom by dx wheel steps.
+EMSCRIPTEN_KEEPALIVE void ts_camera_gesture(int kind, double dx, double dy) {
+  if (!std::isfinite(dx) || !std::isfinite(dy)) return;
+  OrbitCamera& c = g_app.camera;
+  const float k = float(g_app.pixelRatio);
+  if (kind == 0) c.orbit(float(dx) * k, float(dy) * k, float(g_app.height));
+  else if (kind == 1) c.pan(float(dx) * k, float(dy) * k, float(g_app.height));
+  else if (kind == 2) c.zoom(float(dx));
+  else return;
+  g_app.cameraMoved = true;
+  requestRedraw();
+}
+
+// Draws a frame soon and calls Module.onCapture() right after it (screenshot).
+EMSCRIPTEN_KEEPALIVE void ts_request_capture() {
+  g_app.captureRequested = true;
+  requestRedraw(1);
+}
+
+EMSCRIPTEN_KEEPALIVE void ts_set_view_option(const char* name, int value) {
+  requestRedraw();
+  if (!name) return;
+  const std::string_view n(name);
+  if (n == "boundary") g_app.state.showBoundary = value != 0;
+  if (n == "help") g_app.state.showHelp = value != 0;
+}
+
+EMSCRIPTEN_KEEPALIVE void ts_set_link_note(const char* note) {
+  requestRedraw();
+  g_app.state.linkNote = note ? note : "";
+}
+
 EMSCRIPTEN_KEEPALIVE void ts_fail(const char* message) {
   requestRedraw();
   failLoad(g_app.state, message ? message : "");
@@ -425,6 +735,7 @@ EMSCRIPTEN_KEEPALIVE void ts_fail(const char* message) {
 
 EMSCRIPTEN_KEEPALIVE const char* ts_stats_json() {
   tick(g_app.state, emscripten_get_now());
+  g_app.state.heapBytes = emscripten_get_heap_size();
   g_app.statsBuffer = statsJson(g_app.state);
   return g_app.statsBuffer.c_str();
 }

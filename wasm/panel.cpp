@@ -5,7 +5,9 @@
 #include <cstdio>
 #include <string>
 
+#include "colourmap.h"
 #include "imgui.h"
+#include "viewer_memory.h"
 
 namespace tetstream::viewer {
 namespace {
@@ -34,9 +36,7 @@ std::string rate(double bytesPerSec) {
 
 std::string duration(double seconds) {
   char buf[32];
-  if (seconds < 1)
-    return "under a second";
-  else if (seconds < 90)
+  if (seconds < 90)
     std::snprintf(buf, sizeof buf, "%.0f s", seconds);
   else
     std::snprintf(buf, sizeof buf, "%.0f min", seconds / 60);
@@ -54,6 +54,15 @@ Rect cssRect(float pixelsPerCssPixel) {
   ImVec2 lo = ImGui::GetItemRectMin(), hi = ImGui::GetItemRectMax();
   float k = 1.f / pixelsPerCssPixel;
   return {lo.x * k, lo.y * k, ImGui::CalcItemWidth() * k, (hi.y - lo.y) * k};
+}
+
+const ImVec4 kWarning(1.f, 0.75f, 0.35f, 1.f);
+const ImVec4 kError(1.f, 0.45f, 0.4f, 1.f);
+
+void coloredWrapped(const ImVec4& color, const std::string& text) {
+  ImGui::PushStyleColor(ImGuiCol_Text, color);
+  ImGui::TextWrapped("%s", text.c_str());
+  ImGui::PopStyleColor();
 }
 
 void section(const char* title) {
@@ -79,6 +88,7 @@ void downloadSection(ViewerState& s, float width, float pixelsPerCssPixel) {
   ImGui::ProgressBar(total ? float(double(have) / double(total)) : 0.f, ImVec2(width, 0), label.c_str());
 
   s.pauseButtonRect = {};
+  if (!s.notice.empty() && s.state != LoadState::Error) coloredWrapped(kWarning, s.notice);
   if (allReceived || s.state == LoadState::Error) return;
   // One line that is always there, so the button below does not move under the mouse.
   if (s.paused) {
@@ -86,7 +96,10 @@ void downloadSection(ViewerState& s, float width, float pixelsPerCssPixel) {
   } else {
     double left = secondsLeft(s);
     std::string line = s.rateBytesPerSec > 0 ? rate(s.rateBytesPerSec) : std::string("waiting for data");
-    if (left >= 0) line += ", about " + duration(left) + " left";
+    if (left >= 1)
+      line += ", about " + duration(left) + " left";
+    else if (left >= 0)
+      line += ", less than a second left";
     ImGui::TextUnformatted(line.c_str());
   }
   if (ImGui::Button(s.paused ? "resume download" : "pause download")) setPaused(s, !s.paused);
@@ -151,6 +164,128 @@ void levelSection(ViewerState& s, float width, float pixelsPerCssPixel) {
   }
 }
 
+// What the viewer holds now and what the dataset will need, against the limit.
+void memorySection(const ViewerState& s) {
+  // Folds away while the slice is on, like the timings (the panel would outgrow the screen).
+  static int lastSliceOn = -1;
+  if (int(s.sliceOn) != lastSliceOn) ImGui::SetNextItemOpen(!s.sliceOn);
+  lastSliceOn = int(s.sliceOn);
+  ImGui::Spacing();
+  if (!ImGui::TreeNodeEx("memory", ImGuiTreeNodeFlags_NoTreePushOnOpen)) return;
+  row("in use", formatBytes(memoryInUse(s)) + " (page heap " + formatBytes(s.heapBytes) + ")");
+  row("on the GPU", formatBytes(s.gpuBytes));
+  if (s.chunksTotal == 0) return;
+  std::string need = "about " + formatBytes(s.memoryNeededBytes);
+  if (s.memoryLimitBytes) need += ", limit " + formatBytes(s.memoryLimitBytes);
+  row("full dataset", need);
+  if (s.chunksAllowed < s.chunksTotal && s.state != LoadState::Error && s.chunksAllowed > 0) {
+    const Manifest& m = s.dataset.manifest;
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "Too big for this page: streaming will stop after part %u of %u (%.1f%% of the vertices).",
+                  s.chunksAllowed, s.chunksTotal,
+                  m.vertices ? 100.0 * m.chunks[s.chunksAllowed - 1].vertices / m.vertices : 0.0);
+    coloredWrapped(kWarning, buf);
+  }
+}
+
+// The colour bar: the map over the range, drawn in 64 bands, with five values under it.
+void colourBar(const ViewerState& s, float width, float pixelsPerCssPixel) {
+  ImDrawList* dl = ImGui::GetWindowDrawList();
+  const float fs = ImGui::GetFontSize();
+  const ImVec2 p = ImGui::GetCursorScreenPos();
+  const float h = 1.2f * fs, inset = 1.6f * fs, w = width - 2 * inset;
+  const ImVec2 lo(p.x + inset, p.y);
+  constexpr int kBands = 64;
+  for (int i = 0; i < kBands; ++i) {
+    auto c0 = mapColour(s.colourMap, float(i) / kBands, 0, 1);
+    auto c1 = mapColour(s.colourMap, float(i + 1) / kBands, 0, 1);
+    ImU32 a = ImGui::ColorConvertFloat4ToU32(ImVec4(c0[0], c0[1], c0[2], 1));
+    ImU32 b = ImGui::ColorConvertFloat4ToU32(ImVec4(c1[0], c1[1], c1[2], 1));
+    dl->AddRectFilledMultiColor(ImVec2(lo.x + w * i / kBands, lo.y), ImVec2(lo.x + w * (i + 1) / kBands + 0.5f, lo.y + h), a, b, b, a);
+  }
+  dl->AddRect(ImVec2(lo.x - 1, lo.y - 1), ImVec2(lo.x + w + 1, lo.y + h + 1), IM_COL32(200, 200, 200, 160));
+  const ImU32 text = ImGui::GetColorU32(ImGuiCol_Text);
+  for (int k = 0; k <= 4; ++k) {
+    const float x = lo.x + w * k / 4;
+    dl->AddLine(ImVec2(x, lo.y + h), ImVec2(x, lo.y + h + 0.35f * fs), text);
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.4g", s.colourMin + (s.colourMax - s.colourMin) * k / 4.f);
+    const float tw = ImGui::CalcTextSize(buf).x;
+    dl->AddText(ImVec2(x - 0.5f * tw, lo.y + h + 0.4f * fs), text, buf);
+  }
+  ImGui::Dummy(ImVec2(width, h + 1.5f * fs));
+  (void)pixelsPerCssPixel;
+}
+
+void colourSection(ViewerState& s, float width, float pixelsPerCssPixel) {
+  const Manifest& m = s.dataset.manifest;
+  section("colour");
+  ImGui::PushItemWidth(width - ImGui::GetFontSize() * 5.5f);
+  const char* current = s.colourField >= 0 ? m.fields[size_t(s.colourField)].name.c_str() : "none (two-sided)";
+  if (ImGui::BeginCombo("colour by", current)) {
+    if (ImGui::Selectable("none (two-sided)", s.colourField < 0)) setColourField(s, -1);
+    for (size_t i = 0; i < m.fields.size(); ++i)
+      if (ImGui::Selectable(m.fields[i].name.c_str(), int(i) == s.colourField)) setColourField(s, int(i));
+    ImGui::EndCombo();
+  }
+  if (s.colourField >= 0) {
+    if (ImGui::BeginCombo("colour map", colourMapName(s.colourMap))) {
+      for (int i = 0; i < kColourMapCount; ++i)
+        if (ImGui::Selectable(colourMapName(ColourMap(i)), int(s.colourMap) == i)) setColourMap(s, ColourMap(i));
+      ImGui::EndCombo();
+    }
+    float range[2] = {s.colourMin, s.colourMax};
+    const Range fr = m.fields[size_t(s.colourField)].range;
+    const float speed = float(fr.max - fr.min) / 500.f;
+    if (ImGui::DragFloat2("range", range, speed > 0 ? speed : 0.01f, 0, 0, "%.4g")) setColourRange(s, range[0], range[1]);
+    ImGui::SameLine();
+    if (ImGui::SmallButton("reset")) setColourRange(s, float(fr.min), float(fr.max));
+  }
+  ImGui::PopItemWidth();
+  if (s.colourField >= 0) colourBar(s, width, pixelsPerCssPixel);
+}
+
+// The slice: on/off, x/y/z or free orientation (two angles), and its position.
+void sliceSection(ViewerState& s, float width, float pixelsPerCssPixel) {
+  section("slice");
+  bool on = s.sliceOn;
+  if (ImGui::Checkbox("slice plane", &on)) setSliceEnabled(s, on);
+  if (!s.sliceOn) return;
+  const auto n = s.slice.normal();
+  float lo = 0, hi = 0;
+  sliceOffsetRange(s, lo, hi);
+  static const char* kAxes[3] = {"x", "y", "z"};
+  for (int k = 0; k < 3; ++k) {
+    ImGui::SameLine();
+    if (ImGui::SmallButton(kAxes[k])) {
+      std::array<float, 3> axis{0, 0, 0};
+      axis[size_t(k)] = 1;
+      const Bounds& b = s.dataset.manifest.bounds;
+      setSlicePlane(s, axis, 0.5f * (b.min[k] + b.max[k]));
+    }
+  }
+  ImGui::PushItemWidth(width - ImGui::GetFontSize() * 5.5f);
+  // Free orientation: azimuth around z and elevation from the xy plane.
+  float az = std::atan2(n[1], n[0]) * 57.29578f, el = std::asin(std::clamp(n[2], -1.f, 1.f)) * 57.29578f;
+  bool turned = ImGui::SliderFloat("azimuth", &az, -180.f, 180.f, "%.0f deg");
+  turned |= ImGui::SliderFloat("elevation", &el, -90.f, 90.f, "%.0f deg");
+  if (turned) {
+    const float a = az / 57.29578f, e = el / 57.29578f;
+    // The same relative position across the bounds for the new normal.
+    const float frac = hi > lo ? (s.slice.offset() - lo) / (hi - lo) : 0.5f;
+    const std::array<float, 3> m{std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e)};
+    float lo2 = 0, hi2 = 0;
+    SliceTracker::offsetRange(m, s.dataset.manifest.bounds.min, s.dataset.manifest.bounds.max, lo2, hi2);
+    setSlicePlane(s, m, lo2 + frac * (hi2 - lo2));
+  }
+  float offset = s.slice.offset();
+  if (ImGui::SliderFloat("position", &offset, lo, hi, "%.4g")) setSlicePlane(s, s.slice.normal(), offset);
+  s.sliceSliderRect = cssRect(pixelsPerCssPixel);
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("Or shift + drag in the view, or [ and ].");
+  ImGui::PopItemWidth();
+  row("triangles", grouped(s.slice.surface().triangleCount()));
+}
+
 }  // namespace
 
 PanelActions drawPanel(ViewerState& s, float uiScale, float pixelsPerCssPixel) {
@@ -167,10 +302,17 @@ PanelActions drawPanel(ViewerState& s, float uiScale, float pixelsPerCssPixel) {
   ImGui::TextUnformatted(!haveDataset ? "no dataset" : m.name.empty() ? "(unnamed dataset)" : m.name.c_str());
   if (s.state == LoadState::Idle) ImGui::TextDisabled("waiting for a dataset");
   if (s.state == LoadState::Complete) ImGui::TextDisabled("complete: every part received and applied");
-  if (s.state == LoadState::Error) {
-    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.f, 0.45f, 0.4f, 1.f));
-    ImGui::TextWrapped("Error: %s", s.error.c_str());
-    ImGui::PopStyleColor();
+  if (s.state == LoadState::Error) coloredWrapped(kError, (s.memoryLimited ? "Stopped: " : "Error: ") + s.error);
+  if (ImGui::SmallButton("copy link")) actions.copyLink = true;
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("Copies a link that opens this view: dataset, fields, colours, slice,\nlevel and camera (L).");
+  ImGui::SameLine();
+  if (ImGui::SmallButton("screenshot")) actions.screenshot = true;
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("Saves the picture as a PNG (S).");
+  ImGui::SameLine();
+  if (ImGui::SmallButton("keys (?)")) actions.toggleHelp = true;
+  if (!s.linkNote.empty()) {
+    ImGui::SameLine();
+    ImGui::TextDisabled("%s", s.linkNote.c_str());
   }
 
   if (haveDataset) {
@@ -202,12 +344,22 @@ PanelActions drawPanel(ViewerState& s, float uiScale, float pixelsPerCssPixel) {
     }
   }
 
+  if (s.field >= 0) colourSection(s, width, pixelsPerCssPixel);
+  if (s.field >= 0 && haveDataset) sliceSection(s, width, pixelsPerCssPixel);
+
+  memorySection(s);
+
   ImGui::Spacing();
   ImGui::Checkbox("show boundary", &s.showBoundary);
   ImGui::SameLine();
   if (ImGui::Button("reset view")) actions.resetView = true;
 
   ImGui::Separator();
+  // Timings fold away while the slice is on (the panel would outgrow a laptop screen).
+  static int lastSliceOn = -1;
+  if (int(s.sliceOn) != lastSliceOn) ImGui::SetNextItemOpen(!s.sliceOn);
+  lastSliceOn = int(s.sliceOn);
+  if (ImGui::TreeNodeEx("timings", ImGuiTreeNodeFlags_NoTreePushOnOpen)) {
   ImGui::TextDisabled("frames every %.1f ms, longest frame %.0f ms", s.frameMs, s.maxFrameMs);
   if (s.refineSteps)
     ImGui::TextDisabled("last refinement %.1f ms (%u splits)", s.refineMs, s.refineSteps);
@@ -218,16 +370,63 @@ PanelActions drawPanel(ViewerState& s, float uiScale, float pixelsPerCssPixel) {
     else
       ImGui::TextDisabled("first surface at %.2f s", s.firstSurfaceMs / 1000);
   }
-  ImGui::TextDisabled("drag rotates, right-drag pans, wheel zooms");
+  }
+  ImGui::TextDisabled("drag rotates, right-drag pans, wheel zooms; ? for keys");
 
   ImGui::PopTextWrapPos();
   // An auto-resizing window takes its size from the previous frame's content.
   static ImVec2 lastSize;
   ImVec2 size = ImGui::GetWindowSize();
+  {
+    const ImVec2 pos = ImGui::GetWindowPos();
+    const float k = 1.f / pixelsPerCssPixel;
+    s.panelRect = {pos.x * k, pos.y * k, size.x * k, size.y * k};
+  }
   actions.layoutChanged = size.x != lastSize.x || size.y != lastSize.y;
   lastSize = size;
   ImGui::End();
   return actions;
+}
+
+const Shortcut kShortcuts[] = {
+    {"? or F1", "show / hide this help"},
+    {"R", "reset the view"},
+    {"B", "show / hide the domain boundary"},
+    {"P", "slice plane on / off"},
+    {"X, Y, Z", "slice across the x, y or z axis"},
+    {"[ and ]", "move the slice back / forward (or shift + drag)"},
+    {"C", "colour by: next field (or none)"},
+    {"M", "next colour map"},
+    {"L", "copy a link to this view"},
+    {"S", "save a screenshot (PNG)"},
+    {"Space", "pause / resume the download"},
+    {"O", "open a packed dataset folder from the disk (or drop it)"},
+    {"Esc", "close this help"},
+};
+const int kShortcutCount = int(sizeof kShortcuts / sizeof kShortcuts[0]);
+
+void drawHelp(bool& open, float uiScale) {
+  if (!open) return;
+  const ImGuiViewport* vp = ImGui::GetMainViewport();
+  ImGui::SetNextWindowPos(ImVec2(vp->Size.x * 0.5f, vp->Size.y * 0.5f), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
+  ImGui::SetNextWindowBgAlpha(0.92f);
+  ImGui::Begin("keyboard shortcuts", &open,
+               ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoCollapse);
+  if (ImGui::BeginTable("keys", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit)) {
+    for (int i = 0; i < kShortcutCount; ++i) {
+      ImGui::TableNextRow();
+      ImGui::TableSetColumnIndex(0);
+      ImGui::TextUnformatted(kShortcuts[i].key);
+      ImGui::TableSetColumnIndex(1);
+      ImGui::TextUnformatted(kShortcuts[i].action);
+    }
+    ImGui::EndTable();
+  }
+  ImGui::Spacing();
+  ImGui::TextDisabled("mouse: drag rotates, right-drag pans, wheel zooms");
+  ImGui::TextDisabled("touch: one finger rotates, pinch zooms, two fingers pan");
+  (void)uiScale;
+  ImGui::End();
 }
 
 }  // namespace tetstream::viewer

@@ -11,7 +11,22 @@ namespace tetstream::viewer {
 struct PanelActions {
   bool resetView = false;
   bool layoutChanged = false;  // the panel changed size: draw another frame so it settles
+  bool copyLink = false;       // "copy link": the platform puts the view's URL on the clipboard
+  bool screenshot = false;     // "screenshot": the platform saves the next frame as a PNG
+  bool toggleHelp = false;     // "help": show or hide the keyboard shortcuts
 };
+
+// The keyboard shortcuts, as the help panel lists them: {key, what it does}.
+struct Shortcut {
+  const char* key;
+  const char* action;
+};
+extern const Shortcut kShortcuts[];
+extern const int kShortcutCount;
+
+// The help panel (keyboard shortcuts and mouse/touch gestures); `open` is cleared by its close
+// button.
+void drawHelp(bool& open, float uiScale);
 
 // Call between ImGui::NewFrame() and ImGui::Render(). `uiScale` multiplies sizes given in CSS
 // pixels; `pixelsPerCssPixel` converts ImGui coordinates back to CSS pixels for the slider

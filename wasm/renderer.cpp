@@ -3,6 +3,7 @@
 #include <GLES3/gl3.h>
 
 #include <algorithm>
+#include <cmath>
 #include <span>
 
 #include <glm/gtc/type_ptr.hpp>
@@ -14,14 +15,17 @@ namespace {
 const char* kSurfaceVs = R"(#version 300 es
 layout(location = 0) in vec3 aPosition;
 layout(location = 1) in vec3 aNormal;
+layout(location = 2) in float aColour;  // the colour field (0 where no buffer is bound)
 uniform mat4 uView;
 uniform mat4 uProj;
 out vec3 vPosition;  // view space
 out vec3 vNormal;    // view space (uView is rigid, so its 3x3 part transforms normals)
+out float vColour;
 void main() {
   vec4 p = uView * vec4(aPosition, 1.0);
   vPosition = p.xyz;
   vNormal = mat3(uView) * aNormal;
+  vColour = aColour;
   gl_Position = uProj * p;
 }
 )";
@@ -29,11 +33,18 @@ void main() {
 // Headlight shading: a key light above and left of the eye, a weaker fill from the eye itself,
 // Blinn-Phong highlights and a little sky/ground ambient. Triangle normals point toward
 // increasing field, so a front face is seen from the high side. The low side (the outside of
-// the region above the isovalue) gets the warm colour, the high side a cool one.
+// the region above the isovalue) gets the warm colour, the high side a cool one. Coloured by a
+// field (uColourBy), both sides take the colour map's colour of the interpolated value: the
+// 256x1 map texture at the texel centres, (v - lo) / (hi - lo) clamped (colourmap.h).
 const char* kSurfaceFs = R"(#version 300 es
 precision highp float;
 in vec3 vPosition;
 in vec3 vNormal;
+in float vColour;
+uniform bool uColourBy;
+uniform vec2 uColourRange;
+uniform sampler2D uColourMap;
+uniform float uUnlit;  // 0: lit; up to 1: the plain colour (the slice)
 out vec4 fragColor;
 const vec3 kLowSide = vec3(0.92, 0.56, 0.24);
 const vec3 kHighSide = vec3(0.33, 0.55, 0.80);
@@ -45,12 +56,17 @@ void main() {
   vec3 v = normalize(-vPosition);
   if (dot(n, v) < 0.0) n = normalize(n - 1.01 * dot(n, v) * v);  // interpolated normal past the silhouette
   vec3 base = gl_FrontFacing ? kHighSide : kLowSide;
+  if (uColourBy) {
+    float span = uColourRange.y - uColourRange.x;
+    float x = span > 0.0 ? clamp((vColour - uColourRange.x) / span, 0.0, 1.0) : 0.5;
+    base = texture(uColourMap, vec2((x * 255.0 + 0.5) / 256.0, 0.5)).rgb;
+  }
   vec3 key = normalize(vec3(-0.5, 0.7, 0.75));
   float diffuse = 0.72 * max(dot(n, key), 0.0) + 0.26 * max(dot(n, v), 0.0);
   float ambient = 0.08 + 0.08 * (0.5 + 0.5 * n.y);
   float spec = 0.25 * pow(max(dot(n, normalize(key + v)), 0.0), 40.0);
   vec3 color = base * (ambient + diffuse) + vec3(spec);
-  fragColor = vec4(color, 1.0);
+  fragColor = vec4(mix(color, base * (0.8 + 0.2 * max(dot(n, v), 0.0)), uUnlit), 1.0);
 }
 )";
 
@@ -167,10 +183,13 @@ void sync(Renderer& r, GLenum target, GpuBuffer& buf, const void* data, uint32_t
   if (count > buf.capacity) {
     buf.capacity = std::max(2 * count, 4096u);  // doubling: a whole upload is rare
     glBufferData(target, GLsizeiptr(size_t(buf.capacity) * elemBytes), nullptr, GL_DYNAMIC_DRAW);
+    buf.bytes = uint64_t(buf.capacity) * elemBytes;
+    ++r.uploads.grown;
     full = true;
   }
   if (full) {
-    if (count) glBufferSubData(target, 0, GLsizeiptr(size_t(count) * elemBytes), bytes);
+    if (count == 0) return;  // nothing to send (a cleared hull before the base)
+    glBufferSubData(target, 0, GLsizeiptr(size_t(count) * elemBytes), bytes);
     r.uploads.bytes += uint64_t(count) * elemBytes;
     ++r.uploads.full;
     return;
@@ -207,6 +226,15 @@ void sync(Renderer& r, GLenum target, GpuBuffer& buf, const void* data, uint32_t
 
 }  // namespace
 
+uint64_t gpuBufferBytes(const Renderer& r) {
+  uint64_t n = 0;
+  for (const GpuBuffer* b : {&r.iso.positions, &r.iso.normals, &r.iso.colours, &r.iso.indices, &r.slice.positions,
+                             &r.slice.normals, &r.slice.colours, &r.slice.indices, &r.hullPositions, &r.hullNormals,
+                             &r.lines})
+    n += b->bytes;
+  return n;
+}
+
 bool initRenderer(Renderer& r, std::string& info, std::string& error) {
   info = "GL_VERSION: " + glString(GL_VERSION) + " | GLSL: " + glString(GL_SHADING_LANGUAGE_VERSION) +
          " | GL_RENDERER: " + glString(GL_RENDERER);
@@ -217,17 +245,37 @@ bool initRenderer(Renderer& r, std::string& info, std::string& error) {
   if (!r.isoProgram || !r.hullProgram || !r.lineProgram || !r.backgroundProgram) return false;
   r.isoView = glGetUniformLocation(r.isoProgram, "uView");
   r.isoProj = glGetUniformLocation(r.isoProgram, "uProj");
+  r.isoColourBy = glGetUniformLocation(r.isoProgram, "uColourBy");
+  r.isoColourRange = glGetUniformLocation(r.isoProgram, "uColourRange");
+  r.isoUnlit = glGetUniformLocation(r.isoProgram, "uUnlit");
+  glUseProgram(r.isoProgram);
+  glUniform1i(glGetUniformLocation(r.isoProgram, "uColourMap"), 0);  // texture unit 0
+  glUseProgram(0);
+  glGenTextures(1, &r.colourMapTexture);
+  glBindTexture(GL_TEXTURE_2D, r.colourMapTexture);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  r.colourMapLoaded = -1;
+  setColourMap(r, ColourMap::Viridis);
   r.hullView = glGetUniformLocation(r.hullProgram, "uView");
   r.hullProj = glGetUniformLocation(r.hullProgram, "uProj");
   r.lineViewProj = glGetUniformLocation(r.lineProgram, "uViewProj");
 
-  for (GpuBuffer* b : {&r.isoPositions, &r.isoNormals, &r.isoIndices, &r.hullPositions, &r.hullNormals, &r.lines})
-    glGenBuffers(1, &b->id);
-  glGenVertexArrays(1, &r.isoVao);
-  glBindVertexArray(r.isoVao);
-  bindFloat3(0, r.isoPositions.id);
-  bindFloat3(1, r.isoNormals.id);
-  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, r.isoIndices.id);  // recorded in the VAO
+  for (GpuBuffer* b : {&r.hullPositions, &r.hullNormals, &r.lines}) glGenBuffers(1, &b->id);
+  for (SurfaceGpu* g : {&r.iso, &r.slice}) {
+    for (GpuBuffer* b : {&g->positions, &g->normals, &g->colours, &g->indices}) glGenBuffers(1, &b->id);
+    glGenVertexArrays(1, &g->vao);
+    glBindVertexArray(g->vao);
+    bindFloat3(0, g->positions.id);
+    bindFloat3(1, g->normals.id);
+    glBindBuffer(GL_ARRAY_BUFFER, g->colours.id);
+    glEnableVertexAttribArray(2);
+    glVertexAttribPointer(2, 1, GL_FLOAT, GL_FALSE, 0, nullptr);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g->indices.id);  // recorded in the VAO
+  }
 
   glGenVertexArrays(1, &r.hullVao);
   glBindVertexArray(r.hullVao);
@@ -252,10 +300,12 @@ void destroyRenderer(Renderer& r) {
   glDeleteProgram(r.hullProgram);
   glDeleteProgram(r.lineProgram);
   glDeleteProgram(r.backgroundProgram);
-  for (GpuBuffer* b : {&r.isoPositions, &r.isoNormals, &r.isoIndices, &r.hullPositions, &r.hullNormals, &r.lines})
+  for (GpuBuffer* b : {&r.iso.positions, &r.iso.normals, &r.iso.colours, &r.iso.indices, &r.slice.positions,
+                       &r.slice.normals, &r.slice.colours, &r.slice.indices, &r.hullPositions, &r.hullNormals, &r.lines})
     glDeleteBuffers(1, &b->id);
-  GLuint vaos[4] = {r.isoVao, r.hullVao, r.lineVao, r.emptyVao};
-  glDeleteVertexArrays(4, vaos);
+  glDeleteTextures(1, &r.colourMapTexture);
+  GLuint vaos[5] = {r.iso.vao, r.slice.vao, r.hullVao, r.lineVao, r.emptyVao};
+  glDeleteVertexArrays(5, vaos);
   r = Renderer{};
 }
 
@@ -263,32 +313,38 @@ void warmUpRenderer(Renderer& r) {
   const float tri[9] = {0, 0, 2, 1, 0, 2, 0, 1, 2};  // z = 2: outside the clip volume
   const uint32_t indices[3] = {0, 1, 2};
   glBindVertexArray(0);
-  for (GpuBuffer* b : {&r.isoPositions, &r.isoNormals, &r.hullPositions, &r.hullNormals, &r.lines}) {
+  for (GpuBuffer* b : {&r.iso.positions, &r.iso.normals, &r.iso.colours, &r.hullPositions, &r.hullNormals, &r.lines}) {
     glBindBuffer(GL_ARRAY_BUFFER, b->id);
     glBufferData(GL_ARRAY_BUFFER, sizeof tri, tri, GL_DYNAMIC_DRAW);
     b->capacity = 0;  // the first real upload allocates again
   }
-  glBindVertexArray(r.isoVao);
+  glBindVertexArray(r.iso.vao);
   glBufferData(GL_ELEMENT_ARRAY_BUFFER, sizeof indices, indices, GL_DYNAMIC_DRAW);
-  r.isoIndices.capacity = 0;
+  r.iso.indices.capacity = 0;
   glBindVertexArray(0);
-  r.isoIndexCount = 3;
+  r.iso.indexCount = 3;
   r.hullVertexCount = 3;
   r.lineVertexCount = 2;
   drawScene(r, FrameParams{});
-  r.isoIndexCount = r.hullVertexCount = r.lineVertexCount = 0;
+  r.iso.indexCount = r.hullVertexCount = r.lineVertexCount = 0;
 }
 
-void uploadSurface(Renderer& r, const IncrementalIsosurface& s) {
+namespace {
+void uploadTo(Renderer& r, SurfaceGpu& g, const IncrementalIsosurface& s) {
   const bool full = s.fullUploadNeeded();
   glBindVertexArray(0);  // keep the VAO's element binding untouched by the array uploads
-  sync(r, GL_ARRAY_BUFFER, r.isoPositions, s.positions().data(), s.vertexSlotCount(), 12, s.changedVertices(), full);
-  sync(r, GL_ARRAY_BUFFER, r.isoNormals, s.normals().data(), s.vertexSlotCount(), 12, s.changedVertices(), full);
-  glBindVertexArray(r.isoVao);  // the element buffer is bound through the VAO
-  sync(r, GL_ELEMENT_ARRAY_BUFFER, r.isoIndices, s.indices().data(), s.triangleCount(), 12, s.changedTriangles(), full);
+  sync(r, GL_ARRAY_BUFFER, g.positions, s.positions().data(), s.vertexSlotCount(), 12, s.changedVertices(), full);
+  sync(r, GL_ARRAY_BUFFER, g.normals, s.normals().data(), s.vertexSlotCount(), 12, s.changedVertices(), full);
+  sync(r, GL_ARRAY_BUFFER, g.colours, s.colours().data(), s.vertexSlotCount(), 4, s.changedVertices(), full);
+  glBindVertexArray(g.vao);  // the element buffer is bound through the VAO
+  sync(r, GL_ELEMENT_ARRAY_BUFFER, g.indices, s.indices().data(), s.triangleCount(), 12, s.changedTriangles(), full);
   glBindVertexArray(0);
-  r.isoIndexCount = int32_t(3 * s.triangleCount());
+  g.indexCount = int32_t(3 * s.triangleCount());
 }
+}  // namespace
+
+void uploadSurface(Renderer& r, const IncrementalIsosurface& s) { uploadTo(r, r.iso, s); }
+void uploadSlice(Renderer& r, const IncrementalIsosurface& s) { uploadTo(r, r.slice, s); }
 
 void uploadHull(Renderer& r, const HullTracker& h) {
   const bool full = h.fullUploadNeeded();
@@ -298,6 +354,22 @@ void uploadHull(Renderer& r, const HullTracker& h) {
   sync(r, GL_ARRAY_BUFFER, r.lines, h.lineVertices().data(), h.lineCount(), 24, h.changedLines(), full);
   r.hullVertexCount = int32_t(3 * h.triangleCount());
   r.lineVertexCount = int32_t(2 * h.lineCount());
+}
+
+void setColourMap(Renderer& r, ColourMap map) {
+  if (r.colourMapLoaded == int(map)) return;
+  const float(*t)[3] = colourMapTable(map);
+  uint8_t texels[kColourMapSize * 4];
+  for (int i = 0; i < kColourMapSize; ++i) {
+    for (int k = 0; k < 3; ++k) texels[4 * i + k] = uint8_t(std::lround(255.f * std::clamp(t[i][k], 0.f, 1.f)));
+    texels[4 * i + 3] = 255;
+  }
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_2D, r.colourMapTexture);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, kColourMapSize, 1, 0, GL_RGBA, GL_UNSIGNED_BYTE, texels);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  r.colourMapLoaded = int(map);
 }
 
 void drawScene(const Renderer& r, const FrameParams& p) {
@@ -316,12 +388,31 @@ void drawScene(const Renderer& r, const FrameParams& p) {
 
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LEQUAL);
-  if (r.isoIndexCount > 0) {
+  const bool slice = p.showSlice && r.slice.indexCount > 0;
+  if (r.iso.indexCount > 0 || slice) {
     glUseProgram(r.isoProgram);
     glUniformMatrix4fv(r.isoView, 1, GL_FALSE, glm::value_ptr(p.view));
     glUniformMatrix4fv(r.isoProj, 1, GL_FALSE, glm::value_ptr(p.projection));
-    glBindVertexArray(r.isoVao);
-    glDrawElements(GL_TRIANGLES, r.isoIndexCount, GL_UNSIGNED_INT, nullptr);
+    glUniform2f(r.isoColourRange, p.colourMin, p.colourMax);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, r.colourMapTexture);
+  }
+  if (r.iso.indexCount > 0) {
+    glUniform1i(r.isoColourBy, p.colourBy ? 1 : 0);
+    glUniform1f(r.isoUnlit, 0.f);
+    glBindVertexArray(r.iso.vao);
+    glDrawElements(GL_TRIANGLES, r.iso.indexCount, GL_UNSIGNED_INT, nullptr);
+  }
+  if (slice) {
+    // Mostly unlit, so the colours read as the map's; pushed back a little in depth so the
+    // isosurface wins where the two meet.
+    glUniform1i(r.isoColourBy, 1);
+    glUniform1f(r.isoUnlit, 0.75f);
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(1.f, 1.f);
+    glBindVertexArray(r.slice.vao);
+    glDrawElements(GL_TRIANGLES, r.slice.indexCount, GL_UNSIGNED_INT, nullptr);
+    glDisable(GL_POLYGON_OFFSET_FILL);
   }
 
   if (p.showBoundary) {

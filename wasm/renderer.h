@@ -13,6 +13,7 @@
 
 #include <glm/glm.hpp>
 
+#include "colourmap.h"
 #include "isosurface_incremental.h"
 #include "viewer_state.h"
 
@@ -22,21 +23,33 @@ namespace tetstream::viewer {
 struct GpuBuffer {
   uint32_t id = 0;
   uint32_t capacity = 0;
+  uint64_t bytes = 0;  // allocated on the GPU
 };
 
 // What went to the GPU, for the stats (tests check that streaming uploads stay partial).
 struct UploadStats {
   uint64_t bytes = 0;
   uint32_t full = 0, partial = 0;  // buffer uploads of each kind
+  uint32_t grown = 0;              // full uploads because the buffer had to grow (first one too)
+};
+
+// The GPU side of an IncrementalIsosurface (the isosurface, or the slice).
+struct SurfaceGpu {
+  GpuBuffer positions, normals, colours, indices;  // elements: vertex slots (x3) and triangles
+  uint32_t vao = 0;
+  int32_t indexCount = 0;
 };
 
 struct Renderer {
   uint32_t isoProgram = 0, hullProgram = 0, lineProgram = 0, backgroundProgram = 0;
-  uint32_t isoVao = 0, hullVao = 0, lineVao = 0, emptyVao = 0;
-  GpuBuffer isoPositions, isoNormals, isoIndices;  // elements: vertex slots, vertex slots, triangles
+  uint32_t hullVao = 0, lineVao = 0, emptyVao = 0;
+  SurfaceGpu iso, slice;
+  uint32_t colourMapTexture = 0;                   // 256x1 RGBA8, the current colour map
+  int colourMapLoaded = -1;                        // the ColourMap in it
   GpuBuffer hullPositions, hullNormals, lines;     // elements: triangles, triangles, segments
+  int32_t isoColourBy = -1, isoColourRange = -1, isoUnlit = -1;
   int32_t isoView = -1, isoProj = -1, hullView = -1, hullProj = -1, lineViewProj = -1;
-  int32_t isoIndexCount = 0, hullVertexCount = 0, lineVertexCount = 0;
+  int32_t hullVertexCount = 0, lineVertexCount = 0;
   UploadStats uploads;
   std::vector<uint32_t> scratch;  // sorted change lists
 };
@@ -53,13 +66,24 @@ void warmUpRenderer(Renderer& r);
 
 // Sends what changed since the model's last clearChanges(); the caller clears them afterwards.
 void uploadSurface(Renderer& r, const IncrementalIsosurface& surface);
+void uploadSlice(Renderer& r, const IncrementalIsosurface& slice);  // an empty one hides it
 void uploadHull(Renderer& r, const HullTracker& hull);
 
 struct FrameParams {
   glm::mat4 view{1.f}, projection{1.f};
   int framebufferWidth = 1, framebufferHeight = 1;
   bool showBoundary = true;
+  bool colourBy = false;  // colour the surface by its colour field (else the two-sided tint)
+  float colourMin = 0, colourMax = 1;
+  bool showSlice = false;  // the slice, always coloured by the colour field
 };
+
+// Loads a colour map into the texture (nothing when it is loaded already).
+void setColourMap(Renderer& r, ColourMap map);
+
+// Bytes allocated in the GPU buffers (the panel's memory line; textures and the framebuffer
+// are not counted).
+uint64_t gpuBufferBytes(const Renderer& r);
 
 // Clears to the background gradient and draws surface, then hull and crease lines.
 void drawScene(const Renderer& r, const FrameParams& p);

@@ -23,6 +23,9 @@ target_compile_definitions(tetstream_imgui PUBLIC IMGUI_USER_CONFIG="imconfig_te
 add_executable(tetstream_viewer
   ${CMAKE_CURRENT_LIST_DIR}/main.cpp
   ${CMAKE_CURRENT_LIST_DIR}/viewer_state.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/colourmap.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/slice.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/viewer_memory.cpp
   ${CMAKE_CURRENT_LIST_DIR}/camera.cpp
   ${CMAKE_CURRENT_LIST_DIR}/renderer.cpp
   ${CMAKE_CURRENT_LIST_DIR}/panel.cpp
@@ -35,7 +38,7 @@ target_compile_options(tetstream_viewer PRIVATE -Wno-deprecated-volatile)
 set(TETSTREAM_VIEWER_EXPORTS
   _main _malloc _free
   _ts_open_manifest _ts_chunk_file _ts_add_chunk _ts_download_progress _ts_set_paused _ts_set_level
-  _ts_set_isovalue _ts_set_field _ts_fail _ts_stats_json)
+  _ts_set_isovalue _ts_set_field _ts_set_colour_field _ts_set_colour_map _ts_set_colour_range _ts_set_slice _ts_camera_get _ts_camera_set _ts_camera_gesture _ts_request_capture _ts_set_view_option _ts_set_link_note _ts_fail _ts_stats_json _ts_check_chunk _ts_set_memory_limit _ts_set_notice _ts_work)
 list(JOIN TETSTREAM_VIEWER_EXPORTS "," TETSTREAM_VIEWER_EXPORTS)
 target_link_options(tetstream_viewer PRIVATE
   -sUSE_GLFW=3
@@ -53,11 +56,20 @@ set_target_properties(tetstream_viewer PROPERTIES
   SUFFIX ".js"
   RUNTIME_OUTPUT_DIRECTORY ${TETSTREAM_WEB_DIR})
 
-# The static shell: copied on every build so edits to web/ show up after a rebuild.
+# The static shell: copied on every build so edits to web/ show up after a rebuild; index.html
+# is written after the link, with the wasm's size in it (web_page.cmake).
 file(GLOB TETSTREAM_WEB_FILES CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/web/*)
+list(FILTER TETSTREAM_WEB_FILES EXCLUDE REGEX "/index\\.html$")
 add_custom_target(tetstream_web_files
   COMMAND ${CMAKE_COMMAND} -E make_directory ${TETSTREAM_WEB_DIR}
   COMMAND ${CMAKE_COMMAND} -E copy_if_different ${TETSTREAM_WEB_FILES} ${TETSTREAM_WEB_DIR}
   COMMENT "Copying web/ to ${TETSTREAM_WEB_DIR}"
   VERBATIM)
 add_dependencies(tetstream_viewer tetstream_web_files)
+add_custom_command(OUTPUT ${TETSTREAM_WEB_DIR}/index.html
+  COMMAND ${CMAKE_COMMAND} -DIN=${CMAKE_CURRENT_SOURCE_DIR}/web/index.html -DOUT=${TETSTREAM_WEB_DIR}/index.html
+          -DWASM=${TETSTREAM_WEB_DIR}/tetstream.wasm -P ${CMAKE_CURRENT_LIST_DIR}/web_page.cmake
+  DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/web/index.html ${CMAKE_CURRENT_LIST_DIR}/web_page.cmake tetstream_viewer
+  COMMENT "Writing ${TETSTREAM_WEB_DIR}/index.html"
+  VERBATIM)
+add_custom_target(tetstream_web_page ALL DEPENDS ${TETSTREAM_WEB_DIR}/index.html)

@@ -3,12 +3,15 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 
 #include <nlohmann/json.hpp>
 
 #include "adjacency.h"
+#include "hash.h"
 #include "tet_tables.h"
+#include "viewer_memory.h"
 
 namespace tetstream::viewer {
 namespace {
@@ -56,6 +59,15 @@ std::span<const float> fieldValues(const ViewerState& s) {
   return mesh.fields[size_t(f)].values;
 }
 
+// The values of the colour field on the current level, empty when there is none.
+std::span<const float> colourValues(const ViewerState& s) {
+  const TetMesh& mesh = s.dataset.pm.mesh;
+  if (s.colourField < 0 || size_t(s.colourField) >= s.dataset.manifest.fields.size()) return {};
+  int f = mesh.findField(s.dataset.manifest.fields[size_t(s.colourField)].name);
+  if (f < 0 || mesh.fields[size_t(f)].values.size() != mesh.vertexCount()) return {};
+  return mesh.fields[size_t(f)].values;
+}
+
 // The whole surface of the current level (isovalue or field changed, or the base arrived).
 void extract(ViewerState& s) {
   s.surfaceDirty = true;
@@ -66,26 +78,58 @@ void extract(ViewerState& s) {
     return;
   }
   double t0 = nowMs();
-  s.surface.rebuild(s.dataset.pm.mesh, values, s.isovalue);
+  s.surface.rebuild(s.dataset.pm.mesh, values, s.isovalue, colourValues(s));
   s.extractMs = nowMs() - t0;
   s.surfaceReady = true;
 }
 
+// The whole slice of the current level (plane moved, turned on, or the base arrived).
+void extractSlice(ViewerState& s) {
+  s.sliceDirty = true;
+  if (!s.sliceOn || s.dataset.pm.mesh.tetCount() == 0) {
+    s.slice.clear();
+    return;
+  }
+  s.slice.rebuild(s.dataset.pm.mesh, colourValues(s));
+}
+
 // Growing the mesh arrays by doubling while streaming would copy tens of MB inside one frame
-// (~20 ms natively at 1 M tets): size them for the full mesh once, as the manifest announces
-// it. The manifest is untrusted, so only up to 4 M tets (~100 MB); bigger meshes grow as usual.
-void reserveFullLevel(Dataset& ds) {
+// (~20 ms natively at 1 M tets): size them once for the last level that will be streamed (the
+// full mesh unless memory is limited), as the manifest announces it. The manifest is untrusted,
+// so only up to 4 M tets (~100 MB) without a memory limit; bigger meshes grow as usual.
+void reserveLevel(ViewerState& s) {
   constexpr uint32_t kMaxReservedTets = 4u << 20;
+  Dataset& ds = s.dataset;
   const Manifest& m = ds.manifest;
-  if (m.tets > kMaxReservedTets || m.vertices > kMaxReservedTets) return;
+  if (s.chunksAllowed == 0) return;
+  const ChunkInfo& last = m.chunks[s.chunksAllowed - 1];
+  if (!s.memoryLimitBytes && (last.tets > kMaxReservedTets || last.vertices > kMaxReservedTets)) return;
   ProgressiveMesh& pm = ds.pm;
-  pm.mesh.positions.reserve(3 * size_t(m.vertices));
-  pm.mesh.tets.reserve(4 * size_t(m.tets));
-  for (ScalarField& f : pm.mesh.fields) f.values.reserve(m.vertices);
-  pm.cornerNext.reserve(4 * size_t(m.tets));
-  pm.vertexHead.reserve(m.vertices);
-  pm.splitJ.reserve(m.vertices);
-  pm.splitTetsBefore.reserve(m.vertices);
+  pm.mesh.positions.reserve(3 * size_t(last.vertices));
+  pm.mesh.tets.reserve(4 * size_t(last.tets));
+  for (ScalarField& f : pm.mesh.fields) f.values.reserve(last.vertices);
+  pm.cornerNext.reserve(4 * size_t(last.tets));
+  pm.vertexHead.reserve(last.vertices);
+  pm.splitJ.reserve(last.vertices);
+  pm.splitTetsBefore.reserve(last.vertices);
+  s.surface.reserveTets(last.tets);
+}
+
+// "part 12 of 30" as people count.
+std::string partName(const ViewerState& s, uint32_t index) {
+  return "part " + std::to_string(index + 1) + " of " + std::to_string(s.chunksTotal);
+}
+
+// The stop at the last level that fits, in plain words.
+void stopForMemory(ViewerState& s) {
+  const Manifest& m = s.dataset.manifest;
+  const uint32_t k = s.dataset.chunksReceived;
+  char level[32];
+  std::snprintf(level, sizeof level, "%.1f%%", m.vertices ? 100.0 * m.chunks[k - 1].vertices / m.vertices : 0.0);
+  s.memoryLimited = true;
+  failLoad(s, "This dataset needs about " + formatBytes(s.memoryNeededBytes) + " of memory at full detail, more " +
+                  "than the " + formatBytes(s.memoryLimitBytes) + " this page may use. Streaming stopped after " +
+                  partName(s, k - 1) + " (" + level + " of the vertices); that level stays fully usable.");
 }
 
 void updateState(ViewerState& s) {
@@ -116,11 +160,19 @@ const char* loadStateName(LoadState s) {
 
 Result openManifest(ViewerState& s, std::string_view manifestJson) {
   s.surface.reset();
+  // The interval tree waits until the level settles (growTree): see IncrementalIsosurface.
+  s.surface.setTreeDeferred(true);
   s.hull.clear();
   s.surfaceDirty = s.hullDirty = true;
   s.surfaceReady = false;
   s.chunksTotal = 0;
+  s.slice.clear();
+  s.sliceOn = false;
+  s.sliceDirty = true;
   s.field = -1;
+  s.colourField = -1;
+  s.colourMin = 0;
+  s.colourMax = 1;
   s.targetSplits = 0;
   s.live = true;
   s.paused = false;
@@ -128,6 +180,10 @@ Result openManifest(ViewerState& s, std::string_view manifestJson) {
   s.rate.reset();
   s.rateBytesPerSec = 0;
   s.completeMs = -1;
+  s.notice.clear();
+  s.memoryNeededBytes = 0;
+  s.chunksAllowed = 0;
+  s.memoryLimited = false;
   if (Result r = openDataset(s.dataset, manifestJson); !r) {
     s.dataset.manifest = {};
     s.dataset.pm = {};
@@ -144,7 +200,32 @@ Result openManifest(ViewerState& s, std::string_view manifestJson) {
   if (f < 0 && !m.fields.empty()) f = 0;
   s.field = f;
   if (f >= 0) s.isovalue = middleOf(m.fields[size_t(f)].range);
+  s.slice.setPlane({0, 0, 1}, 0.5f * (m.bounds.min[2] + m.bounds.max[2]));
+
+  s.memoryNeededBytes = s.memoryBaseBytes + estimateLevelBytes(m, s.chunksTotal);
+  s.chunksAllowed = s.chunksTotal;
+  if (s.memoryLimitBytes) {
+    const uint64_t budget = s.memoryLimitBytes > s.memoryBaseBytes ? s.memoryLimitBytes - s.memoryBaseBytes : 0;
+    s.chunksAllowed = chunksThatFit(m, budget);
+    if (s.chunksAllowed == 0) {
+      s.memoryLimited = true;
+      const std::string message = "This dataset needs about " +
+                                  formatBytes(s.memoryBaseBytes + estimateLevelBytes(m, 1)) +
+                                  " of memory even at its coarsest level, more than the " +
+                                  formatBytes(s.memoryLimitBytes) + " this page may use.";
+      failLoad(s, message);
+      return fail(Status::TooLarge, message);
+    }
+  }
   return Result::success();
+}
+
+ChunkCheck checkChunk(const ViewerState& s, uint32_t index, std::span<const uint8_t> bytes) {
+  const Manifest& m = s.dataset.manifest;
+  if (index >= m.chunks.size()) return ChunkCheck::NoSuchChunk;
+  const ChunkInfo& info = m.chunks[index];
+  if (bytes.size() != info.bytes) return ChunkCheck::WrongSize;
+  return contentHash(bytes) == info.hash ? ChunkCheck::Ok : ChunkCheck::WrongHash;
 }
 
 Result addChunk(ViewerState& s, uint32_t index, std::span<const uint8_t> bytes) {
@@ -155,6 +236,26 @@ Result addChunk(ViewerState& s, uint32_t index, std::span<const uint8_t> bytes) 
     return r;
   }
   Dataset& ds = s.dataset;
+  if (index >= s.chunksAllowed) {
+    Result r = fail(Status::TooLarge, partName(s, index) + " does not fit in memory");
+    failLoad(s, r.message);
+    return r;
+  }
+  // Memory for the level this chunk makes, asked for before anything grows: a refusal stops
+  // here with a message instead of failing an allocation half way through. With the base, the
+  // arrays are sized for the last level that will come (reserveLevel), so that much is asked
+  // for first; if the browser will not give it now, the arrays grow as levels come instead.
+  const uint64_t need = s.memoryBaseBytes + estimateLevelBytes(ds.manifest, index + 1);
+  const bool reserveAll = index == 0 && (!s.reserveHeap ||
+                                         s.reserveHeap(s.memoryBaseBytes + estimateLevelBytes(ds.manifest, s.chunksAllowed)));
+  if (s.reserveHeap && !reserveAll && !s.reserveHeap(need)) {
+    s.memoryLimited = true;
+    Result r = fail(Status::TooLarge, "The browser did not give the viewer the " + formatBytes(need) +
+                                          " of memory that " + partName(s, index) + " needs." +
+                                          (ds.chunksReceived ? " Showing the last complete level." : ""));
+    failLoad(s, r.message);
+    return r;
+  }
   if (Result r = receiveChunk(ds, index, bytes); !r) {
     failLoad(s, "Part " + std::to_string(index + 1) + " of " + std::to_string(s.chunksTotal) +
                     " of the dataset could not be used: " + r.message +
@@ -162,13 +263,15 @@ Result addChunk(ViewerState& s, uint32_t index, std::span<const uint8_t> bytes) 
     return r;
   }
   if (ds.chunksReceived == 1) {  // the base: shown at once
-    reserveFullLevel(ds);
+    if (reserveAll) reserveLevel(s);
     extract(s);
+    extractSlice(s);
     s.hull.rebuild(ds.pm);
     s.hullDirty = true;
   }
   if (s.live) s.targetSplits = ds.splitsReceived();
   updateState(s);
+  if (ds.chunksReceived == s.chunksAllowed && s.chunksAllowed < s.chunksTotal) stopForMemory(s);
   return Result::success();
 }
 
@@ -190,7 +293,7 @@ bool advance(ViewerState& s, double deadlineMs, Clock now) {
     s.splitVertices.clear();
     // The hull needs every split's i and j; an undo forgets j, so read it first.
     if (a0 > target)
-      for (uint32_t g = a0 - n; g < a0; ++g) s.splitVertices.insert(s.splitVertices.end(), {base + g, ds.pm.splitJ[g]});
+      for (uint32_t g = a0; g-- > a0 - n;) s.splitVertices.insert(s.splitVertices.end(), {base + g, ds.pm.splitJ[g]});
     bool reached = false;
     Result r = stepTowards(ds, target, n, s.changed, &reached);
     const uint32_t a1 = ds.splitsApplied();
@@ -198,7 +301,8 @@ bool advance(ViewerState& s, double deadlineMs, Clock now) {
     steps += a1 > a0 ? a1 - a0 : a0 - a1;
     // Paper §4.3: only the changed tets (T_new, T_moved, and the removed ones) are looked at.
     if (std::span<const float> values = fieldValues(s); !values.empty())
-      s.surface.updateTets(ds.pm.mesh, values, s.changed);
+      s.surface.updateTets(ds.pm.mesh, values, s.changed, colourValues(s));
+    if (s.sliceOn && s.slice.built()) s.slice.update(ds.pm.mesh, s.changed, colourValues(s));
     if (!r) {
       // The bad chunk and everything after it are gone (undone further than this batch): the
       // surface followed through `changed`, the hull is rebuilt once.
@@ -211,6 +315,7 @@ bool advance(ViewerState& s, double deadlineMs, Clock now) {
     s.hull.update(ds.pm, s.splitVertices);
   } while (now() < deadlineMs);
   s.surfaceDirty = s.hullDirty = true;
+  if (s.sliceOn) s.sliceDirty = true;
   s.refineMs = now() - t0;
   s.maxRefineMs = std::max(s.maxRefineMs, s.refineMs);
   s.refineSteps = steps;
@@ -257,9 +362,65 @@ bool setField(ViewerState& s, int index) {
 
 bool setField(ViewerState& s, std::string_view name) { return setField(s, s.dataset.manifest.findField(name)); }
 
+bool setColourField(ViewerState& s, int index) {
+  const Manifest& m = s.dataset.manifest;
+  if (index < -1 || index >= int(m.fields.size())) return false;
+  s.colourField = index;
+  if (index >= 0) {
+    s.colourMin = float(m.fields[size_t(index)].range.min);
+    s.colourMax = float(m.fields[size_t(index)].range.max);
+  }
+  s.surface.recolour(colourValues(s));
+  s.surfaceDirty = true;
+  if (s.slice.built()) {
+    s.slice.recolour(colourValues(s));
+    s.sliceDirty = true;
+  }
+  return true;
+}
+
+bool setColourField(ViewerState& s, std::string_view name) {
+  if (name.empty() || name == "none") return setColourField(s, -1);
+  const int f = s.dataset.manifest.findField(name);
+  return f >= 0 && setColourField(s, f);
+}
+
+void setColourMap(ViewerState& s, ColourMap map) { s.colourMap = map; }
+
+void setColourRange(ViewerState& s, float lo, float hi) {
+  if (!std::isfinite(lo) || !std::isfinite(hi)) return;
+  if (lo > hi) std::swap(lo, hi);
+  s.colourMin = lo;
+  s.colourMax = hi;
+}
+
+void setSliceEnabled(ViewerState& s, bool on) {
+  if (on == s.sliceOn) return;
+  s.sliceOn = on;
+  if (on && s.colourField < 0 && s.field >= 0) setColourField(s, s.field);
+  extractSlice(s);
+}
+
+bool setSlicePlane(ViewerState& s, std::array<float, 3> normal, float offset) {
+  const bool changed = s.slice.setPlane(normal, offset);
+  if (changed) extractSlice(s);
+  return changed || (std::isfinite(offset) && (normal[0] != 0 || normal[1] != 0 || normal[2] != 0));
+}
+
+void sliceOffsetRange(const ViewerState& s, float& lo, float& hi) {
+  const Bounds& b = s.dataset.manifest.bounds;
+  SliceTracker::offsetRange(s.slice.normal(), b.min, b.max, lo, hi);
+}
+
 void failLoad(ViewerState& s, std::string_view message) {
   s.state = LoadState::Error;
   s.error = message.empty() ? "Unknown error." : std::string(message);
+}
+
+void setNotice(ViewerState& s, std::string_view message) { s.notice = message; }
+
+uint64_t memoryInUse(const ViewerState& s) {
+  return datasetMemoryBytes(s.dataset) + s.surface.memoryBytes() + s.hull.memoryBytes() + s.slice.memoryBytes();
 }
 
 // ------------------------------------------------------------------ download figures
@@ -295,12 +456,35 @@ void tick(ViewerState& s, double nowMs) { s.rateBytesPerSec = downloading(s) ? s
 
 bool downloading(const ViewerState& s) {
   return (s.state == LoadState::Loading || s.state == LoadState::Streaming) && !s.paused &&
-         s.dataset.chunksReceived < s.chunksTotal;
+         s.dataset.chunksReceived < s.chunksAllowed;
+}
+
+bool treePending(const ViewerState& s) {
+  return s.surfaceReady && !refining(s) && !downloading(s) && s.state != LoadState::Loading &&
+         s.surface.treeCoverage() < s.dataset.pm.mesh.tetCount() && !fieldValues(s).empty();
+}
+
+bool growTree(ViewerState& s, double deadlineMs, Clock now) {
+  if (!treePending(s)) return false;
+  const TetMesh& mesh = s.dataset.pm.mesh;
+  // A small mesh at once (a bulk build is faster than inserting); a big one in steps.
+  constexpr uint32_t kAtOnce = 1u << 16, kStep = 2048;
+  const uint32_t step = s.surface.treeCoverage() == 0 && mesh.tetCount() <= kAtOnce ? kAtOnce : kStep;
+  bool whole;
+  do whole = s.surface.extendTree(mesh, fieldValues(s), step);
+  while (!whole && now() < deadlineMs);
+  return !whole;
+}
+
+bool refining(const ViewerState& s) {
+  const Dataset& ds = s.dataset;
+  return ds.chunksReceived > 0 && std::min(s.targetSplits, ds.splitsReceived()) != ds.splitsApplied();
 }
 
 double secondsLeft(const ViewerState& s) {
   if (!downloading(s) || s.rateBytesPerSec <= 0) return -1;
-  uint64_t total = s.dataset.manifest.totalBytes();
+  uint64_t total = 0;  // of the chunks that will be fetched
+  for (uint32_t c = 0; c < s.chunksAllowed; ++c) total += s.dataset.manifest.chunks[c].bytes;
   uint64_t have = std::max(s.datasetBytes, s.dataset.bytesReceived);
   return have >= total ? 0 : double(total - have) / s.rateBytesPerSec;
 }
@@ -389,6 +573,13 @@ void HullTracker::clear() {
   fullUpload_ = true;
 }
 
+size_t HullTracker::memoryBytes() const {
+  auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  return bytes(faces_) + bytes(positions_) + bytes(normals_) + bytes(head_) + bytes(next_) + bytes(prev_) +
+         bytes(lines_) + bytes(lineKeys_) + lineOfEdge_.memoryBytes() + bytes(dirtyEdges_) + bytes(entries_) +
+         bytes(vertexScratch_) + bytes(dropScratch_) + bytes(changedTriangles_) + bytes(changedLines_);
+}
+
 void HullTracker::clearChanges() {
   changedTriangles_.clear();
   changedLines_.clear();
@@ -414,8 +605,23 @@ void HullTracker::rebuild(const ProgressiveMesh& pm) {
 
 void HullTracker::update(const ProgressiveMesh& pm, std::span<const uint32_t> vertices) {
   const uint32_t nv = pm.vertexCount();
+  // A split or undo of (i, j) with neither on the hull changes no hull face: the tets it changes
+  // fill star(i) ∪ star(j), whose faces through i or j are then all interior, before and after
+  // (the region's outer faces contain neither). About nine in ten splits of a volume mesh are
+  // such, and recounting their stars was a quarter of the refinement time. A vertex that an
+  // earlier split of the batch did touch may have changed sides: those are recounted.
+  const uint32_t known = uint32_t(head_.size());  // vertices the hull has seen
   if (head_.size() < nv) head_.resize(nv, kNone);
-  vertexScratch_.assign(vertices.begin(), vertices.end());
+  vertexScratch_.clear();
+  touched_.clear();
+  auto onHull = [&](uint32_t v) { return v < known && head_[v] != kNone; };
+  auto touched = [&](uint32_t v) { return std::find(touched_.begin(), touched_.end(), v) != touched_.end(); };
+  for (size_t k = 0; k + 1 < vertices.size(); k += 2) {
+    const uint32_t i = vertices[k], j = vertices[k + 1];
+    if (!onHull(i) && !onHull(j) && !touched(i) && !touched(j)) continue;
+    touched_.insert(touched_.end(), {i, j});
+    vertexScratch_.insert(vertexScratch_.end(), {i, j});
+  }
   std::sort(vertexScratch_.begin(), vertexScratch_.end());
   vertexScratch_.erase(std::unique(vertexScratch_.begin(), vertexScratch_.end()), vertexScratch_.end());
   // Removed vertices first (their faces go), then a recount around each remaining one. Every
@@ -621,6 +827,14 @@ std::string statsJson(const ViewerState& s) {
       {"isovalue", s.isovalue},
       {"surfaceArea", s.surface.area()},
       {"field", s.field >= 0 ? json(m.fields[size_t(s.field)].name) : json(nullptr)},
+      {"colourField", s.colourField >= 0 ? json(m.fields[size_t(s.colourField)].name) : json(nullptr)},
+      {"colourMap", colourMapName(s.colourMap)},
+      {"colourRange", json::array({s.colourMin, s.colourMax})},
+      {"slice", {{"on", s.sliceOn},
+                 {"normal", json::array({s.slice.normal()[0], s.slice.normal()[1], s.slice.normal()[2]})},
+                 {"offset", s.slice.offset()},
+                 {"triangles", s.slice.surface().triangleCount()},
+                 {"area", s.slice.surface().area()}}},
       {"fields", std::move(fields)},
       {"chunksReceived", ds.chunksReceived},
       {"chunksApplied", ds.chunksApplied()},
@@ -650,13 +864,31 @@ std::string statsJson(const ViewerState& s) {
       {"frameMs", s.frameMs},
       {"maxFrameMs", s.maxFrameMs},
       {"maxFrameGapMs", s.maxFrameGapMs},
+      {"drawMs", s.drawMs},
+      {"treeTets", s.surface.treeCoverage()},
+      {"maxDrawMs", s.maxDrawMs},
       {"uploadBytes", s.uploadBytes},
       {"fullUploads", s.fullUploads},
       {"partialUploads", s.partialUploads},
+      {"grownUploads", s.grownUploads},
       {"showBoundary", s.showBoundary},
+      {"notice", s.notice},
+      {"chunksAllowed", s.chunksAllowed},
+      {"memoryLimited", s.memoryLimited},
+      {"memory",
+       {{"heapBytes", s.heapBytes},
+        {"dataBytes", memoryInUse(s)},
+        {"gpuBytes", s.gpuBytes},
+        {"limitBytes", s.memoryLimitBytes ? json(s.memoryLimitBytes) : json(nullptr)},
+        {"neededBytes", s.memoryNeededBytes},
+        {"allowedBytes", s.chunksAllowed ? s.memoryBaseBytes + estimateLevelBytes(m, s.chunksAllowed) : 0}}},
       {"sliderRect", rect(s.sliderRect)},
       {"levelSliderRect", rect(s.levelSliderRect)},
       {"pauseButtonRect", rect(s.pauseButtonRect)},
+      {"sliceSliderRect", rect(s.sliceSliderRect)},
+      {"panelRect", rect(s.panelRect)},
+      {"showHelp", s.showHelp},
+      {"targetLevel", s.live ? 1.0 : m.vertices ? double(s.dataset.pm.baseVertices + s.targetSplits) / m.vertices : 0.0},
   };
   // Messages may carry bytes from the network: never let invalid UTF-8 abort the dump.
   return j.dump(-1, ' ', false, json::error_handler_t::replace);

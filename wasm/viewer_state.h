@@ -16,6 +16,12 @@
 //   setPaused                    the shell stops or restarts downloading; applying goes on
 //   noteDownload                 network progress reported by the shell (for the rate)
 //   failLoad(message)            network problems reported by JS -> error
+//   setNotice(message)           what the network is doing (retrying, offline), shown as is
+// Memory: openManifest estimates what each level needs (viewer_memory.h) and, with a limit set
+// (memoryLimitBytes), allows only the chunks whose level fits; addChunk asks the platform to
+// grow the heap for the next level first (reserveHeap). Past the last chunk that fits, or when
+// the browser refuses memory, the state becomes Error with a plain message and the level
+// reached stays usable.
 // Errors never drop what is on screen: the last valid level, its surface and hull stay, and the
 // level slider keeps working over the chunks that did arrive.
 #pragma once
@@ -25,8 +31,10 @@
 #include <string_view>
 #include <vector>
 
+#include "colourmap.h"
 #include "dataset.h"
 #include "isosurface_incremental.h"
+#include "slice.h"
 
 namespace tetstream::viewer {
 
@@ -68,8 +76,9 @@ class HullTracker {
   void clear();
   // From scratch (face adjacency over the whole mesh): the base level, or after a failure.
   void rebuild(const ProgressiveMesh& pm);
-  // After splits or undos: `vertices` holds every split's i and j (ids may repeat; ids >=
-  // pm.vertexCount() are vertices removed by undo).
+  // After splits or undos: `vertices` holds every split's i and j as pairs, in the order the
+  // splits or undos were applied (ids may repeat; ids >= pm.vertexCount() are vertices removed
+  // by undo).
   void update(const ProgressiveMesh& pm, std::span<const uint32_t> vertices);
 
   uint32_t triangleCount() const { return uint32_t(faces_.size() / 3); }
@@ -79,6 +88,7 @@ class HullTracker {
   std::span<const float> lineVertices() const { return lines_; }
   // Boundary triangles as outward-wound vertex id triples (tests).
   std::span<const uint32_t> faces() const { return faces_; }
+  size_t memoryBytes() const;  // vector capacities
 
   bool fullUploadNeeded() const { return fullUpload_; }
   std::span<const uint32_t> changedTriangles() const { return changedTriangles_; }
@@ -112,7 +122,7 @@ class HullTracker {
 
   std::vector<uint64_t> dirtyEdges_;
   std::vector<FaceEntry> entries_;        // recount scratch
-  std::vector<uint32_t> vertexScratch_, dropScratch_;  // update scratch
+  std::vector<uint32_t> vertexScratch_, dropScratch_, touched_;  // update scratch
   std::vector<uint32_t> changedTriangles_, changedLines_;
   bool fullUpload_ = false;
 };
@@ -140,12 +150,34 @@ struct ViewerState {
   Dataset dataset;
   int field = -1;        // index into dataset.manifest.fields, -1 before a manifest
   float isovalue = 0;
+  // Colour by field: the surface's vertices carry this field (any point field, independent of
+  // the isovalue's), mapped through colourMap over [colourMin, colourMax]. -1: no colouring (the
+  // two-sided tint).
+  int colourField = -1;
+  ColourMap colourMap = ColourMap::Viridis;
+  float colourMin = 0, colourMax = 1;
   IncrementalIsosurface surface;
   HullTracker hull;
+  // The slice plane (slice.h), coloured by the colour field, kept up to date like the surface
+  // while sliceOn. The plane is kept when it is off.
+  bool sliceOn = false;
+  SliceTracker slice;
 
   LoadState state = LoadState::Idle;
   std::string error;       // plain words, shown in the panel; empty unless state == Error
+  std::string notice;      // from the shell: a network problem being retried, in plain words
   uint32_t chunksTotal = 0;
+
+  // Memory (bytes). The platform sets the limit (the browser's wasm maximum, or the page's
+  // ?maxMemoryMB=; 0 = none), the heap in use before any dataset (code, stack, UI), the heap
+  // size and the GPU buffers, and may install reserveHeap. openManifest sets the rest.
+  uint64_t memoryLimitBytes = 0, memoryBaseBytes = 0;
+  uint64_t heapBytes = 0, gpuBytes = 0;
+  uint64_t memoryNeededBytes = 0;  // estimate for the whole dataset
+  uint32_t chunksAllowed = 0;      // chunks whose level fits the limit (chunksTotal without one)
+  bool memoryLimited = false;      // stopped short of the full dataset for lack of memory
+  // Grows the heap to at least `bytes` now; false when the browser refuses.
+  bool (*reserveHeap)(uint64_t bytes) = nullptr;
 
   // Level of detail: splits to have applied. `live`: the target follows new data (the slider
   // sits at the newest level); cleared when the user moves it back.
@@ -169,13 +201,16 @@ struct ViewerState {
   // Set by the main loop, counted from the first surface on (before it, start-up work such as
   // WebGL and ImGui set-up is not the viewer's frame rate):
   double frameMs = 0;          // smoothed interval between frame callbacks
-  double maxFrameMs = 0;       // longest frame callback (refinement, uploads, drawing)
+  double maxFrameMs = 0;       // longest frame callback (uploads, drawing, UI)
+  double drawMs = 0, maxDrawMs = 0;  // the last / longest drawn frame's callback
   double maxFrameGapMs = 0;    // longest interval between two frame callbacks (browser included)
   uint64_t uploadBytes = 0;    // GPU bytes uploaded in all (renderer)
   uint32_t fullUploads = 0, partialUploads = 0;
+  uint32_t grownUploads = 0;   // full uploads that were a buffer growing (renderer)
 
   // Set by the model, cleared by whoever consumes them.
   bool surfaceDirty = false;   // surface changed: renderer uploads the changed ranges
+  bool sliceDirty = false;     // slice changed (or turned off): renderer uploads it
   bool hullDirty = false;      // hull changed: renderer uploads the changed ranges
   bool frameRequested = false; // new bounds known: the camera should frame them
   bool surfaceReady = false;   // a level has been extracted (first-surface timing)
@@ -183,8 +218,12 @@ struct ViewerState {
 
   // View options and UI feedback.
   bool showBoundary = true;
+  bool showHelp = false;  // the keyboard shortcuts panel
+  std::string linkNote;   // "link copied" and the like, from the platform
   Rect sliderRect;       // the isovalue slider, recorded by the panel so tests can drag it
   Rect levelSliderRect;  // the level slider
+  Rect sliceSliderRect;  // the slice position slider (while the slice is on)
+  Rect panelRect;        // the whole panel (touches there go to the panel, not the camera)
   Rect pauseButtonRect;  // the pause/resume button (while parts are still to come)
 
   // Scratch, reused every frame.
@@ -226,8 +265,34 @@ void setIsovalue(ViewerState& s, float value);
 bool setField(ViewerState& s, int index);
 bool setField(ViewerState& s, std::string_view name);
 
+// Colour by field (index or name; -1 / "" = none): the range becomes the field's range.
+// False (and nothing changes) when there is no such field.
+bool setColourField(ViewerState& s, int index);
+bool setColourField(ViewerState& s, std::string_view name);
+void setColourMap(ViewerState& s, ColourMap map);
+// Non-finite values are ignored; lo > hi are swapped.
+void setColourRange(ViewerState& s, float lo, float hi);
+
+// The slice plane: on/off and the plane n·p = offset (n normalised; a zero normal is refused).
+// Turning it on without a colour field colours by the isovalue's field.
+void setSliceEnabled(ViewerState& s, bool on);
+bool setSlicePlane(ViewerState& s, std::array<float, 3> normal, float offset);
+// The range of offsets that cut the dataset's bounds for the current normal.
+void sliceOffsetRange(const ViewerState& s, float& lo, float& hi);
+
 // Reports a failure from outside the model (network, platform) in plain words.
 void failLoad(ViewerState& s, std::string_view message);
+
+// What the shell's network side is doing, in plain words ("" when all is well).
+void setNotice(ViewerState& s, std::string_view message);
+
+// Checks a downloaded chunk against the manifest (size, then content hash) without changing
+// anything: the shell fetches a chunk again when it does not match.
+enum class ChunkCheck : uint8_t { Ok, WrongSize, WrongHash, NoSuchChunk };
+ChunkCheck checkChunk(const ViewerState& s, uint32_t index, std::span<const uint8_t> bytes);
+
+// Heap bytes held by the dataset, the surface and the hull now.
+uint64_t memoryInUse(const ViewerState& s);
 
 // Network progress from the shell (cumulative counts), and the rate refresh (once a frame).
 void noteDownload(ViewerState& s, uint64_t networkBytes, uint64_t datasetBytes, double nowMs);
@@ -237,16 +302,33 @@ void tick(ViewerState& s, double nowMs);
 double levelFraction(const ViewerState& s);      // vertices shown / vertices of the full mesh
 double fieldErrorBound(const ViewerState& s);    // manifest estimate for the last complete chunk
 bool downloading(const ViewerState& s);          // chunks still to fetch, not paused, no error
+bool refining(const ViewerState& s);             // splits to apply or undo toward the target
+
+// The interval tree (paper §4.2) is not kept while a level streams in: each split would cost a
+// third more, for isovalue changes that meanwhile test every tet (~10 ms at 1.5M tets in
+// wasm). Once nothing more is coming (complete, paused, stopped) and the level is reached,
+// growTree builds it in slices until the deadline; true while more is to do.
+bool treePending(const ViewerState& s);
+bool growTree(ViewerState& s, double deadlineMs, Clock now);
 double secondsLeft(const ViewerState& s);        // at the current rate; < 0 when unknown
 
 // Everything a test or the JS shell wants to know, as one JSON object:
 // {state, error, name, vertices, tets, triangles, surfaceVertices, isovalue, surfaceArea, field,
+//  colourField (null: none), colourMap, colourRange:[lo,hi], slice:{on, normal:[x,y,z], offset,
+//  triangles, area},
 //  fields:[{name,min,max}], chunksReceived, chunksApplied, chunksTotal, bytesReceived,
 //  bytesDownloaded, bytesTotal, rateBytesPerSec, secondsLeft, splitsApplied, splitsReceived,
 //  splitsTotal, targetSplits, level, live, paused, fieldError, baseVertices, hullTriangles,
 //  hullLines, firstSurfaceMs, completeMs, extractMs, refineMs, maxRefineMs, refineSteps,
-//  frameMs, maxFrameMs, maxFrameGapMs, uploadBytes, fullUploads, partialUploads, showBoundary,
-//  sliderRect:{x,y,w,h}, levelSliderRect:{x,y,w,h}, pauseButtonRect:{x,y,w,h}}.
+//  frameMs, maxFrameMs, maxFrameGapMs, drawMs, maxDrawMs, treeTets (tets the interval tree covers), uploadBytes, fullUploads, partialUploads,
+//  grownUploads (full uploads because a buffer grew), showBoundary,
+//  notice, chunksAllowed, memoryLimited, memory:{heapBytes, dataBytes, gpuBytes, limitBytes,
+//  neededBytes, allowedBytes}, sliderRect:{x,y,w,h}, levelSliderRect:{x,y,w,h},
+//  pauseButtonRect:{x,y,w,h}, sliceSliderRect:{x,y,w,h}, panelRect:{x,y,w,h}, targetLevel (the
+//  level asked for as a fraction of the full mesh's vertices; 1 while live), showBoundary,
+//  showHelp}. memory: heapBytes the wasm memory's size, dataBytes what the
+//  dataset, surface and hull hold, gpuBytes the GPU buffers, limitBytes the limit (null: none),
+//  neededBytes / allowedBytes the estimates for the full dataset / the last level that fits.
 // Times in ms; absolute times (firstSurfaceMs, completeMs) are null until they happen.
 std::string statsJson(const ViewerState& s);
 

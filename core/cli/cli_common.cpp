@@ -17,10 +17,17 @@ void addLevelOptions(CLI::App* sub, LevelOption& level) {
   c->excludes(f);
 }
 
-Result loadInput(const std::string& path, Input& in, const LevelOption& level) {
+void addReadOptions(CLI::App* sub, ReadOptions& read) {
+  sub->add_option("--q,--solution", read.solution,
+                   "PLOT3D Q file for a grid (default: a sibling such as bluntfinq.bin for bluntfinxyz.bin), or a "
+                   "Medit .sol (default: NAME.sol)");
+}
+
+Result loadInput(const std::string& path, Input& in, const LevelOption& level, const ReadOptions& read) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) {
     if (!isPackedDir(path)) return fail(Status::IoError, path + ": a folder without manifest.json is not a packed dataset");
+    if (!read.solution.empty()) return fail(Status::BadArgument, "--q applies to mesh files, not to packed datasets");
     Dataset ds;
     uint32_t maxVertices = ~0u;
     if (level.fraction >= 0) {
@@ -40,7 +47,8 @@ Result loadInput(const std::string& path, Input& in, const LevelOption& level) {
   if (level.chunks >= 0 || level.fraction >= 0)
     return fail(Status::BadArgument, "--chunks and --fraction apply to packed datasets, not to " + path);
   ReadReport report;
-  Result r = readMesh(path, in.mesh, report);
+  Result r = readMesh(path, in.mesh, report, read);
+  in.format = report.format;
   in.notes = report.notes;
   if (r && in.mesh.name.empty()) in.mesh.name = std::filesystem::path(path).stem().string();
   return r;

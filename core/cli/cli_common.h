@@ -10,6 +10,7 @@
 
 #include "manifest.h"
 #include "mesh.h"
+#include "pack/mesh_io.h"
 #include "status.h"
 
 namespace tetstream::cli {
@@ -31,10 +32,14 @@ struct Input {
   uint32_t chunksApplied = 0;       // when packed: complete chunks
   uint32_t splitsApplied = 0;       // when packed: vertex splits applied
   std::vector<std::string> notes;   // what the reader did (converted fields, skipped cells)
+  std::string format;               // mesh files: what the reader read (ReadReport::format)
 };
 
-// A packed dataset folder (with manifest.json) or a mesh file (.vtu, .vtk).
-Result loadInput(const std::string& path, Input& in, const LevelOption& level = {});
+// --q FILE: the solution file of a PLOT3D grid (Q) or of a Medit mesh (.sol).
+void addReadOptions(CLI::App* sub, ReadOptions& read);
+
+// A packed dataset folder (with manifest.json) or a mesh file (any format readMesh reads).
+Result loadInput(const std::string& path, Input& in, const LevelOption& level = {}, const ReadOptions& read = {});
 
 // Picks the field by name, or the dataset's default (isoField for packed data, else the first).
 // Returns its index or sets `r` to a MissingField error listing the available names.

@@ -9,15 +9,18 @@
 namespace tetstream::cli {
 
 Runner addInfo(CLI::App& app) {
-  struct Opts { std::string input; bool json = false; LevelOption level; };
+  struct Opts { std::string input; bool json = false; LevelOption level; ReadOptions read; };
   auto o = std::make_shared<Opts>();
   CLI::App* sub = app.add_subcommand("info", "Counts, fields and ranges, and validation findings");
   sub->add_option("input", o->input, "mesh file or packed dataset folder")->required();
   sub->add_flag("--json", o->json, "print the result as JSON on stdout");
   addLevelOptions(sub, o->level);
+  addReadOptions(sub, o->read);
   return [o] {
     Input in;
-    if (Result r = loadInput(o->input, in, o->level); !r) return reportError(r, o->json);
+    Stopwatch sw;
+    if (Result r = loadInput(o->input, in, o->level, o->read); !r) return reportError(r, o->json);
+    const double readMs = sw.ms();
     const TetMesh& m = in.mesh;
     Bounds b = computeBounds(m.positions);
     ValidationReport v = validateMesh(m);
@@ -37,6 +40,10 @@ Runner addInfo(CLI::App& app) {
                                 {"nonManifoldFaces", v.nonManifoldFaces}, {"boundaryFaces", v.boundaryFaces},
                                 {"nonManifoldBoundaryEdges", v.nonManifoldBoundaryEdges}, {"findings", v.findings}}},
                 {"notes", in.notes}};
+      if (!in.packed) {
+        j["inputFormat"] = in.format;
+        j["readMs"] = readMs;
+      }
       if (in.packed) {
         j["format"] = {{"formatVersion", in.manifest.formatVersion}, {"generator", in.manifest.generator},
                        {"chunks", in.manifest.chunks.size()}, {"chunksApplied", in.chunksApplied},
@@ -49,6 +56,7 @@ Runner addInfo(CLI::App& app) {
     }
     std::printf("%s%s\n", o->input.c_str(), in.packed ? " (packed dataset)" : "");
     std::printf("  name      %s\n", m.name.c_str());
+    if (!in.packed) std::printf("  read      %s in %.0f ms\n", in.format.c_str(), readMs);
     std::printf("  vertices  %u\n  tets      %u\n", m.vertexCount(), m.tetCount());
     std::printf("  bounds    [%g, %g, %g] .. [%g, %g, %g]\n", b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2]);
     for (const ScalarField& f : m.fields) {

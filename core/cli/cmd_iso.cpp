@@ -11,7 +11,7 @@
 namespace tetstream::cli {
 
 Runner addIso(CLI::App& app) {
-  struct Opts { std::string input, field, out; double value = 0; bool json = false; LevelOption level; };
+  struct Opts { std::string input, field, out; double value = 0; bool json = false; LevelOption level; ReadOptions read; };
   auto o = std::make_shared<Opts>();
   CLI::App* sub = app.add_subcommand("iso", "Extract an isosurface (marching tetrahedra)");
   sub->add_option("input", o->input, "mesh file or packed dataset folder")->required();
@@ -20,9 +20,10 @@ Runner addIso(CLI::App& app) {
   sub->add_option("-o,--output", o->out, "write the surface as binary PLY with normals");
   sub->add_flag("--json", o->json, "print the result as JSON on stdout");
   addLevelOptions(sub, o->level);
+  addReadOptions(sub, o->read);
   return [o] {
     Input in;
-    if (Result r = loadInput(o->input, in, o->level); !r) return reportError(r, o->json);
+    if (Result r = loadInput(o->input, in, o->level, o->read); !r) return reportError(r, o->json);
     Result r;
     int f = chooseField(in, o->field, r);
     if (f < 0) return reportError(r, o->json);

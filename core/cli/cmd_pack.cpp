@@ -68,10 +68,14 @@ Runner addPack(CLI::App& app) {
     uint32_t baseVertices = 0, baseTets = 0, chunkKb = 256;
     int level = 19;
     bool lossless = false, json = false;
+    ReadOptions read;
   };
   auto o = std::make_shared<Opts>();
   CLI::App* sub = app.add_subcommand("pack", "Pack a mesh into a progressive dataset folder (manifest + chunks)");
-  sub->add_option("input", o->input, "mesh file (.vtu, .vtk)")->required();
+  sub->add_option("input", o->input,
+                  "mesh file: .vtu/.vts/.vti, .vtk, .msh (Gmsh), .node/.ele (TetGen), .mesh (Medit), PLOT3D grid")
+      ->required();
+  addReadOptions(sub, o->read);
   sub->add_option("-o,--output", o->out, "output folder (created; an earlier pack there is replaced)")->required();
   sub->add_option("--field", o->field, "field that steers simplification and is shown first (default: the first)");
   sub->add_option("--name", o->name, "dataset name shown in the viewer (default: the file name)");
@@ -96,7 +100,7 @@ Runner addPack(CLI::App& app) {
     ProgressLine bar(!o->json && isatty(2));
     bar.update("read", 0, 1);
     Input in;
-    if (Result r = loadInput(o->input, in); !r) {
+    if (Result r = loadInput(o->input, in, {}, o->read); !r) {
       bar.finishLine();
       return reportError(r, o->json);
     }
@@ -133,7 +137,7 @@ Runner addPack(CLI::App& app) {
     for (const std::string& n : s.notes) notes.push_back(n);
     if (o->json) {
       printJson({{"output", o->out}, {"name", m.name}, {"vertices", m.vertices}, {"tets", m.tets},
-                 {"inputVertices", inputVertices}, {"field", m.isoField}, {"lossless", m.lossless},
+                 {"inputVertices", inputVertices}, {"inputFormat", in.format}, {"field", m.isoField}, {"lossless", m.lossless},
                  {"positionBits", m.positionBits}, {"baseVertices", s.baseVertices}, {"baseTets", s.baseTets},
                  {"splits", s.splits}, {"chunks", m.chunks.size()}, {"bytes", bytes}, {"baseBytes", baseBytes},
                  {"bitsPerTet", bitsPerTet}, {"bytesPerSplit", bytesPerSplit},
@@ -145,6 +149,7 @@ Runner addPack(CLI::App& app) {
     }
     for (const auto& n : notes) std::printf("note: %s\n", n.get<std::string>().c_str());
     std::printf("packed %s -> %s/\n", o->input.c_str(), o->out.c_str());
+    std::printf("  format    %s\n", in.format.c_str());
     std::printf("  input     %u vertices, %u tets, field '%s'\n", m.vertices, m.tets, m.isoField.c_str());
     std::printf("  base      %u vertices (%.2f%%), %u tets, %.1f KB, field error <= %.3g (est.)\n", s.baseVertices,
                 100.0 * s.baseVertices / std::max<uint32_t>(m.vertices, 1), s.baseTets, baseBytes / 1024.0,

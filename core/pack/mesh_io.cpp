@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <limits>
@@ -22,7 +23,68 @@ std::string lowerExtension(const std::string& path) {
   return ext;
 }
 
-constexpr const char* kSupported = "supported: .vtu (VTK XML UnstructuredGrid), .vtk (legacy VTK UNSTRUCTURED_GRID)";
+constexpr const char* kSupported =
+    "supported: .vtu/.vts/.vti (VTK XML), .vtk (legacy VTK), .msh (Gmsh 2.2/4.1), .node/.ele (TetGen), "
+    ".mesh (Medit), PLOT3D grids (.xyz, .x, .g, .grd, .p3d, .bin; Q file with --q)";
+
+enum class Format { Unknown, VtkXml, LegacyVtk, Gmsh, Medit, Tetgen, Plot3d };
+
+// The extensions that name a format outright; anything else is sniffed from the content.
+Format byExtension(const std::string& ext) {
+  if (ext == ".vtu" || ext == ".vts" || ext == ".vti") return Format::VtkXml;
+  if (ext == ".vtk") return Format::LegacyVtk;
+  if (ext == ".msh") return Format::Gmsh;
+  if (ext == ".mesh") return Format::Medit;
+  if (ext == ".node" || ext == ".ele") return Format::Tetgen;
+  if (ext == ".xyz") return Format::Plot3d;
+  return Format::Unknown;
+}
+
+bool isPlot3dExtension(const std::string& ext) {
+  for (const char* e : {".xyz", ".x", ".g", ".grd", ".p3d", ".bin", ".dat", ".q", ".fmt"})
+    if (ext == e) return true;
+  return false;
+}
+
+// Recognizes a format by its first bytes. Text formats have a magic word; binary data of a file
+// with a PLOT3D-like extension is taken as PLOT3D (the reader then checks the sizes).
+Format sniff(std::string_view head, const std::string& ext) {
+  size_t p = 0;
+  if (head.substr(0, 3) == "\xEF\xBB\xBF") p = 3;
+  // Skip blank lines and '#' comment lines (Medit, TetGen) but not "# vtk DataFile".
+  while (p < head.size()) {
+    if (head[p] == ' ' || head[p] == '\t' || head[p] == '\r' || head[p] == '\n') {
+      ++p;
+      continue;
+    }
+    if (head[p] == '#' && head.substr(p, 14) != "# vtk DataFile") {
+      size_t e = head.find('\n', p);
+      if (e == std::string_view::npos) break;
+      p = e + 1;
+      continue;
+    }
+    break;
+  }
+  std::string_view t = head.substr(std::min(p, head.size()));
+  if (t.starts_with("<")) return Format::VtkXml;
+  if (t.starts_with("# vtk DataFile")) return Format::LegacyVtk;
+  if (t.starts_with("$MeshFormat")) return Format::Gmsh;
+  if (t.starts_with("MeshVersionFormatted")) return Format::Medit;
+  if (isPlot3dExtension(ext)) return Format::Plot3d;
+  return Format::Unknown;
+}
+
+const char* formatName(Format f) {
+  switch (f) {
+    case Format::VtkXml: return "VTK XML";
+    case Format::LegacyVtk: return "legacy VTK";
+    case Format::Gmsh: return "Gmsh";
+    case Format::Medit: return "Medit";
+    case Format::Tetgen: return "TetGen";
+    case Format::Plot3d: return "PLOT3D";
+    default: return "unknown";
+  }
+}
 
 Result readWholeFile(const std::string& path, std::string& bytes) {
   std::FILE* f = std::fopen(path.c_str(), "rb");
@@ -37,21 +99,28 @@ Result readWholeFile(const std::string& path, std::string& bytes) {
   return Result::success();
 }
 
-}  // namespace
+Result readHead(const std::string& path, std::string& head) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return fail(Status::IoError, path + ": cannot open (" + std::strerror(errno) + ")");
+  head.resize(4096);
+  head.resize(std::fread(head.data(), 1, head.size(), f));
+  std::fclose(f);
+  return Result::success();
+}
 
-Result readMeshBytes(std::string_view bytes, const std::string& name, TetMesh& out, ReadReport& report) {
-  out = TetMesh{};
-  std::string ext = lowerExtension(name);
+bool fileExists(const std::string& path) {
+  std::error_code ec;
+  return std::filesystem::is_regular_file(path, ec);
+}
+
+// Runs a reader, turning exceptions (out of memory) into a Result and clearing `out` on failure.
+template <class F>
+Result guarded(const std::string& name, TetMesh& out, F&& read) {
   Result r;
   // The readers allocate only what the input justifies, but a huge valid file can still exhaust
   // memory; that must come back as a Result, not an exception through the library boundary.
   try {
-    if (ext == ".vtu")
-      r = readVtu(bytes, name, out, report);
-    else if (ext == ".vtk")
-      r = readLegacyVtk(bytes, name, out, report);
-    else
-      return fail(Status::Unsupported, name + ": unsupported mesh format '" + ext + "'; " + kSupported);
+    r = read();
   } catch (const std::bad_alloc&) {
     r = fail(Status::TooLarge, name + ": out of memory while reading");
   } catch (...) {
@@ -65,18 +134,113 @@ Result readMeshBytes(std::string_view bytes, const std::string& name, TetMesh& o
   return r;
 }
 
-Result readMesh(const std::string& path, TetMesh& out, ReadReport& report) {
+Result readOneFile(Format fmt, std::string_view bytes, const std::string& name, TetMesh& out, ReadReport& report) {
+  switch (fmt) {
+    case Format::VtkXml: return readVtu(bytes, name, out, report);
+    case Format::LegacyVtk: return readLegacyVtk(bytes, name, out, report);
+    case Format::Gmsh: return readGmsh(bytes, name, out, report);
+    case Format::Medit: return readMedit(bytes, name, {}, "", out, report);
+    case Format::Plot3d: return readPlot3d(bytes, name, {}, "", out, report);
+    case Format::Tetgen:
+      return fail(Status::Unsupported,
+                  name + ": a TetGen mesh is two files (.node and .ele); read it by path, not from bytes");
+    default: break;
+  }
+  return fail(Status::Unsupported, name + ": unsupported mesh format; " + kSupported);
+}
+
+// "grid.xyz" -> "grid.q"-style companions of a PLOT3D grid that exist on disk, best first.
+std::vector<std::string> plot3dSolutionCandidates(const std::string& path) {
+  namespace fs = std::filesystem;
+  fs::path p(path);
+  std::string file = p.filename().string(), dir = p.parent_path().string();
+  auto join = [&](const std::string& f) { return dir.empty() ? f : (fs::path(dir) / f).string(); };
+  std::vector<std::string> out;
+  std::string lower = file;
+  for (char& c : lower) c = char(std::tolower(static_cast<unsigned char>(c)));
+  // "bluntfinxyz.bin" -> "bluntfinq.bin"; "wing.x" / "wing.xyz" -> "wing.q".
+  for (const char* tag : {"xyz", "grid", "grd"}) {
+    size_t at = lower.rfind(tag);
+    if (at != std::string::npos) out.push_back(join(file.substr(0, at) + "q" + file.substr(at + std::strlen(tag))));
+  }
+  out.push_back(join(p.stem().string() + ".q"));
+  std::vector<std::string> existing;
+  for (const std::string& c : out)
+    if (c != path && fileExists(c) && std::find(existing.begin(), existing.end(), c) == existing.end())
+      existing.push_back(c);
+  return existing;
+}
+
+}  // namespace
+
+Result readMeshBytes(std::string_view bytes, const std::string& name, TetMesh& out, ReadReport& report) {
   out = TetMesh{};
+  std::string ext = lowerExtension(name);
+  Format fmt = byExtension(ext);
+  if (fmt == Format::Unknown) fmt = sniff(bytes.substr(0, 4096), ext);
+  if (fmt == Format::Unknown)
+    return fail(Status::Unsupported, name + ": unsupported mesh format '" + ext + "'; " + kSupported);
+  return guarded(name, out, [&] { return readOneFile(fmt, bytes, name, out, report); });
+}
+
+Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const ReadOptions& options) {
+  out = TetMesh{};
+  namespace fs = std::filesystem;
   std::string ext = lowerExtension(path);
-  if (ext != ".vtu" && ext != ".vtk")  // say so before reading a possibly large file
-    return fail(Status::Unsupported, path + ": unsupported mesh format '" + ext + "'; " + kSupported);
-  std::string bytes;
+  Format fmt = byExtension(ext);
+  if (fmt == Format::Unknown || fmt == Format::Plot3d) {
+    // Sniff the first bytes before reading a possibly large file we cannot read anyway.
+    std::string head;
+    if (Result r = readHead(path, head); !r) return r;
+    fmt = sniff(head, ext);
+    if (fmt == Format::Unknown)
+      return fail(Status::Unsupported, path + ": unsupported mesh format '" + ext + "' (content not recognized); " +
+                                           kSupported);
+  }
+  if (!options.solution.empty() && fmt != Format::Plot3d && fmt != Format::Medit)
+    return fail(Status::BadArgument, path + ": a solution file (--q " + options.solution +
+                                         ") goes with a PLOT3D grid or a Medit mesh, and this is " + formatName(fmt));
+
+  std::string bytes, second;
+  std::string secondPath;
   try {
+    if (fmt == Format::Tetgen) {
+      // Either file may be given; the other has the same stem.
+      const std::string stem = (fs::path(path).parent_path() / fs::path(path).stem()).string();
+      const std::string nodePath = ext == ".node" ? path : stem + ".node";
+      const std::string elePath = ext == ".ele" ? path : stem + ".ele";
+      if (Result r = readWholeFile(nodePath, bytes); !r)
+        return fail(r.status, r.message + " (the .node file of TetGen mesh " + path + ")");
+      if (Result r = readWholeFile(elePath, second); !r)
+        return fail(r.status, r.message + " (the .ele file of TetGen mesh " + path + ")");
+      return guarded(path, out, [&] { return readTetgen(bytes, nodePath, second, elePath, out, report); });
+    }
     if (Result r = readWholeFile(path, bytes); !r) return r;
+    if (fmt == Format::Medit || fmt == Format::Plot3d) {
+      if (!options.solution.empty()) {
+        secondPath = options.solution;
+      } else if (fmt == Format::Medit) {
+        std::string sol = (fs::path(path).parent_path() / fs::path(path).stem()).string() + ".sol";
+        if (fileExists(sol)) secondPath = sol;
+      } else {
+        std::vector<std::string> cands = plot3dSolutionCandidates(path);
+        if (!cands.empty()) {
+          secondPath = cands[0];
+          report.notes.push_back("using the Q solution file " + secondPath +
+                                 " found next to the grid (name another with --q FILE)");
+        }
+      }
+      if (!secondPath.empty())
+        if (Result r = readWholeFile(secondPath, second); !r) return r;
+    }
   } catch (const std::bad_alloc&) {
     return fail(Status::TooLarge, path + ": out of memory while loading the file");
   }
-  return readMeshBytes(bytes, path, out, report);
+  if (fmt == Format::Medit)
+    return guarded(path, out, [&] { return readMedit(bytes, path, second, secondPath, out, report); });
+  if (fmt == Format::Plot3d)
+    return guarded(path, out, [&] { return readPlot3d(bytes, path, second, secondPath, out, report); });
+  return guarded(path, out, [&] { return readOneFile(fmt, bytes, path, out, report); });
 }
 
 Result writeMesh(const std::string& path, const TetMesh& mesh) {
@@ -332,52 +496,6 @@ std::string vtkCellTypeName(int64_t type) {
   return "VTK cell type " + std::to_string(type);
 }
 
-Result appendTets(const std::string& where, std::span<const int64_t> connectivity, std::span<const int64_t> offsets,
-                  std::span<const int64_t> types, uint64_t vertexBase, uint64_t pieceVertexCount, TetMesh& mesh,
-                  CellTally& tally) {
-  const size_t n = types.size();
-  if (offsets.size() != n + 1)
-    return fail(Status::Corrupt, where + ": " + std::to_string(n) + " cell types but " +
-                                     std::to_string(offsets.size() - 1) + " cells in the offsets");
-  const int64_t connSize = int64_t(connectivity.size());
-  if (offsets[0] < 0 || offsets[0] > connSize)
-    return fail(Status::Corrupt, where + ": first cell offset " + std::to_string(offsets[0]) +
-                                     " is outside the connectivity (" + std::to_string(connSize) + " ids)");
-  uint64_t tetCells = 0;
-  for (size_t c = 0; c < n; ++c)
-    if (types[c] == 10 || types[c] == 24) ++tetCells;
-  mesh.tets.reserve(mesh.tets.size() + 4 * tetCells);  // bounded by real data: types has n entries
-
-  for (size_t c = 0; c < n; ++c) {
-    const int64_t b = offsets[c], e = offsets[c + 1];
-    if (e < b || e > connSize)
-      return fail(Status::Corrupt, where + ": cell " + std::to_string(c) + " has offsets " + std::to_string(b) + ".." +
-                                       std::to_string(e) + ", outside 0.." + std::to_string(connSize) +
-                                       " or going backwards");
-    const int64_t type = types[c];
-    if (type != 10 && type != 24) {
-      ++tally.skipped[type];
-      continue;
-    }
-    const int64_t want = type == 10 ? 4 : 10;
-    if (e - b != want)
-      return fail(Status::Corrupt, where + ": cell " + std::to_string(c) + " is " + vtkCellTypeName(type) + " with " +
-                                       std::to_string(e - b) + " points, expected " + std::to_string(want));
-    for (int64_t k = b; k < e; ++k) {
-      int64_t id = connectivity[size_t(k)];
-      if (id < 0 || uint64_t(id) >= pieceVertexCount)
-        return fail(Status::OutOfRange, where + ": cell " + std::to_string(c) + " (" + vtkCellTypeName(type) +
-                                            ") references vertex " + std::to_string(id) + ", but there are " +
-                                            std::to_string(pieceVertexCount) + " points");
-    }
-    // Quadratic tets list their 4 corners first (VTK numbering), then the 6 mid-edge nodes.
-    for (int64_t k = b; k < b + 4; ++k) mesh.tets.push_back(uint32_t(vertexBase + uint64_t(connectivity[size_t(k)])));
-    if (type == 24) ++tally.quadraticTets;
-  }
-  tally.cells += n;
-  return Result::success();
-}
-
 std::vector<float> tuplesToScalars(std::span<const double> tuples, uint32_t components) {
   std::vector<float> out(components ? tuples.size() / components : 0);
   if (components == 1) {
@@ -395,10 +513,10 @@ std::vector<float> tuplesToScalars(std::span<const double> tuples, uint32_t comp
   return out;
 }
 
-std::string fieldNameFor(const std::string& arrayName, uint32_t components, ReadReport& report) {
+std::string fieldNameFor(const std::string& arrayName, uint32_t components, ReadReport& report, const char* kind) {
   if (components == 1) return arrayName;
   std::string name = arrayName + "_magnitude";
-  report.notes.push_back("converted " + std::to_string(components) + "-component point array '" + arrayName +
+  report.notes.push_back("converted " + std::to_string(components) + "-component " + kind + " array '" + arrayName +
                          "' to its magnitude '" + name + "'");
   return name;
 }
@@ -409,46 +527,6 @@ void addField(TetMesh& mesh, ScalarField field, ReadReport& report) {
     return;
   }
   mesh.fields.push_back(std::move(field));
-}
-
-Result finishMesh(const std::string& label, TetMesh& mesh, const CellTally& tally, ReadReport& report) {
-  if (mesh.positions.size() / 3 > kMaxVertices)
-    return fail(Status::TooLarge, label + ": " + std::to_string(mesh.positions.size() / 3) +
-                                      " points; tetstream indexes vertices with 32 bits");
-  if (mesh.tets.size() / 4 > 0xFFFFFFFFull) return fail(Status::TooLarge, label + ": more than 2^32-1 tetrahedra");
-
-  if (tally.quadraticTets)
-    report.notes.push_back("reduced " + std::to_string(tally.quadraticTets) +
-                           " VTK_QUADRATIC_TETRA (24) cells to their 4 corner vertices");
-  std::string found;
-  for (const auto& [type, count] : tally.skipped) {
-    std::string name = vtkCellTypeName(type);
-    report.notes.push_back("skipped " + std::to_string(count) + " cells of unsupported type " + name + " (" +
-                           std::to_string(type) + ")");
-    report.skippedCells.push_back({int(type), name, count});
-    found += (found.empty() ? "" : ", ") + std::to_string(count) + " " + name;
-  }
-
-  if (mesh.tets.empty())
-    return fail(Status::NoTets, label + ": no tetrahedra (VTK_TETRA or VTK_QUADRATIC_TETRA) among " +
-                                    std::to_string(tally.cells) + " cells" +
-                                    (found.empty() ? "" : " (found " + found + ")"));
-
-  const size_t nv = mesh.positions.size() / 3;
-  for (size_t v = 0; v < nv; ++v) {
-    const float* p = &mesh.positions[3 * v];
-    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
-      char buf[128];
-      std::snprintf(buf, sizeof buf, "(%g, %g, %g)", double(p[0]), double(p[1]), double(p[2]));
-      return fail(Status::NonFinite, label + ": point " + std::to_string(v) + " has a non-finite coordinate " + buf);
-    }
-  }
-  for (const ScalarField& f : mesh.fields) {
-    size_t bad = 0;
-    for (float x : f.values) bad += !std::isfinite(x);
-    if (bad) report.notes.push_back("field '" + f.name + "' has " + std::to_string(bad) + " non-finite values");
-  }
-  return Result::success();
 }
 
 }  // namespace vtkio

@@ -1,20 +1,29 @@
-// Mesh files in and out (pack side): VTK XML UnstructuredGrid (.vtu) and legacy VTK (.vtk).
+// Mesh files in and out (pack side). Readers: VTK XML (.vtu UnstructuredGrid, .vts StructuredGrid,
+// .vti ImageData), legacy VTK (.vtk: UNSTRUCTURED_GRID, STRUCTURED_POINTS, STRUCTURED_GRID,
+// RECTILINEAR_GRID), Gmsh .msh 2.2/4.1 (ASCII and binary), TetGen .node/.ele, Medit .mesh (+ .sol),
+// PLOT3D grid + Q. Writer: .vtu.
 //
 // The readers take bytes from strangers: every failure is a Result whose message names the file,
-// the array or cell, and what was expected vs. found. They never throw, never allocate more than
-// the input can justify (a count is checked against the bytes left before anything is sized by
-// it), and report everything they change or drop in ReadReport::notes.
+// the array, section, line or cell, and what was expected vs. found. They never throw, never
+// allocate more than the input can justify (a count is checked against the bytes left before
+// anything is sized by it), and report everything they change or drop in ReadReport::notes, one
+// line per step.
 //
-// What a read produces (TetMesh, core/mesh.h):
-//   - VTK_TETRA (10) cells become tets; VTK_QUADRATIC_TETRA (24) keep their 4 corners (a note
-//     says so); every other cell type is counted by name and listed in notes and skippedCells.
+// What a read produces (TetMesh, core/mesh.h), the same for every format (cells.cpp):
+//   - Tetrahedra stay; hexahedra, wedges and pyramids (and structured grid cells) are split into
+//     6, 3 and 2 tetrahedra, each quad face cut through its smallest vertex id so neighbouring
+//     cells agree (conforming); higher-order cells keep their corners.
+//   - Coincident vertices (equal coordinates) are merged; tetrahedra that then repeat a vertex are
+//     dropped; vertices no tetrahedron uses (mid-edge nodes, unreferenced points) are dropped.
 //   - 1-component point arrays become scalar fields under their own name; n-component arrays
-//     become "NAME_magnitude" (Euclidean norm of the tuple). Cell data is ignored with a note.
-//   - All points are kept, also those no tet uses after dropping cells (validation reports them).
+//     become "NAME_magnitude" (Euclidean norm of the tuple). Cell data becomes point data: the
+//     volume-weighted average over the cells around each vertex ("NAME_cell" when a point array has
+//     the name). Lower-dimensional cells are counted by name and listed in notes and skippedCells.
+//   - Orientation and flat tetrahedra are left to the packer (it re-orients and removes them).
 // Errors: IoError (file), BadMagic (not this format), Unsupported (valid file, feature not read,
 // e.g. DATASET POLYDATA or an LZ4 compressor), Truncated, Corrupt, OutOfRange (a cell's vertex id;
 // the message names the cell), NonFinite (a NaN/Inf coordinate; names the vertex), TooLarge (more
-// than 2^32-1 vertices or tets), DecompressFailed (a zlib block), NoTets (no tetrahedra at all).
+// than 2^32-1 vertices or tets), DecompressFailed (a zlib block), NoTets (no volume cells at all).
 // On failure `out` is left empty; notes gathered so far stay in the report.
 #pragma once
 #include <cstdint>
@@ -39,11 +48,21 @@ struct ReadReport {
   std::vector<SkippedCells> skippedCells;  // by VTK type, ascending
 };
 
-// Reads a mesh file, choosing the reader by extension (.vtu, .vtk; case-insensitive).
-// out.name is set to the file's stem.
-Result readMesh(const std::string& path, TetMesh& out, ReadReport& report);
+struct ReadOptions {
+  // The solution file of a PLOT3D grid (Q file) or a Medit mesh (.sol). Empty: a PLOT3D grid looks
+  // for a sibling ("bluntfinxyz.bin" -> "bluntfinq.bin", "wing.x" -> "wing.q"), a Medit mesh for
+  // NAME.sol.
+  std::string solution;
+};
+
+// Reads a mesh file, choosing the reader by extension (case-insensitive): .vtu/.vts/.vti, .vtk,
+// .msh, .mesh, .node/.ele (reads both), .xyz; other extensions are recognized by their content
+// (PLOT3D for binary data under .x, .g, .grd, .p3d, .bin, .dat). out.name is the file's stem.
+Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const ReadOptions& options = {});
 
 // The same from bytes already in memory; `name` supplies the extension and the label in messages.
+// Formats of two files read only the first here (a PLOT3D grid without Q, a Medit mesh without
+// .sol); TetGen needs readTetgen (readers.h).
 Result readMeshBytes(std::string_view bytes, const std::string& name, TetMesh& out, ReadReport& report);
 
 // Writes a .vtu (VTK XML, appended raw binary; see vtu_writer.cpp). Only .vtu is supported.

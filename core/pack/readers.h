@@ -1,6 +1,7 @@
 // The format back ends behind mesh_io.h, plus the pieces the two VTK readers share.
 // Callers normally use readMesh/readMeshBytes/writeMesh; tests call these directly on bytes.
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <map>
 #include <span>
@@ -14,15 +15,40 @@
 
 namespace tetstream {
 
-// VTK XML UnstructuredGrid (.vtu): format="ascii", inline "binary" (base64) and appended data
-// (encoding="raw" or "base64"), optionally vtkZLibDataCompressor, header_type UInt32 or UInt64,
-// LittleEndian or BigEndian. Several Pieces are concatenated. `label` names the source in messages.
+// VTK XML UnstructuredGrid (.vtu), StructuredGrid (.vts) and ImageData (.vti), by the VTKFile
+// type: format="ascii", inline "binary" (base64) and appended data (encoding="raw" or "base64"),
+// optionally vtkZLibDataCompressor, header_type UInt32 or UInt64, LittleEndian or BigEndian.
+// Several Pieces are concatenated (points they share are merged by finishMesh). Point and cell
+// data are read. `label` names the source in messages.
 Result readVtu(std::string_view bytes, const std::string& label, TetMesh& out, ReadReport& report);
 
-// Legacy VTK (.vtk) DATASET UNSTRUCTURED_GRID, ASCII or BINARY (big-endian), versions up to 5.1:
-// classic CELLS n size and the 5.1 OFFSETS/CONNECTIVITY layout; POINT_DATA SCALARS, VECTORS,
-// NORMALS, TENSORS(6) and FIELD arrays become fields; CELL_DATA is skipped with a note.
+// Legacy VTK (.vtk) DATASET UNSTRUCTURED_GRID, STRUCTURED_POINTS, STRUCTURED_GRID or
+// RECTILINEAR_GRID, ASCII or BINARY (big-endian), versions up to 5.1: classic CELLS n size and
+// the 5.1 OFFSETS/CONNECTIVITY layout; POINT_DATA SCALARS, VECTORS, NORMALS, TENSORS(6) and FIELD
+// arrays become fields, CELL_DATA ones become point data.
 Result readLegacyVtk(std::string_view bytes, const std::string& label, TetMesh& out, ReadReport& report);
+
+// Gmsh .msh 2.2 and 4.1, ASCII and binary (either byte order). Tetrahedra, hexahedra, prisms and
+// pyramids of any order (higher-order nodes dropped); other elements skipped with a count;
+// $NodeData becomes fields, $ElementData becomes point data (volume-weighted). Physical and
+// entity tags are ignored.
+Result readGmsh(std::string_view bytes, const std::string& label, TetMesh& out, ReadReport& report);
+
+// TetGen .node + .ele (either file's bytes may come first; `nodeLabel`/`eleLabel` name them).
+// Point attributes become fields attr0, attr1, ...; 0- or 1-based numbering; 4- or 10-node tets.
+Result readTetgen(std::string_view node, const std::string& nodeLabel, std::string_view ele, const std::string& eleLabel,
+                  TetMesh& out, ReadReport& report);
+
+// Medit .mesh (ASCII): Vertices, Tetrahedra, Hexahedra, Prisms, Pyramids, TetrahedraP2,
+// HexahedraQ2; `sol` (may be empty) is a sibling .sol file whose SolAtVertices become fields.
+Result readMedit(std::string_view mesh, const std::string& label, std::string_view sol, const std::string& solLabel,
+                 TetMesh& out, ReadReport& report);
+
+// PLOT3D grid (.xyz/.x/.g/.bin) with an optional Q solution file (empty: geometry only). The
+// layout (byte order, 4- or 8-byte reals, C binary or Fortran records, single- or multi-grid
+// header, IBLANK) is found by trying every combination against the file size.
+Result readPlot3d(std::string_view grid, const std::string& gridLabel, std::string_view q, const std::string& qLabel,
+                  TetMesh& out, ReadReport& report);
 
 // VTK XML, appended raw binary: Float32 points, Int64 connectivity/offsets, UInt8 types, Float32
 // point data. One fwrite per array; writes PATH.tmp, then renames.
@@ -51,39 +77,177 @@ int parseNextDouble(std::string_view text, size_t& pos, double& out);
 int parseNextInt(std::string_view text, size_t& pos, int64_t& out);
 bool parseU64(std::string_view s, uint64_t& out);  // whole string, decimal digits only
 
+// ASCII case-insensitive equality (keywords of the text formats).
+inline bool iequals(std::string_view a, std::string_view b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i) {
+    char x = a[i], y = b[i];
+    if (x >= 'A' && x <= 'Z') x = char(x - 'A' + 'a');
+    if (y >= 'A' && y <= 'Z') y = char(y - 'A' + 'a');
+    if (x != y) return false;
+  }
+  return true;
+}
+
 // Untrusted text for a message: at most 40 characters, non-printable bytes as '?'.
 std::string printable(std::string_view s);
 
 // "VTK_HEXAHEDRON" for 12; "VTK cell type 99" for a number VTK does not define.
 std::string vtkCellTypeName(int64_t type);
 
-// Counts of what appendTets kept and dropped, over all pieces of a file.
-struct CellTally {
-  uint64_t cells = 0;
-  uint64_t quadraticTets = 0;
-  std::map<int64_t, uint64_t> skipped;  // VTK type -> count
+// ------------------------------------------------------------------ cells (cells.cpp)
+// Every reader collects its volume cells in a CellSoup (corners only, in VTK order) and hands it
+// to finishMesh, which turns it into tetrahedra the same way for every format. That one place
+// merges coincident vertices, splits hexahedra, wedges and pyramids conformingly, turns cell data
+// into point data and drops unused vertices, each step said in one note line.
+enum class CellShape : uint8_t { Tet = 0, Pyramid = 1, Wedge = 2, Hex = 3 };
+inline constexpr int kShapeCorners[4] = {4, 5, 6, 8};
+
+struct CellSoup {
+  std::vector<uint8_t> shapes;    // per cell
+  std::vector<uint32_t> corners;  // concatenated, kShapeCorners[shape] per cell, VTK corner order
+  std::vector<uint32_t> source;   // per cell: index of the input cell it came from (for cell data)
+  uint64_t inputCells = 0;        // every input cell seen, kept or not (the next source index)
+  // Higher-order cells reduced to their corners: type label ("VTK_QUADRATIC_TETRA (24)") ->
+  // (corners kept, count).
+  std::map<std::string, std::pair<int, uint64_t>> reduced;
+  // Cells that are not read: (VTK type or 0, label) -> count. The label names the format's type.
+  std::map<std::pair<int64_t, std::string>, uint64_t> skipped;
+  // Vertices some input cell lists (any node, also mid-edge nodes and nodes of skipped cells).
+  // Readers that cannot leave a vertex out (structured grids) may leave it empty.
+  std::vector<uint8_t> referenced;
+  uint64_t structuredCells = 0;   // hexahedra made from a structured grid (noted apart)
+
+  void add(CellShape shape, const uint32_t* ids, uint64_t sourceIndex) {
+    shapes.push_back(uint8_t(shape));
+    corners.insert(corners.end(), ids, ids + kShapeCorners[int(shape)]);
+    source.push_back(uint32_t(sourceIndex));
+  }
+  void markReferenced(uint64_t v) {
+    if (referenced.size() <= v) referenced.resize(v + 1, 0);
+    referenced[v] = 1;
+  }
 };
 
+// A scalar per input cell (NaN: this cell has no value), to become point data.
+struct CellArray {
+  std::string name;
+  std::vector<double> values;
+};
+
+// What a VTK cell type is to the readers: its linear shape, the node count it must have (0: at
+// least the corners, for Lagrange/Bezier cells of any order), the corners it keeps.
+struct VtkCellInfo {
+  bool volume = false;   // a 3D cell tetstream reads
+  CellShape shape = CellShape::Tet;
+  int nodes = 0;         // exact node count, or 0 for "at least kShapeCorners"
+  bool voxel = false;    // VTK_VOXEL: corners in (i, j, k) order, not around the faces
+};
+VtkCellInfo vtkCellInfo(int64_t type);
+
 // Cell c of a piece uses connectivity[offsets[c] .. offsets[c+1]); offsets has types.size()+1
-// entries. Tets (and the corners of quadratic tets) are appended to mesh.tets with ids shifted by
-// vertexBase; ids must be < pieceVertexCount. `where` starts every message ("a.vtu" or
-// "a.vtu Piece 2"). Corrupt for bad offsets or a tet of the wrong size, OutOfRange for an id.
-Result appendTets(const std::string& where, std::span<const int64_t> connectivity, std::span<const int64_t> offsets,
-                  std::span<const int64_t> types, uint64_t vertexBase, uint64_t pieceVertexCount, TetMesh& mesh,
-                  CellTally& tally);
+// entries. Volume cells go to the soup with ids shifted by vertexBase; ids must be <
+// pieceVertexCount. `where` starts every message ("a.vtu" or "a.vtu Piece 2"). Corrupt for bad
+// offsets or a cell of the wrong size, OutOfRange for an id.
+Result appendVtkCells(const std::string& where, std::span<const int64_t> connectivity, std::span<const int64_t> offsets,
+                      std::span<const int64_t> types, uint64_t vertexBase, uint64_t pieceVertexCount, CellSoup& soup);
+
+// Adds `count` hexahedra of an ni x nj x nk structured grid (points numbered i fastest, starting
+// at vertexBase) to the soup; cell (i, j, k) has source index sourceBase + i + (ni-1)(j + (nj-1)k).
+// keepPoint, when given, has one flag per point (indexed like the mesh, vertexBase included): a cell with a point whose flag is 0 is left
+// out (PLOT3D IBLANK = 0). Returns the number of cells added.
+uint64_t appendStructuredCells(uint64_t ni, uint64_t nj, uint64_t nk, uint64_t vertexBase, uint64_t sourceBase,
+                               CellSoup& soup, const std::vector<uint8_t>* keepPoint = nullptr);
 
 // `tuples` holds vertexCount tuples of `components` values. Returns the scalar per tuple: the
 // value itself for 1 component, else the tuple's Euclidean norm.
 std::vector<float> tuplesToScalars(std::span<const double> tuples, uint32_t components);
 // "NAME" for 1 component, "NAME_magnitude" otherwise; a note says what was converted.
-std::string fieldNameFor(const std::string& arrayName, uint32_t components, ReadReport& report);
+// `kind` is "point" or "cell" (for the note).
+std::string fieldNameFor(const std::string& arrayName, uint32_t components, ReadReport& report,
+                         const char* kind = "point");
 // Adds the field unless a field of that name exists (then a note says it was dropped).
 void addField(TetMesh& mesh, ScalarField field, ReadReport& report);
 
-// Checks shared by every reader once all cells are in: vertex/tet counts within uint32, finite
-// coordinates (NonFinite names the vertex), at least one tet (NoTets lists what was found), and
-// notes for quadratic tets, skipped cells and non-finite field values. Fills report.skippedCells.
-Result finishMesh(const std::string& label, TetMesh& mesh, const CellTally& tally, ReadReport& report);
+// Checks and conversions shared by every reader once all cells are in: finite coordinates
+// (NonFinite names the input vertex), then (cells.cpp) coincident vertices merged, cells split into
+// tetrahedra, cell arrays turned into point fields (volume-weighted), unused vertices dropped;
+// vertex/tet counts within uint32, at least one tet (NoTets lists what was found); notes for each
+// step, skipped cells and non-finite field values. Fills report.skippedCells.
+// mesh.positions and mesh.fields hold the input points; mesh.tets is filled here.
+Result finishMesh(const std::string& label, TetMesh& mesh, CellSoup& soup, std::vector<CellArray> cellArrays,
+                  ReadReport& report);
+
+// Whitespace-separated text with '#' comments (TetGen, Medit), with line numbers for messages.
+struct TextReader {
+  std::string label;
+  std::string_view s;
+  size_t pos = 0;
+
+  // "file line N" for byte position p.
+  std::string at(size_t p) const {
+    return label + " line " +
+           std::to_string(1 + std::count(s.begin(), s.begin() + std::ptrdiff_t(std::min(p, s.size())), '\n'));
+  }
+  void skip() {
+    while (pos < s.size()) {
+      char c = s[pos];
+      if (c == '#') {
+        while (pos < s.size() && s[pos] != '\n') ++pos;
+      } else if (c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v') {
+        ++pos;
+      } else {
+        break;
+      }
+    }
+  }
+  std::string_view peekToken() {
+    skip();
+    size_t e = pos;
+    while (e < s.size() && s[e] != ' ' && s[e] != '\t' && s[e] != '\r' && s[e] != '\n' && s[e] != '#') ++e;
+    return s.substr(pos, e - pos);
+  }
+  // The rest of the current line is consumed (comment included).
+  void endLine() {
+    while (pos < s.size() && s[pos] != '\n') ++pos;
+  }
+  // Number of tokens left on the current line (before a comment).
+  int tokensLeftOnLine() const {
+    int n = 0;
+    size_t p = pos;
+    while (p < s.size() && s[p] != '\n' && s[p] != '#') {
+      while (p < s.size() && (s[p] == ' ' || s[p] == '\t' || s[p] == '\r')) ++p;
+      if (p >= s.size() || s[p] == '\n' || s[p] == '#') break;
+      ++n;
+      while (p < s.size() && s[p] != ' ' && s[p] != '\t' && s[p] != '\r' && s[p] != '\n' && s[p] != '#') ++p;
+    }
+    return n;
+  }
+  // The next token as an integer / a number; Truncated at the end, Corrupt for anything else.
+  Result integer(const std::string& what, int64_t& v) {
+    skip();
+    const size_t p = pos;
+    std::string_view tok = peekToken();
+    if (tok.empty()) return fail(Status::Truncated, at(p) + ": file ends before " + what);
+    size_t q = 0;
+    if (parseNextInt(tok, q, v) != 1 || q != tok.size())
+      return fail(Status::Corrupt, at(p) + ": " + what + ": '" + printable(tok) + "' is not an integer");
+    pos += tok.size();
+    return Result::success();
+  }
+  Result number(const std::string& what, double& v) {
+    skip();
+    const size_t p = pos;
+    std::string_view tok = peekToken();
+    if (tok.empty()) return fail(Status::Truncated, at(p) + ": file ends before " + what);
+    size_t q = 0;
+    if (parseNextDouble(tok, q, v) != 1 || q != tok.size())
+      return fail(Status::Corrupt, at(p) + ": " + what + ": '" + printable(tok) + "' is not a number");
+    pos += tok.size();
+    return Result::success();
+  }
+};
+
 
 // Caps on what a file may declare before we believe it.
 inline constexpr uint64_t kMaxComponents = 1024;  // per array tuple

@@ -1,4 +1,5 @@
-// Legacy VTK reader (DATASET UNSTRUCTURED_GRID). Reference: "VTK File Formats", legacy section
+// Legacy VTK reader (DATASET UNSTRUCTURED_GRID, STRUCTURED_POINTS, STRUCTURED_GRID,
+// RECTILINEAR_GRID). Reference: "VTK File Formats", legacy section
 // (https://docs.vtk.org/en/latest/design_documents/VTKFileFormats.html) and vtkDataReader.
 //
 // The file is keyword lines ("POINTS 27 float") each followed by its values: whitespace-separated
@@ -6,8 +7,12 @@
 // BINARY files. Cells come in two layouts: classic "CELLS n size" (per cell: count, ids) and the
 // 5.1 "CELLS nOffsets nConnectivity" followed by OFFSETS and CONNECTIVITY arrays (VTK 9, meshio 5).
 // VTK 9 follows arrays with "METADATA" blocks that end at an empty line; they are skipped.
+// Structured datasets have no cells in the file: DIMENSIONS nx ny nz gives (nx-1)(ny-1)(nz-1)
+// hexahedra over points numbered x fastest, from ORIGIN/SPACING (STRUCTURED_POINTS), POINTS
+// (STRUCTURED_GRID) or X/Y/Z_COORDINATES (RECTILINEAR_GRID). Cell data becomes point data.
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstring>
 #include <set>
 
@@ -17,13 +22,6 @@ namespace tetstream {
 namespace {
 
 using namespace vtkio;
-
-bool iequals(std::string_view a, std::string_view b) {
-  if (a.size() != b.size()) return false;
-  for (size_t i = 0; i < a.size(); ++i)
-    if (std::tolower(static_cast<unsigned char>(a[i])) != std::tolower(static_cast<unsigned char>(b[i]))) return false;
-  return true;
-}
 
 bool isSpace(char c) { return c == ' ' || c == '\n' || c == '\r' || c == '\t' || c == '\f' || c == '\v'; }
 
@@ -104,6 +102,7 @@ bool parseLegacyType(std::string_view n, LegacyType& t) {
 }
 
 enum class Section { Dataset, PointData, CellData };
+enum class Kind { Unstructured, StructuredPoints, StructuredGrid, Rectilinear };
 
 struct Legacy {
   std::string label;
@@ -114,11 +113,17 @@ struct Legacy {
 
   // What has been read.
   bool haveDataset = false, havePoints = false, haveCells = false, haveTypes = false, newCellLayout = false;
+  Kind kind = Kind::Unstructured;
+  bool haveDims = false, haveOrigin = false, haveSpacing = false;
+  uint64_t dims[3] = {0, 0, 0};
+  double origin[3] = {0, 0, 0}, spacing[3] = {1, 1, 1};
+  std::vector<double> axis[3];  // RECTILINEAR_GRID coordinates
   uint64_t pointCount = 0, cellCount = 0;
   std::vector<float> positions;
   std::vector<int64_t> connectivity, offsets, types;
   std::vector<ScalarField> fields;
-  std::vector<std::string> cellArrays, skippedArrays;
+  std::vector<CellArray> cellArrays;
+  std::vector<std::string> skippedArrays;
   Section section = Section::Dataset;
   uint64_t sectionCount = 0;
 
@@ -281,6 +286,80 @@ struct Legacy {
     return Result::success();
   }
 
+  uint64_t structuredCellCount() const {
+    if (!haveDims) return 0;
+    uint64_t n = 1;
+    for (uint64_t d : dims) n *= d > 1 ? d - 1 : 0;
+    return n;
+  }
+
+  // The structured dataset's mesh is complete once its points are known.
+  bool meshComplete() const {
+    switch (kind) {
+      case Kind::Unstructured: return havePoints && haveCells && haveTypes;
+      case Kind::StructuredPoints: return haveDims;
+      case Kind::StructuredGrid: return haveDims && havePoints;
+      case Kind::Rectilinear: return haveDims && !axis[0].empty() && !axis[1].empty() && !axis[2].empty();
+    }
+    return false;
+  }
+
+  Result readDimensions(const std::vector<std::string_view>& a, size_t p) {
+    if (haveDims) return error(Status::Corrupt, p, "a second DIMENSIONS");
+    if (a.size() < 3) return error(Status::Corrupt, p, "DIMENSIONS needs three counts");
+    uint64_t n = 1;
+    for (int k = 0; k < 3; ++k) {
+      if (Result r = parseCount(a[size_t(k)], p, "DIMENSIONS", dims[k]); !r) return r;
+      if (dims[k] == 0) return error(Status::Corrupt, p, "DIMENSIONS has a zero count");
+      if (__builtin_mul_overflow(n, dims[k], &n) || n > kMaxVertices)
+        return error(Status::TooLarge, p,
+                     "DIMENSIONS " + std::string(a[0]) + " " + std::string(a[1]) + " " + std::string(a[2]) +
+                         ": more than 2^32-1 points; tetstream indexes vertices with 32 bits");
+    }
+    // STRUCTURED_POINTS stores no coordinates: a huge grid in a tiny file is a lie until its point
+    // data arrives, so cap what the file size can justify (16 points per byte, at least 2^20).
+    if (kind == Kind::StructuredPoints && n > std::max<uint64_t>(uint64_t(1) << 20, 16 * uint64_t(s.size())))
+      return error(Status::Truncated, p,
+                   "DIMENSIONS declares " + std::to_string(n) + " points, far more than a file of " +
+                       std::to_string(s.size()) + " bytes can carry data for");
+    if (havePoints && n != pointCount)
+      return error(Status::Corrupt, p,
+                   "DIMENSIONS gives " + std::to_string(n) + " points, POINTS has " + std::to_string(pointCount));
+    pointCount = n;
+    haveDims = true;
+    return Result::success();
+  }
+
+  Result readTriple(std::string_view kw, const std::vector<std::string_view>& a, size_t p) {
+    if (a.size() < 3) return error(Status::Corrupt, p, std::string(kw) + " needs three numbers");
+    double v[3];
+    for (int k = 0; k < 3; ++k) {
+      size_t q = 0;
+      if (parseNextDouble(a[size_t(k)], q, v[k]) != 1 || !std::isfinite(v[k]))
+        return error(Status::Corrupt, p,
+                     std::string(kw) + ": '" + printable(a[size_t(k)]) + "' is not a finite number");
+    }
+    double* dst = iequals(kw, "ORIGIN") ? origin : spacing;
+    std::copy(v, v + 3, dst);
+    (iequals(kw, "ORIGIN") ? haveOrigin : haveSpacing) = true;
+    return Result::success();
+  }
+
+  Result readAxis(std::string_view kw, const std::vector<std::string_view>& a, size_t p) {
+    const int k = kw[0] == 'X' || kw[0] == 'x' ? 0 : kw[0] == 'Y' || kw[0] == 'y' ? 1 : 2;
+    if (!axis[k].empty()) return error(Status::Corrupt, p, "a second " + std::string(kw));
+    if (a.size() < 2) return error(Status::Corrupt, p, std::string(kw) + " needs a count and a type");
+    uint64_t n;
+    LegacyType t;
+    if (Result r = parseCount(a[0], p, std::string(kw).c_str(), n); !r) return r;
+    if (Result r = parseType(a[1], p, t); !r) return r;
+    if (haveDims && n != dims[k])
+      return error(Status::Corrupt, p,
+                   std::string(kw) + " has " + std::to_string(n) + " values, DIMENSIONS says " + std::to_string(dims[k]));
+    if (n == 0) return error(Status::Corrupt, p, std::string(kw) + " is empty");
+    return readValues<double>(t, n, std::string(kw), &axis[k]);
+  }
+
   Result readCells(const std::vector<std::string_view>& a, size_t p) {
     if (!haveDataset) return error(Status::Corrupt, p, "CELLS before DATASET");
     if (haveCells) return error(Status::Corrupt, p, "a second CELLS section");
@@ -369,16 +448,20 @@ struct Legacy {
     uint64_t count;
     if (__builtin_mul_overflow(tuples, comps, &count))
       return error(Status::TooLarge, pos, what + ": value count overflows");
-    bool keep = section == Section::PointData && convertible && tuples == pointCount;
+    const bool cellSection = section == Section::CellData;
+    bool keep = convertible && ((section == Section::PointData && tuples == pointCount) ||
+                                (cellSection && tuples == sectionCount));
     if (!keep) {
-      if (section == Section::CellData)
-        cellArrays.push_back(name);
-      else
-        skippedArrays.push_back(what);
+      skippedArrays.push_back(what);
       return readValues<double>(t, count, what, nullptr);
     }
     std::vector<double> v;
     if (Result r = readValues<double>(t, count, what, &v); !r) return r;
+    if (cellSection) {
+      std::vector<float> scalars = tuplesToScalars(v, uint32_t(comps));
+      cellArrays.push_back({fieldNameFor(name, uint32_t(comps), report, "cell"), std::vector<double>(scalars.begin(), scalars.end())});
+      return Result::success();
+    }
     ScalarField f{fieldNameFor(name, uint32_t(comps), report), tuplesToScalars(v, uint32_t(comps))};
     fields.push_back(std::move(f));
     return Result::success();
@@ -471,24 +554,49 @@ struct Legacy {
   Result keyword(std::string_view kw, const std::vector<std::string_view>& a, size_t kp) {
     if (iequals(kw, "DATASET")) {
       if (a.empty()) return error(Status::Corrupt, kp, "DATASET needs a type");
-      if (!iequals(a[0], "UNSTRUCTURED_GRID"))
+      if (haveDataset) return error(Status::Corrupt, kp, "a second DATASET");
+      if (iequals(a[0], "UNSTRUCTURED_GRID"))
+        kind = Kind::Unstructured;
+      else if (iequals(a[0], "STRUCTURED_POINTS"))
+        kind = Kind::StructuredPoints;
+      else if (iequals(a[0], "STRUCTURED_GRID"))
+        kind = Kind::StructuredGrid;
+      else if (iequals(a[0], "RECTILINEAR_GRID"))
+        kind = Kind::Rectilinear;
+      else
         return error(Status::Unsupported, kp,
-                     "DATASET " + printable(a[0]) + " is not supported; tetstream reads UNSTRUCTURED_GRID");
+                     "DATASET " + printable(a[0]) +
+                         " is not supported; tetstream reads UNSTRUCTURED_GRID, STRUCTURED_POINTS, STRUCTURED_GRID "
+                         "and RECTILINEAR_GRID");
       haveDataset = true;
       return Result::success();
     }
     if (!haveDataset) return error(Status::Corrupt, kp, "expected DATASET, found '" + printable(kw) + "'");
-    if (iequals(kw, "POINTS")) return readPoints(a, kp);
+    const bool structured = kind != Kind::Unstructured;
+    if (iequals(kw, "DIMENSIONS") && structured) return readDimensions(a, kp);
+    if ((iequals(kw, "ORIGIN") || iequals(kw, "SPACING") || iequals(kw, "ASPECT_RATIO")) &&
+        kind == Kind::StructuredPoints)
+      return readTriple(kw, a, kp);
+    if ((iequals(kw, "X_COORDINATES") || iequals(kw, "Y_COORDINATES") || iequals(kw, "Z_COORDINATES")) &&
+        kind == Kind::Rectilinear)
+      return readAxis(kw, a, kp);
+    if (iequals(kw, "POINTS") && (kind == Kind::Unstructured || kind == Kind::StructuredGrid)) return readPoints(a, kp);
+    if ((iequals(kw, "CELLS") || iequals(kw, "CELL_TYPES")) && structured)
+      return error(Status::Corrupt, kp, std::string(kw) + " in a structured dataset");
     if (iequals(kw, "CELLS")) return readCells(a, kp);
     if (iequals(kw, "CELL_TYPES")) return readCellTypes(a, kp);
     if (iequals(kw, "POINT_DATA") || iequals(kw, "CELL_DATA")) {
       bool pd = iequals(kw, "POINT_DATA");
       if (a.empty() || !parseU64(a[0], sectionCount))
         return error(Status::Corrupt, kp, std::string(kw) + " needs a count");
-      if (pd && havePoints && sectionCount != pointCount)
+      if (pd && (havePoints || haveDims) && sectionCount != pointCount)
         return error(
             Status::Corrupt, kp,
             "POINT_DATA " + std::to_string(sectionCount) + " but there are " + std::to_string(pointCount) + " points");
+      const uint64_t cells = structured ? structuredCellCount() : cellCount;
+      if (!pd && (haveCells || haveDims) && sectionCount != cells)
+        return error(Status::Corrupt, kp,
+                     "CELL_DATA " + std::to_string(sectionCount) + " but there are " + std::to_string(cells) + " cells");
       section = pd ? Section::PointData : Section::CellData;
       return Result::success();
     }
@@ -524,8 +632,13 @@ struct Legacy {
                   label + ": legacy VTK version " + printable(v[0]) + " (tetstream reads up to 5.1)");
     if (pos >= s.size()) return fail(Status::Truncated, label + ": file ends after the first line");
     restOfLine();  // title
+    // vtkDataReader reads the file type as a word: blank lines before it are allowed.
     size_t mp = pos;
     std::vector<std::string_view> mode = split(restOfLine());
+    while (mode.empty() && pos < s.size()) {
+      mp = pos;
+      mode = split(restOfLine());
+    }
     if (mode.empty()) return error(Status::Truncated, mp, "file ends before ASCII/BINARY");
     if (iequals(mode[0], "BINARY"))
       binary = true;
@@ -542,7 +655,7 @@ struct Legacy {
       if (r) continue;
       // A string array cannot be skipped (its length is not declared up front); once the mesh
       // itself is complete, keep what we have rather than refuse the file.
-      if (r.status == Status::Unsupported && section != Section::Dataset && havePoints && haveCells && haveTypes) {
+      if (r.status == Status::Unsupported && section != Section::Dataset && meshComplete()) {
         report.notes.push_back("stopped reading attributes: " + r.message.substr(label.size() + 1) +
                                "; later arrays are ignored");
         break;
@@ -550,6 +663,22 @@ struct Legacy {
       return r;
     }
     if (!haveDataset) return fail(Status::Truncated, label + ": file ends before DATASET");
+    if (kind != Kind::Unstructured) {
+      if (!haveDims) return fail(Status::Truncated, label + ": file ends before DIMENSIONS");
+      if (kind == Kind::StructuredGrid && !havePoints) return fail(Status::Truncated, label + ": file ends before POINTS");
+      if (kind == Kind::Rectilinear)
+        for (int k = 0; k < 3; ++k)
+          if (axis[k].empty())
+            return fail(Status::Truncated, label + ": file ends before " + "XYZ"[k] + std::string("_COORDINATES"));
+      if (kind == Kind::StructuredGrid && pointCount != dims[0] * dims[1] * dims[2])
+        return fail(Status::Corrupt, label + ": POINTS has " + std::to_string(pointCount) + " points, DIMENSIONS " +
+                                         std::to_string(dims[0] * dims[1] * dims[2]));
+      static constexpr const char* kKinds[] = {"", "STRUCTURED_POINTS", "STRUCTURED_GRID", "RECTILINEAR_GRID"};
+      report.format = std::string("legacy VTK ") + version + " (" + (binary ? "BINARY" : "ASCII") + ", " +
+                      kKinds[int(kind)] + " " + std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" +
+                      std::to_string(dims[2]) + ")";
+      return Result::success();
+    }
     if (!havePoints) return fail(Status::Truncated, label + ": file ends before POINTS");
     if (haveCells && !haveTypes) return fail(Status::Truncated, label + ": file has CELLS but ends before CELL_TYPES");
     if (haveTypes && !haveCells) return fail(Status::Corrupt, label + ": CELL_TYPES without CELLS");
@@ -569,22 +698,39 @@ Result readLegacyVtk(std::string_view bytes, const std::string& label, TetMesh& 
   Legacy lg(label, bytes, report);
   if (Result r = lg.parse(); !r) return r;
 
-  if (!lg.haveCells)
-    return fail(Status::NoTets,
-                label + ": no CELLS section (" + std::to_string(lg.pointCount) + " points and no cells)");
   TetMesh mesh;
-  mesh.positions = std::move(lg.positions);
-  CellTally tally;
-  if (lg.offsets.empty()) lg.offsets.push_back(0);
-  if (Result r = appendTets(label, lg.connectivity, lg.offsets, lg.types, 0, lg.pointCount, mesh, tally); !r) return r;
-  for (ScalarField& f : lg.fields) addField(mesh, std::move(f), report);
-  if (!lg.cellArrays.empty()) {
-    std::string names;
-    for (const std::string& n : lg.cellArrays) names += (names.empty() ? "'" : ", '") + n + "'";
-    report.notes.push_back("ignored cell data arrays " + names + " (tetstream reads point data only)");
+  CellSoup soup;
+  if (lg.kind == Kind::Unstructured) {
+    if (!lg.haveCells)
+      return fail(Status::NoTets,
+                  label + ": no CELLS section (" + std::to_string(lg.pointCount) + " points and no cells)");
+    mesh.positions = std::move(lg.positions);
+    if (lg.offsets.empty()) lg.offsets.push_back(0);
+    if (Result r = appendVtkCells(label, lg.connectivity, lg.offsets, lg.types, 0, lg.pointCount, soup); !r) return r;
+  } else {
+    const uint64_t nx = lg.dims[0], ny = lg.dims[1], nz = lg.dims[2];
+    if (nx < 2 || ny < 2 || nz < 2)
+      return fail(Status::NoTets, label + ": DIMENSIONS " + std::to_string(nx) + " " + std::to_string(ny) + " " +
+                                      std::to_string(nz) + " is not a 3D grid (no volume cells)");
+    if (lg.kind == Kind::StructuredGrid) {
+      mesh.positions = std::move(lg.positions);
+    } else {
+      mesh.positions.resize(3 * lg.pointCount);
+      for (uint64_t k = 0, v = 0; k < nz; ++k)
+        for (uint64_t j = 0; j < ny; ++j)
+          for (uint64_t i = 0; i < nx; ++i, ++v) {
+            const uint64_t ijk[3] = {i, j, k};
+            for (int c = 0; c < 3; ++c)
+              mesh.positions[3 * v + c] = float(lg.kind == Kind::Rectilinear ? lg.axis[c][ijk[c]]
+                                                                            : lg.origin[c] + lg.spacing[c] * double(ijk[c]));
+          }
+    }
+    appendStructuredCells(nx, ny, nz, 0, 0, soup);
+    soup.inputCells = lg.structuredCellCount();
   }
+  for (ScalarField& f : lg.fields) addField(mesh, std::move(f), report);
   for (const std::string& w : lg.skippedArrays) report.notes.push_back("skipped " + w);
-  if (Result r = finishMesh(label, mesh, tally, report); !r) return r;
+  if (Result r = finishMesh(label, mesh, soup, std::move(lg.cellArrays), report); !r) return r;
   out = std::move(mesh);
   return Result::success();
 }

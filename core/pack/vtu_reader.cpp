@@ -13,6 +13,7 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <pugixml.hpp>
 #include <set>
@@ -137,6 +138,7 @@ struct Vtu {
   bool hasAppended = false;
   bool appendedBase64 = false;
   std::string_view appended;        // after '_' up to </AppendedData>
+  size_t fileBytes = 0;
   std::set<std::string> encodings;  // seen, for ReadReport::format
 };
 
@@ -370,26 +372,128 @@ Result readComponents(pugi::xml_node da, const ArrayRef& ref, uint64_t& comps) {
 
 struct PieceResult {
   std::vector<ScalarField> fields;
-  std::vector<std::string> cellArrays;
+  std::vector<CellArray> cellArrays;  // one value per cell of this piece
 };
 
-// Reads one Piece: appends its points and tets to mesh, returns its point fields.
-Result readPiece(Vtu& vtu, pugi::xml_node piece, const std::string& where, TetMesh& mesh, CellTally& tally,
-                 ReadReport& report, bool notePieceConversions, PieceResult& pr) {
-  uint64_t np, nc;
-  if (Result r = readCount(piece, "NumberOfPoints", where, np); !r) return r;
-  if (Result r = readCount(piece, "NumberOfCells", where, nc); !r) return r;
+enum class GridKind { Unstructured, Structured, Image };
+
+// The geometry of a structured piece: its Extent and, for ImageData, how indices become points.
+struct Grid {
+  int64_t extent[6] = {0, 0, 0, 0, 0, 0};
+  double origin[3] = {0, 0, 0}, spacing[3] = {1, 1, 1};
+  double direction[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  uint64_t n(int axis) const { return uint64_t(extent[2 * axis + 1] - extent[2 * axis] + 1); }
+};
+
+// Parses "a b c ..." of exactly `count` numbers from an attribute.
+template <class T>
+bool parseNumbers(const char* text, int count, T* out) {
+  std::string_view s(text);
+  size_t pos = 0;
+  for (int k = 0; k < count; ++k) {
+    if constexpr (std::is_same_v<T, int64_t>) {
+      if (parseNextInt(s, pos, out[k]) != 1) return false;
+    } else {
+      if (parseNextDouble(s, pos, out[k]) != 1 || !std::isfinite(out[k])) return false;
+    }
+  }
+  T extra;
+  if constexpr (std::is_same_v<T, int64_t>)
+    return parseNextInt(s, pos, extra) == 0;
+  else
+    return parseNextDouble(s, pos, extra) == 0;
+}
+
+Result readExtent(pugi::xml_node node, const char* attr, const std::string& where, Grid& g) {
+  const char* text = node.attribute(attr).value();
+  if (!parseNumbers(text, 6, g.extent))
+    return fail(Status::Corrupt, where + ": " + attr + "='" + printable(text) + "' is not six integers");
+  for (int a = 0; a < 3; ++a)
+    if (g.extent[2 * a + 1] < g.extent[2 * a] || g.extent[2 * a + 1] - g.extent[2 * a] >= int64_t(kMaxVertices))
+      return fail(Status::Corrupt, where + ": " + attr + "='" + printable(text) + "' has an empty or huge range");
+  return Result::success();
+}
+
+// Reads the PointData and CellData arrays of one piece (np points, nc cells).
+Result readPieceData(Vtu& vtu, pugi::xml_node piece, const std::string& where, uint64_t np, uint64_t nc,
+                     ReadReport& report, bool notePieceConversions, PieceResult& pr) {
+  for (const char* section : {"PointData", "CellData"}) {
+    const bool cells = section[0] == 'C';
+    const char* kind = cells ? "cell" : "point";
+    int index = 0;
+    for (pugi::xml_node da : piece.child(section).children("DataArray")) {
+      std::string name = da.attribute("Name").value();
+      if (name.empty()) name = "array" + std::to_string(index);
+      ++index;
+      ArrayRef ref{where, name};
+      ScalarType type;
+      if (!parseXmlScalarType(da.attribute("type").value(), type)) {
+        if (notePieceConversions)
+          report.notes.push_back(std::string("skipped ") + kind + " array '" + name + "' of non-numeric type '" +
+                                 da.attribute("type").value() + "'");
+        continue;
+      }
+      uint64_t comps;
+      if (Result r = readComponents(da, ref, comps); !r) return r;
+      std::vector<double> values;
+      if (Result r = readDataArray(vtu, da, ref, (cells ? nc : np) * comps, values); !r) return r;
+      ReadReport scratch;
+      std::string fname = fieldNameFor(name, uint32_t(comps), notePieceConversions ? report : scratch, kind);
+      std::vector<float> scalars = tuplesToScalars(values, uint32_t(comps));
+      if (cells)
+        pr.cellArrays.push_back({fname, std::vector<double>(scalars.begin(), scalars.end())});
+      else
+        pr.fields.push_back({fname, std::move(scalars)});
+    }
+  }
+  return Result::success();
+}
+
+// Reads one Piece: appends its points to mesh and its cells to the soup, returns its arrays.
+Result readPiece(Vtu& vtu, GridKind kind, const Grid& whole, pugi::xml_node piece, const std::string& where,
+                 TetMesh& mesh, CellSoup& soup, ReadReport& report, bool notePieceConversions, PieceResult& pr) {
+  uint64_t np = 0, nc = 0;
+  Grid g = whole;
+  if (kind == GridKind::Unstructured) {
+    if (Result r = readCount(piece, "NumberOfPoints", where, np); !r) return r;
+    if (Result r = readCount(piece, "NumberOfCells", where, nc); !r) return r;
+  } else {
+    if (Result r = readExtent(piece, "Extent", where, g); !r) return r;
+    uint64_t n = 1, c = 1;
+    for (int a = 0; a < 3; ++a) {
+      if (__builtin_mul_overflow(n, g.n(a), &n) || n > kMaxVertices)
+        return fail(Status::TooLarge, where + ": Extent gives more than 2^32-1 points");
+      c *= g.n(a) - 1;
+    }
+    np = n;
+    nc = c;
+    // ImageData stores no coordinates: until its arrays arrive, a huge extent is a lie. Cap it
+    // by what the file could carry (16 points per byte, at least 2^20).
+    if (kind == GridKind::Image && np > std::max<uint64_t>(uint64_t(1) << 20, 16 * uint64_t(vtu.fileBytes)))
+      return fail(Status::Truncated, where + ": Extent declares " + std::to_string(np) + " points, far more than a " +
+                                         std::to_string(vtu.fileBytes) + "-byte file can carry data for");
+  }
   const uint64_t vertexBase = mesh.positions.size() / 3;
   if (np > kMaxVertices || vertexBase + np > kMaxVertices)
     return fail(Status::TooLarge,
                 where + ": " + std::to_string(vertexBase + np) + " points; tetstream indexes vertices with 32 bits");
 
   // Points
-  if (np > 0) {
+  if (kind == GridKind::Image) {
+    mesh.positions.reserve(mesh.positions.size() + 3 * np);
+    for (int64_t k = g.extent[4]; k <= g.extent[5]; ++k)
+      for (int64_t j = g.extent[2]; j <= g.extent[3]; ++j)
+        for (int64_t i = g.extent[0]; i <= g.extent[1]; ++i) {
+          const double d[3] = {double(i) * g.spacing[0], double(j) * g.spacing[1], double(k) * g.spacing[2]};
+          for (int c = 0; c < 3; ++c)
+            mesh.positions.push_back(float(g.origin[c] + g.direction[3 * c] * d[0] + g.direction[3 * c + 1] * d[1] +
+                                           g.direction[3 * c + 2] * d[2]));
+        }
+  } else if (np > 0) {
     pugi::xml_node da = piece.child("Points").child("DataArray");
     ArrayRef ref{where, da ? da.attribute("Name").as_string("Points") : "Points"};
     if (!da)
-      return fail(Status::Corrupt, where + ": NumberOfPoints=" + std::to_string(np) + " but no <Points> DataArray");
+      return fail(Status::Corrupt, where + ": " + std::to_string(np) + " points but no <Points> DataArray");
     uint64_t comps;
     if (Result r = readComponents(da, ref, comps); !r) return r;
     if (comps != 3)
@@ -400,8 +504,12 @@ Result readPiece(Vtu& vtu, pugi::xml_node piece, const std::string& where, TetMe
     for (double x : p) mesh.positions.push_back(float(x));
   }
 
-  // Cells: offsets first, since the last offset is the connectivity length.
-  if (nc > 0) {
+  // Cells
+  if (kind != GridKind::Unstructured) {
+    appendStructuredCells(g.n(0), g.n(1), g.n(2), vertexBase, soup.inputCells, soup);
+    soup.inputCells += nc;
+  } else if (nc > 0) {
+    // Offsets first, since the last offset is the connectivity length.
     pugi::xml_node cells = piece.child("Cells");
     pugi::xml_node daOff = findArray(cells, "offsets"), daTypes = findArray(cells, "types"),
                    daConn = findArray(cells, "connectivity");
@@ -417,40 +525,14 @@ Result readPiece(Vtu& vtu, pugi::xml_node piece, const std::string& where, TetMe
                   where + ": DataArray 'offsets': last offset " + std::to_string(connSize) + " is negative");
     if (Result r = readDataArray(vtu, daTypes, {where, "types"}, nc, types); !r) return r;
     if (Result r = readDataArray(vtu, daConn, {where, "connectivity"}, uint64_t(connSize), conn); !r) return r;
-    // VTU offsets are cell ends; appendTets wants starts plus the final end.
+    // VTU offsets are cell ends; appendVtkCells wants starts plus the final end.
     offsets.reserve(ends.size() + 1);
     offsets.push_back(0);
     offsets.insert(offsets.end(), ends.begin(), ends.end());
     ends = {};
-    if (Result r = appendTets(where, conn, offsets, types, vertexBase, np, mesh, tally); !r) return r;
+    if (Result r = appendVtkCells(where, conn, offsets, types, vertexBase, np, soup); !r) return r;
   }
-
-  // Point data
-  int index = 0;
-  for (pugi::xml_node da : piece.child("PointData").children("DataArray")) {
-    std::string name = da.attribute("Name").value();
-    if (name.empty()) name = "array" + std::to_string(index);
-    ++index;
-    ArrayRef ref{where, name};
-    ScalarType type;
-    if (!parseXmlScalarType(da.attribute("type").value(), type)) {
-      if (notePieceConversions)
-        report.notes.push_back("skipped point array '" + name + "' of non-numeric type '" +
-                               da.attribute("type").value() + "'");
-      continue;
-    }
-    uint64_t comps;
-    if (Result r = readComponents(da, ref, comps); !r) return r;
-    std::vector<double> values;
-    if (Result r = readDataArray(vtu, da, ref, np * comps, values); !r) return r;
-    ReadReport scratch;
-    ScalarField f{fieldNameFor(name, uint32_t(comps), notePieceConversions ? report : scratch),
-                  tuplesToScalars(values, uint32_t(comps))};
-    pr.fields.push_back(std::move(f));
-  }
-  for (pugi::xml_node da : piece.child("CellData").children("DataArray"))
-    pr.cellArrays.push_back(da.attribute("Name").value());
-  return Result::success();
+  return readPieceData(vtu, piece, where, np, nc, report, notePieceConversions, pr);
 }
 
 // Locates <AppendedData ...> and its '_' marker in the raw bytes. xmlEnd is where the parsable XML
@@ -536,10 +618,19 @@ Result readVtu(std::string_view bytes, const std::string& label, TetMesh& out, R
   pugi::xml_node root = doc.document_element();
   if (std::strcmp(root.name(), "VTKFile") != 0)
     return fail(Status::BadMagic, label + ": root element is <" + root.name() + ">, expected <VTKFile>");
-  std::string_view type = root.attribute("type").value();
-  if (type != "UnstructuredGrid")
-    return fail(Status::Unsupported, label + ": VTKFile type '" + std::string(type) +
-                                         "' is not supported; tetstream reads UnstructuredGrid (.vtu)");
+  std::string type = root.attribute("type").value();
+  GridKind kind;
+  if (type == "UnstructuredGrid")
+    kind = GridKind::Unstructured;
+  else if (type == "StructuredGrid")
+    kind = GridKind::Structured;
+  else if (type == "ImageData")
+    kind = GridKind::Image;
+  else
+    return fail(Status::Unsupported, label + ": VTKFile type '" + type +
+                                         "' is not supported; tetstream reads UnstructuredGrid (.vtu), StructuredGrid "
+                                         "(.vts) and ImageData (.vti)");
+  vtu.fileBytes = bytes.size();
 
   std::string_view order = root.attribute("byte_order").value();
   if (order == "BigEndian")
@@ -559,28 +650,48 @@ Result readVtu(std::string_view bytes, const std::string& label, TetMesh& out, R
     return fail(Status::Unsupported, label + ": compressor '" + std::string(compressor) +
                                          "' is not supported; re-save with zlib or without compression");
 
-  pugi::xml_node grid = root.child("UnstructuredGrid");
-  if (!grid) return fail(Status::Corrupt, label + ": <VTKFile> has no <UnstructuredGrid>");
+  pugi::xml_node grid = root.child(type.c_str());
+  if (!grid) return fail(Status::Corrupt, label + ": <VTKFile> has no <" + type + ">");
+  Grid whole;
+  if (kind != GridKind::Unstructured) {
+    if (Result r = readExtent(grid, "WholeExtent", label + " <" + type + ">", whole); !r) return r;
+    if (kind == GridKind::Image) {
+      if (grid.attribute("Origin") && !parseNumbers(grid.attribute("Origin").value(), 3, whole.origin))
+        return fail(Status::Corrupt, label + ": ImageData Origin='" + printable(grid.attribute("Origin").value()) +
+                                         "' is not three finite numbers");
+      if (grid.attribute("Spacing") && !parseNumbers(grid.attribute("Spacing").value(), 3, whole.spacing))
+        return fail(Status::Corrupt, label + ": ImageData Spacing='" + printable(grid.attribute("Spacing").value()) +
+                                         "' is not three finite numbers");
+      if (grid.attribute("Direction") && !parseNumbers(grid.attribute("Direction").value(), 9, whole.direction))
+        return fail(Status::Corrupt, label + ": ImageData Direction='" +
+                                         printable(grid.attribute("Direction").value()) + "' is not nine finite numbers");
+    }
+  }
+  if (kind != GridKind::Unstructured && (whole.n(0) < 2 || whole.n(1) < 2 || whole.n(2) < 2))
+    return fail(Status::NoTets, label + ": WholeExtent " + std::to_string(whole.n(0)) + "x" +
+                                    std::to_string(whole.n(1)) + "x" + std::to_string(whole.n(2)) +
+                                    " is not a 3D grid (no volume cells)");
   std::vector<pugi::xml_node> pieces;
   for (pugi::xml_node p : grid.children("Piece")) pieces.push_back(p);
-  if (pieces.empty()) return fail(Status::Corrupt, label + ": <UnstructuredGrid> has no <Piece>");
+  if (pieces.empty()) return fail(Status::Corrupt, label + ": <" + type + "> has no <Piece>");
 
   TetMesh mesh;
-  CellTally tally;
+  CellSoup soup;
   std::vector<ScalarField> fields;
-  std::vector<bool> keep;
-  std::set<std::string> cellArrays;
+  std::vector<CellArray> cellArrays;
+  std::vector<bool> keep, keepCell;
   for (size_t k = 0; k < pieces.size(); ++k) {
     std::string where = pieces.size() == 1 ? label : label + " Piece " + std::to_string(k);
     PieceResult pr;
-    if (Result r = readPiece(vtu, pieces[k], where, mesh, tally, report, k == 0, pr); !r) return r;
-    cellArrays.insert(pr.cellArrays.begin(), pr.cellArrays.end());
+    if (Result r = readPiece(vtu, kind, whole, pieces[k], where, mesh, soup, report, k == 0, pr); !r) return r;
     if (k == 0) {
       fields = std::move(pr.fields);
       keep.assign(fields.size(), true);
+      cellArrays = std::move(pr.cellArrays);
+      keepCell.assign(cellArrays.size(), true);
       continue;
     }
-    // Several pieces: a field survives only if every piece has it.
+    // Several pieces: an array survives only if every piece has it.
     for (size_t i = 0; i < fields.size(); ++i) {
       auto it = std::find_if(pr.fields.begin(), pr.fields.end(),
                              [&](const ScalarField& f) { return f.name == fields[i].name; });
@@ -593,23 +704,36 @@ Result readVtu(std::string_view bytes, const std::string& label, TetMesh& out, R
         fields[i].values.insert(fields[i].values.end(), it->values.begin(), it->values.end());
       }
     }
+    for (size_t i = 0; i < cellArrays.size(); ++i) {
+      auto it = std::find_if(pr.cellArrays.begin(), pr.cellArrays.end(),
+                             [&](const CellArray& f) { return f.name == cellArrays[i].name; });
+      if (it == pr.cellArrays.end()) {
+        if (keepCell[i])
+          report.notes.push_back("dropped cell array '" + cellArrays[i].name + "': Piece " + std::to_string(k) +
+                                 " lacks it");
+        keepCell[i] = false;
+      } else {
+        cellArrays[i].values.insert(cellArrays[i].values.end(), it->values.begin(), it->values.end());
+      }
+    }
   }
   for (size_t i = 0; i < fields.size(); ++i)
     if (keep[i]) addField(mesh, std::move(fields[i]), report);
-  if (!cellArrays.empty()) {
-    std::string names;
-    for (const std::string& n : cellArrays) names += (names.empty() ? "'" : ", '") + n + "'";
-    report.notes.push_back("ignored cell data arrays " + names + " (tetstream reads point data only)");
-  }
+  std::vector<CellArray> keptCells;
+  for (size_t i = 0; i < cellArrays.size(); ++i)
+    if (keepCell[i]) keptCells.push_back(std::move(cellArrays[i]));
   if (pieces.size() > 1) report.notes.push_back("concatenated " + std::to_string(pieces.size()) + " pieces");
 
   std::string enc;
   for (const std::string& e : vtu.encodings) enc += (enc.empty() ? "" : ", ") + e;
-  report.format = "VTK XML UnstructuredGrid (" + (enc.empty() ? std::string("no arrays") : enc) +
+  std::string dims = kind == GridKind::Unstructured ? std::string()
+                                                     : ", " + std::to_string(whole.n(0)) + "x" +
+                                                           std::to_string(whole.n(1)) + "x" + std::to_string(whole.n(2));
+  report.format = "VTK XML " + type + " (" + (enc.empty() ? std::string("no arrays") : enc) +
                   (vtu.zlib ? ", zlib" : "") + (vtu.header64 ? ", UInt64 header" : ", UInt32 header") +
-                  (vtu.bigEndian ? ", BigEndian" : "") + ")";
+                  (vtu.bigEndian ? ", BigEndian" : "") + dims + ")";
 
-  if (Result r = finishMesh(label, mesh, tally, report); !r) return r;
+  if (Result r = finishMesh(label, mesh, soup, std::move(keptCells), report); !r) return r;
   out = std::move(mesh);
   return Result::success();
 }

@@ -3,7 +3,7 @@ import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import path from 'node:path';
-import { cli, tempDir, packedHarmonic } from './helpers.mjs';
+import { cli, root, tempDir, packedHarmonic } from './helpers.mjs';
 
 test('--help on the tool and every subcommand', () => {
   const top = cli('--help');
@@ -80,7 +80,7 @@ test('bad input gives a clear error and a nonzero exit, never a crash', () => {
     ['missing file', [path.join(dir, 'nope.vtu')], /nope\.vtu/],
     ['truncated', [write('trunc.vtu', good.subarray(0, good.length >> 1))], /./],
     ['wrong magic', [write('magic.vtu', Buffer.from('hello world, not xml'))], /./],
-    ['unknown extension', [write('mesh.xyz', good)], /xyz|format|extension/i],
+    ['unknown format', [write('mesh.obj', Buffer.from('v 0 0 0\nv 1 0 0\nf 1 2 3\n'))], /obj|format|extension/i],
     ['index out of range', [write('idx.vtu', ascii('0 1 2 99', okPoints))], /99|range/i],
     ['NaN coordinate', [write('nan.vtu', ascii('0 1 2 3', '0 0 0 nan 0 0 0 1 0 0 0 1'))], /nan|finite/i],
     ['no tetrahedra', [write('empty.vtu', ascii('0 1 2', okPoints, '3', '5'))], /tetra/i],
@@ -99,4 +99,31 @@ test('bad input gives a clear error and a nonzero exit, never a crash', () => {
   assert.match(missing.stderr, /pressure/);
   assert.match(missing.stderr, /harmonic/, 'lists the fields that exist');
   assert.equal(missing.json.error.status, 'missing-field');
+});
+
+test('the other input formats: notes on stdout, --q names the PLOT3D solution', () => {
+  const fx = (name) => path.join(root, 'tests/fixtures/formats', name);
+  const info = cli('info', fx('p3d_be.xyz'), '--json');
+  assert.equal(info.status, 0, info.stderr);
+  assert.match(info.json.inputFormat, /^PLOT3D grid \(C binary, big-endian, float/);
+  assert.deepEqual(info.json.fields.map((f) => f.name), ['density', 'momentum_magnitude', 'energy', 'pressure']);
+  assert.ok(info.json.notes.some((n) => /gamma = 1\.4/.test(n)), info.json.notes.join('\n'));
+  assert.equal(info.json.tets, 72);
+
+  const dir = tempDir('formats');
+  const pack = cli('pack', fx('p3d_fortran_iblank.x'), '--q', fx('p3d_fortran_iblank.q'), '-o', path.join(dir, 'p'));
+  assert.equal(pack.status, 0, pack.stderr);
+  assert.match(pack.stdout, /^note: IBLANK: 1 points are blanked/m);
+  assert.match(pack.stdout, /^  format    PLOT3D grid \(Fortran records/m);
+  const wrong = cli('info', fx('p3d_be.xyz'), '--q', fx('p3d_two_blocks.q'));
+  assert.equal(wrong.status, 1);
+  assert.match(wrong.stderr, /not a PLOT3D Q file for this grid/);
+
+  const tetgen = cli('info', fx('grid.ele'), '--json');
+  assert.equal(tetgen.status, 0, tetgen.stderr);
+  assert.equal(tetgen.json.tets, 48);
+  const gmsh = cli('info', fx('mixed_41_ascii.msh'));
+  assert.equal(gmsh.status, 0, gmsh.stderr);
+  assert.match(gmsh.stdout, /note {6}split 2 hexahedra, 4 wedges, 12 pyramids into 48 tetrahedra/);
+  assert.match(gmsh.stdout, /valid {5}no problems found/);
 });

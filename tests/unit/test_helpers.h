@@ -7,6 +7,7 @@
 
 #include "manifest.h"
 #include "mesh.h"
+#include "pack/mesh_io.h"
 
 namespace tetstream::test {
 
@@ -29,6 +30,24 @@ struct ScratchDir {
   ScratchDir(const ScratchDir&) = delete;
   ScratchDir& operator=(const ScratchDir&) = delete;
 };
+// "\n  note" for every note of a read, for failure messages; whether a note contains needle.
+inline std::string allNotes(const ReadReport& r) {
+  std::string s;
+  for (const std::string& n : r.notes) s += "\n  " + n;
+  return s;
+}
+inline bool hasNote(const ReadReport& r, const std::string& needle) {
+  for (const std::string& n : r.notes)
+    if (n.find(needle) != std::string::npos) return true;
+  return false;
+}
+// A failed Result with this status whose message contains needle.
+#define EXPECT_FAILS(expr, wantStatus, needle)                                          \
+  do {                                                                                  \
+    ::tetstream::Result r_ = (expr);                                                    \
+    EXPECT_EQ(r_.status, wantStatus) << statusName(r_.status) << ": " << r_.message;    \
+    EXPECT_NE(r_.message.find(needle), std::string::npos) << "message: " << r_.message; \
+  } while (0)
 // True when /usr/bin/python3 can import meshio (checked once).
 bool haveMeshioPython();
 // Runs a shell command, returns its exit status and stdout.

@@ -171,9 +171,12 @@ TetMesh harmonicGrid(uint32_t n, float quantum = 0) {
 
 // Random splits and undos with the from-scratch comparison after every step; the isovalue is
 // changed now and then (rebuild), to a random value or to a value some vertex has exactly.
-void runEdits(TetMesh& m, float quantum, uint32_t seed, int steps) {
+// deferredTree: the interval tree covers only a prefix of the tets, grown now and then by a
+// random amount (setTreeDeferred, extendTree), as the viewer does while a level streams in.
+void runEdits(TetMesh& m, float quantum, uint32_t seed, int steps, bool deferredTree = false) {
   Editor ed{m, std::mt19937(seed), quantum};
   IncrementalIsosurface inc;
+  inc.setTreeDeferred(deferredTree);
   float iso = quantum > 0 ? 2 * quantum : 0.05f;
   inc.rebuild(m, m.fields[0].values, iso);
   expectSameSurface(inc, m, "initial");
@@ -186,6 +189,11 @@ void runEdits(TetMesh& m, float quantum, uint32_t seed, int steps) {
     inc.updateTets(m, m.fields[0].values, ed.changed);
     expectSameSurface(inc, m, "step " + std::to_string(step));
     if (::testing::Test::HasFatalFailure()) return;
+    if (deferredTree && ed.rng() % 8 == 0) {
+      const bool whole = inc.extendTree(m, m.fields[0].values, ed.rng() % 4 == 0 ? ~0u : ed.rng() % 300);
+      ASSERT_EQ(whole, inc.treeCoverage() == m.tetCount());
+      ASSERT_TRUE(inc.validate()) << "extended at step " << step;
+    }
     if (step % 60 == 59) {
       iso = ed.rng() % 2 ? m.fields[0].values[ed.rng() % m.vertexCount()] : ed.uniform(-0.1f, 0.4f);
       if (quantum > 0) iso = std::round(iso / quantum) * quantum;
@@ -238,6 +246,37 @@ TEST(IncrementalIso, DegenerateTrianglesKeepTheirVertices) {
 TEST(IncrementalIso, SplitsAndUndosEqualFromScratch) {
   TetMesh m = harmonicGrid(8);
   runEdits(m, 0, 1, 500);
+}
+
+TEST(IncrementalIso, DeferredTreeSplitsAndUndosEqualFromScratch) {
+  TetMesh m = harmonicGrid(8);
+  runEdits(m, 0, 2, 500, true);
+  TetMesh q = harmonicGrid(6, 1.0f / 16);
+  runEdits(q, 1.0f / 16, 3, 300, true);
+}
+
+TEST(IncrementalIso, DeferredTreeIsBuiltInSteps) {
+  TetMesh m = harmonicGrid(10);
+  const auto& f = m.fields[0].values;
+  IncrementalIsosurface inc;
+  inc.setTreeDeferred(true);
+  inc.reserveTets(m.tetCount());
+  inc.rebuild(m, f, 0.1f);
+  EXPECT_EQ(inc.treeCoverage(), 0u) << "deferred: rebuild tests the tets itself";
+  expectSameSurface(inc, m, "no tree");
+  uint32_t calls = 0;
+  while (!inc.extendTree(m, f, 1000)) ++calls;
+  EXPECT_EQ(calls, (m.tetCount() - 1) / 1000);
+  EXPECT_EQ(inc.treeCoverage(), m.tetCount());
+  EXPECT_EQ(inc.intervalTree().storedCount() > 0, true);
+  for (float iso : {-0.05f, 0.02f, 0.3f}) {
+    inc.rebuild(m, f, iso);
+    expectSameSurface(inc, m, "tree built in steps, λ=" + std::to_string(iso));
+  }
+  // Not deferred any more: rebuild keeps the covering tree (no second build).
+  inc.setTreeDeferred(false);
+  inc.rebuild(m, f, 0.1f);
+  expectSameSurface(inc, m, "after switching back");
 }
 
 TEST(IncrementalIso, IsovalueOnVertexValues) {

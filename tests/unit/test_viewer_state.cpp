@@ -20,6 +20,7 @@
 #include "pack/generators.h"
 #include "pack/packer.h"
 #include "test_helpers.h"
+#include "viewer_memory.h"
 #include "viewer_state.h"
 
 using namespace tetstream;
@@ -341,6 +342,181 @@ TEST(ViewerState, PauseAndDownloadRate) {
   EXPECT_LT(secondsLeft(s), 0);
 }
 
+// Harmonic 24³ streamed from a 1% base: the memory estimate against the measured use.
+const Packed& packedMemory() {
+  static Packed p = pack(24, 0.01, 16, "viewer-state-memory");
+  return p;
+}
+
+// Streams every chunk it is allowed to and applies all splits.
+void streamAll(ViewerState& s, const Packed& p) {
+  for (uint32_t c = 0; c < p.chunks.size() && s.state != LoadState::Error; ++c) {
+    if (!addChunk(s, c, p.chunks[c]).ok()) break;
+    settle(s);
+  }
+  settle(s);
+}
+
+TEST(ViewerState, MemoryEstimateFollowsTheMeasuredUse) {
+  const Packed& p = packedMemory();
+  ViewerState s;
+  ASSERT_TRUE(openManifest(s, p.manifest).ok());
+  const Manifest& m = s.dataset.manifest;
+  ASSERT_GE(m.chunks.size(), 6u);
+  setIsovalue(s, 0.1f);
+  // The mesh arrays are reserved for the last level at the base, so every level holds at most
+  // what the last one needs; at the last one the estimate covers the use without wasting half.
+  const uint64_t full = estimateLevelBytes(m, uint32_t(m.chunks.size()));
+  uint64_t previous = 0;
+  for (uint32_t c = 0; c < p.chunks.size(); ++c) {
+    ASSERT_TRUE(addChunk(s, c, p.chunks[c]).ok()) << c;
+    settle(s);
+    const uint64_t estimate = estimateLevelBytes(m, c + 1);
+    EXPECT_GE(estimate, previous) << "levels only grow";
+    previous = estimate;
+    EXPECT_LE(memoryInUse(s), full) << "chunk " << c;
+  }
+  while (growTree(s, g_ticks + 2, fakeNow)) {
+  }
+  EXPECT_EQ(s.surface.treeCoverage(), m.tets) << "the estimate covers the interval tree too";
+  EXPECT_GE(double(full), 1.0 * double(memoryInUse(s)));
+  EXPECT_LE(double(full), 1.5 * double(memoryInUse(s)));
+  EXPECT_EQ(s.state, LoadState::Complete);
+  EXPECT_EQ(s.memoryNeededBytes, estimateLevelBytes(m, s.chunksTotal));
+  std::printf("Harmonic 24: %u tets, estimate %.1f MB, measured %.1f MB (%.1f bytes per tet)\n", m.tets,
+              double(s.memoryNeededBytes) / (1 << 20), double(memoryInUse(s)) / (1 << 20),
+              double(memoryInUse(s)) / m.tets);
+  auto j = stats(s);
+  EXPECT_EQ(j["memory"]["dataBytes"].get<uint64_t>(), memoryInUse(s));
+  EXPECT_EQ(j["memory"]["limitBytes"], nullptr);
+  EXPECT_EQ(j["chunksAllowed"].get<uint32_t>(), s.chunksTotal);
+}
+
+TEST(ViewerState, ADatasetTooBigStopsAtTheLastLevelThatFits) {
+  const Packed& p = packedMemory();
+  Manifest m;
+  ASSERT_TRUE(parseManifest(p.manifest, m).ok());
+  const uint32_t fit = uint32_t(m.chunks.size()) / 2;
+  ViewerState s;
+  s.memoryBaseBytes = 1 << 20;
+  s.memoryLimitBytes = s.memoryBaseBytes + (estimateLevelBytes(m, fit) + estimateLevelBytes(m, fit + 1)) / 2;
+  ASSERT_TRUE(openManifest(s, p.manifest).ok());
+  EXPECT_EQ(s.chunksAllowed, fit);
+  EXPECT_TRUE(downloading(s));
+  streamAll(s, p);
+  EXPECT_EQ(s.state, LoadState::Error);
+  EXPECT_TRUE(s.memoryLimited);
+  EXPECT_EQ(s.dataset.chunksReceived, fit);
+  EXPECT_EQ(s.dataset.splitsApplied(), s.dataset.splitsReceived()) << "everything that fits is applied";
+  EXPECT_NE(s.error.find("Streaming stopped after part " + std::to_string(fit) + " of"), std::string::npos) << s.error;
+  EXPECT_NE(s.error.find("this page may use"), std::string::npos) << s.error;
+  EXPECT_FALSE(downloading(s));
+  EXPECT_LE(memoryInUse(s), estimateLevelBytes(m, fit)) << "what is held fits the estimate that was allowed";
+  expectMatchesFromScratch(s, "stopped for memory");
+  setLevelFraction(s, 0);
+  settle(s);
+  EXPECT_EQ(s.dataset.pm.vertexCount(), s.dataset.pm.baseVertices) << "the level slider still works";
+
+  // Not even the base fits: refused before anything is fetched.
+  ViewerState tiny;
+  tiny.memoryLimitBytes = estimateLevelBytes(m, 1) / 2;
+  EXPECT_FALSE(openManifest(tiny, p.manifest).ok());
+  EXPECT_EQ(tiny.state, LoadState::Error);
+  EXPECT_NE(tiny.error.find("even at its coarsest level"), std::string::npos) << tiny.error;
+}
+
+bool g_refuseHeap = false;
+uint64_t g_heapAsked = 0;  // the last request
+int g_refusals = 0;  // refuse this many more requests, then give
+bool fakeReserveHeap(uint64_t bytes) {
+  g_heapAsked = bytes;
+  if (g_refusals > 0) return --g_refusals, false;
+  return !g_refuseHeap;
+}
+
+TEST(ViewerState, TheBrowserRefusingMemoryStopsWithAMessage) {
+  const Packed& p = packedMemory();
+  ViewerState s;
+  s.reserveHeap = fakeReserveHeap;
+  g_refuseHeap = false;
+  g_heapAsked = 0;
+  ASSERT_TRUE(openManifest(s, p.manifest).ok());
+  ASSERT_TRUE(addChunk(s, 0, p.chunks[0]).ok());
+  EXPECT_EQ(g_heapAsked, estimateLevelBytes(s.dataset.manifest, s.chunksTotal)) << "with the base: for the last level";
+  ASSERT_TRUE(addChunk(s, 1, p.chunks[1]).ok());
+  settle(s);
+  EXPECT_EQ(g_heapAsked, estimateLevelBytes(s.dataset.manifest, 2)) << "asked for the next level before taking it";
+  const uint32_t vertices = s.dataset.pm.vertexCount();
+  g_refuseHeap = true;
+  EXPECT_FALSE(addChunk(s, 2, p.chunks[2]).ok());
+  EXPECT_EQ(s.state, LoadState::Error);
+  EXPECT_TRUE(s.memoryLimited);
+  EXPECT_NE(s.error.find("did not give the viewer"), std::string::npos) << s.error;
+  settle(s);
+  EXPECT_EQ(s.dataset.pm.vertexCount(), vertices);
+  expectMatchesFromScratch(s, "memory refused");
+
+  // Not enough at the base for the last level's arrays at once: they grow level by level.
+  ViewerState t;
+  t.reserveHeap = fakeReserveHeap;
+  g_refuseHeap = false;
+  g_refusals = 1;
+  ASSERT_TRUE(openManifest(t, p.manifest).ok());
+  streamAll(t, p);
+  EXPECT_EQ(g_refusals, 0);
+  EXPECT_EQ(t.state, LoadState::Complete) << t.error;
+  EXPECT_EQ(t.dataset.pm.vertexCount(), t.dataset.manifest.vertices);
+}
+
+TEST(ViewerState, TheIntervalTreeWaitsUntilTheLevelSettles) {
+  const Packed& p = packedStream();
+  ViewerState s;
+  ASSERT_TRUE(openManifest(s, p.manifest).ok());
+  ASSERT_TRUE(addChunk(s, 0, p.chunks[0]).ok());
+  ASSERT_TRUE(addChunk(s, 1, p.chunks[1]).ok());
+  EXPECT_FALSE(treePending(s)) << "chunks still to come: no tree";
+  settle(s);
+  EXPECT_FALSE(treePending(s));
+  EXPECT_EQ(s.surface.treeCoverage(), 0u);
+  setIsovalue(s, 0.2f);
+  expectMatchesFromScratch(s, "isovalue without a tree");
+  for (uint32_t c = 2; c < p.chunks.size(); ++c) ASSERT_TRUE(addChunk(s, c, p.chunks[c]).ok());
+  EXPECT_FALSE(treePending(s)) << "splits still to apply";
+  settle(s);
+  ASSERT_EQ(s.state, LoadState::Complete);
+  EXPECT_TRUE(treePending(s));
+  while (growTree(s, g_ticks + 2, fakeNow)) {
+  }
+  EXPECT_EQ(s.surface.treeCoverage(), s.dataset.pm.mesh.tetCount());
+  EXPECT_FALSE(treePending(s));
+  EXPECT_EQ(stats(s)["treeTets"].get<uint32_t>(), s.dataset.pm.mesh.tetCount());
+  setIsovalue(s, 0.05f);
+  expectMatchesFromScratch(s, "isovalue through the tree");
+  setLevelFraction(s, 0.5);  // undoing splits keeps the tree on the tets that remain
+  settle(s);
+  EXPECT_LE(s.surface.treeCoverage(), s.dataset.pm.mesh.tetCount());
+  setIsovalue(s, 0.1f);
+  expectMatchesFromScratch(s, "after moving the level");
+}
+
+TEST(ViewerState, ChunksAreCheckedWithoutSideEffects) {
+  const Packed& p = packedStream();
+  ViewerState s;
+  ASSERT_TRUE(openManifest(s, p.manifest).ok());
+  EXPECT_EQ(checkChunk(s, 0, p.chunks[0]), ChunkCheck::Ok);
+  EXPECT_EQ(checkChunk(s, 1, p.chunks[0]), ChunkCheck::WrongSize) << "another chunk";
+  std::vector<uint8_t> flipped = p.chunks[1];
+  flipped[flipped.size() / 2] ^= 0x10;
+  EXPECT_EQ(checkChunk(s, 1, flipped), ChunkCheck::WrongHash);
+  EXPECT_EQ(checkChunk(s, 1, std::span<const uint8_t>(p.chunks[1]).first(p.chunks[1].size() - 1)),
+            ChunkCheck::WrongSize);
+  EXPECT_EQ(checkChunk(s, 9999, p.chunks[1]), ChunkCheck::NoSuchChunk);
+  EXPECT_EQ(s.state, LoadState::Loading) << "checking changes nothing";
+  EXPECT_EQ(s.dataset.chunksReceived, 0u);
+  setNotice(s, "connection lost, retrying part 2 in 4 s");
+  EXPECT_EQ(stats(s)["notice"], "connection lost, retrying part 2 in 4 s");
+}
+
 TEST(ViewerState, CameraFramesTheBoundingBox) {
   OrbitCamera c;
   float lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1};
@@ -354,4 +530,58 @@ TEST(ViewerState, CameraFramesTheBoundingBox) {
     EXPECT_GT(p.z, -1);
     EXPECT_LT(p.z, 1);
   }
+}
+
+// Colour by field and the slice plane through the model: the colour field is independent of the
+// isovalue's, the slice turned on mid-stream follows the splits locally (no full upload) and ends
+// equal to one made from scratch, and both show in the stats.
+TEST(ViewerState, ColourFieldAndSliceFollowTheStream) {
+  const Packed& p = packedStream();
+  ViewerState s;
+  ASSERT_TRUE(openManifest(s, p.manifest).ok());
+  ASSERT_TRUE(setField(s, "harmonic"));
+  setIsovalue(s, 0.1f);
+  ASSERT_TRUE(setColourField(s, "distance"));
+  EXPECT_FALSE(setColourField(s, "nonsense"));
+  const Range d = s.dataset.manifest.fields[size_t(s.dataset.manifest.findField("distance"))].range;
+  EXPECT_EQ(s.colourMin, d.min);
+  EXPECT_EQ(s.colourMax, d.max);
+  setColourRange(s, 0.9f, 0.2f);
+  EXPECT_EQ(s.colourMin, 0.2f);
+  EXPECT_EQ(s.colourMax, 0.9f);
+  ASSERT_TRUE(addChunk(s, 0, p.chunks[0]).ok());
+  setSliceEnabled(s, true);
+  ASSERT_TRUE(setSlicePlane(s, {0, 0, 2}, 0.3f));
+  EXPECT_GT(s.slice.surface().triangleCount(), 0u);
+  s.slice.surface().clearChanges();
+  for (uint32_t c = 1; c < p.chunks.size(); ++c) {
+    ASSERT_TRUE(addChunk(s, c, p.chunks[c]).ok()) << c;
+    advance(s, g_ticks + 4, fakeNow);
+    EXPECT_FALSE(s.slice.surface().fullUploadNeeded()) << "splits never re-extract the slice";
+  }
+  settle(s);
+  EXPECT_EQ(s.state, LoadState::Complete);
+  expectMatchesFromScratch(s, "complete");
+  // The surface's colours: the distance field interpolated (|p| at a vertex, up to the
+  // interpolation along an edge, which lies inside the sphere through its ends).
+  for (uint32_t i : s.surface.indices()) {
+    const float* q = &s.surface.positions()[3 * size_t(i)];
+    EXPECT_LE(std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]), s.surface.colours()[i] + 1e-4f);
+  }
+  SliceTracker fresh;
+  fresh.setPlane({0, 0, 1}, 0.3f);
+  fresh.rebuild(s.dataset.pm.mesh, {});
+  EXPECT_EQ(s.slice.surface().triangleCount(), fresh.surface().triangleCount());
+  EXPECT_NEAR(s.slice.surface().area(), 4.0, 1e-3);  // the 16-bit grid moves vertices a little
+  EXPECT_NEAR(s.slice.surface().area(), fresh.surface().area(), 1e-9);
+  auto j = stats(s);
+  EXPECT_EQ(j["colourField"], "distance");
+  EXPECT_EQ(j["colourMap"], "viridis");
+  EXPECT_EQ(j["slice"]["on"], true);
+  EXPECT_EQ(j["slice"]["normal"][2].get<double>(), 1.0);
+  EXPECT_EQ(j["slice"]["triangles"].get<uint32_t>(), s.slice.surface().triangleCount());
+  setSliceEnabled(s, false);
+  EXPECT_EQ(s.slice.surface().triangleCount(), 0u);
+  EXPECT_TRUE(setColourField(s, -1));
+  for (uint32_t i : s.surface.indices()) EXPECT_EQ(s.surface.colours()[i], 0.f);
 }

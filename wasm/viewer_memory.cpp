@@ -1,0 +1,77 @@
+#include "viewer_memory.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace tetstream::viewer {
+namespace {
+
+// Per-element costs in bytes (see the header for where they come from).
+constexpr double kPerVertex = 12 + 4 + 4;   // position; vertexHead; the de-duplication stamp (seen)
+constexpr double kPerFieldValue = 4;
+constexpr double kPerTet = 16 + 16;         // vertex ids; cornerNext
+constexpr double kPerSplit = 4 + 4 + 4;     // undo log (splitJ, splitTetsBefore); record offset
+constexpr double kSurfacePerTet = 56;       // isosurface + interval tree, measured 49 plus margin
+constexpr double kHullPerTriangle = 110;
+constexpr double kFixed = 1 << 20;          // zstd context, scratch, the JSON of the manifest
+
+}  // namespace
+
+uint64_t estimateLevelBytes(const Manifest& m, uint32_t chunks) {
+  chunks = std::min<uint32_t>(chunks, uint32_t(m.chunks.size()));
+  if (chunks == 0) return 0;
+  const ChunkInfo& last = m.chunks[chunks - 1];
+  double splits = 0, payloads = 0, largestRaw = 0;
+  for (uint32_t c = 0; c < chunks; ++c) {
+    const ChunkInfo& info = m.chunks[c];
+    largestRaw = std::max(largestRaw, double(info.rawBytes));  // the decoder's buffer
+    if (c == 0) continue;
+    splits += info.splits;
+    payloads += double(info.rawBytes);  // split records are kept for redo
+  }
+  const double v = last.vertices, t = last.tets;
+  const double hullTriangles = 4 * std::cbrt(t * t);  // a cube of 6n³ tets has 12n² ≈ 3.6 t^(2/3)
+  const double bytes = kFixed + v * (kPerVertex + kPerFieldValue * double(m.fields.size())) + t * kPerTet +
+                       splits * kPerSplit + payloads + largestRaw + t * kSurfacePerTet +
+                       hullTriangles * kHullPerTriangle;
+  return uint64_t(bytes);
+}
+
+uint32_t chunksThatFit(const Manifest& m, uint64_t budgetBytes) {
+  // Levels only grow: the estimate is monotone in the chunk count.
+  uint32_t lo = 0, hi = uint32_t(m.chunks.size());
+  while (lo < hi) {
+    const uint32_t mid = lo + (hi - lo + 1) / 2;
+    if (estimateLevelBytes(m, mid) <= budgetBytes)
+      lo = mid;
+    else
+      hi = mid - 1;
+  }
+  return lo;
+}
+
+uint64_t datasetMemoryBytes(const Dataset& ds) {
+  auto bytes = [](const auto& v) { return uint64_t(v.capacity() * sizeof(v[0])); };
+  const ProgressiveMesh& pm = ds.pm;
+  uint64_t n = bytes(pm.mesh.positions) + bytes(pm.mesh.tets) + bytes(pm.cornerNext) + bytes(pm.vertexHead) +
+               bytes(pm.splitJ) + bytes(pm.splitTetsBefore) + bytes(pm.seen);
+  for (const ScalarField& f : pm.mesh.fields) n += bytes(f.values);
+  for (const auto& p : ds.payloads) n += bytes(p);
+  n += bytes(ds.payloads) + bytes(ds.chunkFirstSplit) + bytes(ds.recordStart) + bytes(ds.decoder.raw);
+  return n;
+}
+
+std::string formatBytes(uint64_t bytes) {
+  char buf[32];
+  const double mb = double(bytes) / (1 << 20);
+  if (mb >= 1024)
+    std::snprintf(buf, sizeof buf, "%.1f GB", mb / 1024);
+  else if (mb >= 10)
+    std::snprintf(buf, sizeof buf, "%.0f MB", mb);
+  else
+    std::snprintf(buf, sizeof buf, "%.1f MB", mb);
+  return buf;
+}
+
+}  // namespace tetstream::viewer

@@ -1,0 +1,307 @@
+// Streams a packed dataset's chunks: fetched ahead a few at a time, each checked against the
+// manifest (size, content hash) before it is handed over, handed over strictly in order. A chunk
+// that fails in a way that may pass (connection lost, no data for the stall time, HTTP 5xx,
+// 408, 429, damaged bytes) is fetched again after a backoff, bypassing caches; one that cannot
+// pass (404 and other 4xx, damaged every time) stops the stream after every chunk before it has
+// been handed over, so the viewer keeps the level it reached. Nothing here blocks: every step
+// runs in a network callback and takes well under a millisecond (the check hashes in wasm).
+//
+// The loader may start before the viewer program is ready, from the manifest's chunk names
+// alone (the shell checks each against FORMAT.md's file rule first): the base chunk at once,
+// more once the program's bytes are in (warm()), so the link is busy while the browser compiles
+// the program. attach() then brings the checks and the hand-over; nothing is handed over, or
+// kept past the check, before it.
+import { fetchBytes, retryDelayMs, seconds, STALL_SECONDS } from './net.js';
+
+// Requests under way: at most MAX_IN_FLIGHT, and past two only while the bytes still to come of
+// those under way are fewer than MAX_OUTSTANDING_BYTES. Equal chunks sharing a link fairly
+// finish together, and a new batch then starts a round trip later with the link idle; counting
+// outstanding bytes starts the next request while the others are still arriving instead.
+export const MAX_IN_FLIGHT = 6;
+export const MAX_OUTSTANDING_BYTES = 1 << 20;
+// ... until the base is in: it alone decides when the first surface appears, so it shares the
+// link with one more request only (which keeps the link busy while the base's last bytes come).
+export const MAX_IN_FLIGHT_BEFORE_BASE = 2;
+export const MAX_AHEAD = 12;                // chunks fetched past the next one the viewer needs
+export const MAX_AHEAD_BYTES = 64 << 20;    // ... and at most this much held in the page
+export const MAX_DAMAGED = 4;               // a chunk damaged this often in a row is broken at the source
+
+const grouped = (n) => n.toLocaleString('en-US');
+
+export class ChunkLoader {
+  // urls, names (as the manifest gives them, for messages), sizes: per chunk.
+  // fail(message): the stream cannot go on (called once, after the chunks before the bad one
+  // have been delivered). done(): every allowed chunk delivered, or stopped.
+  // check, deliver, allowed: see attach(); given here, the loader is attached from the start.
+  constructor({ urls, names = urls, sizes, allowed = urls.length, stallMs = STALL_SECONDS * 1000, check = null,
+    deliver = null, fail, done }) {
+    Object.assign(this, { urls, names, sizes, allowed, stallMs, check, deliver, failed: fail, done });
+    this.attached = !!check;
+    this.warmed = this.attached;   // before: the program is still downloading, only the base
+    this.unchecked = new Set();    // arrived before attach()
+    this.total = urls.length;
+    this.next = 0;                 // next chunk to hand over
+    this.inFlight = new Map();     // index -> { controller, received }
+    this.arrived = new Map();      // index -> bytes, checked, waiting for an earlier chunk
+    this.waiting = new Map();      // index -> { at, timer }: to be fetched again at time `at`
+    this.trouble = new Map();      // index -> { failures, damaged, last }: chunks that failed
+    this.deliveredBytes = 0;
+    this.networkBytes = 0;         // off the wire, failed and aborted requests included
+    this.retries = 0;              // requests made again after a failure
+    this.refused = 0;              // responses the check refused (never handed over)
+    this.paused = false;
+    this.stopped = false;
+    this.failure = null;           // { index, message }: the first chunk that cannot be had
+  }
+
+  part(i) {
+    return `part ${i + 1} of ${this.total}`;
+  }
+
+  // The viewer is ready. check(i, bytes): null when the bytes are chunk i, else what is wrong in
+  // words. deliver(i, bytes): hands chunk i over; false = the viewer stopped (it says why
+  // itself). allowed: chunks to fetch (fewer than urls.length when memory is short).
+  attach({ check, deliver, allowed = this.urls.length }) {
+    Object.assign(this, { check, deliver, allowed, attached: true, warmed: true });
+    for (const [j, e] of [...this.inFlight]) {
+      if (j >= allowed) {
+        e.controller.abort();
+        this.inFlight.delete(j);
+      }
+    }
+    for (const j of [...this.arrived.keys()]) if (j >= allowed) this.arrived.delete(j);
+    for (const i of [...this.unchecked].sort((a, b) => a - b)) {
+      this.unchecked.delete(i);
+      if (this.stopped) return;
+      if (this.failure && i > this.failure.index) this.arrived.delete(i);
+      else if (this.arrived.has(i)) this.accept(i, this.arrived.get(i));
+    }
+    this.deliverReady();
+    this.pump();
+  }
+
+  // The program's bytes are in: the link is free for more than the base.
+  warm() {
+    this.warmed = true;
+    this.pump();
+  }
+
+  pump() {
+    if (this.paused || this.stopped || this.failure) return;
+    const end = Math.min(this.allowed, this.warmed ? this.next + MAX_AHEAD : 1);
+    let ahead = 0, outstanding = 0;
+    for (const b of this.arrived.values()) ahead += b.length;
+    for (const [j, e] of this.inFlight) {
+      ahead += this.sizes[j];
+      outstanding += Math.max(0, this.sizes[j] - e.received);
+    }
+    const limit = this.next === 0 && !this.arrived.has(0) ? MAX_IN_FLIGHT_BEFORE_BASE : MAX_IN_FLIGHT;
+    for (let i = this.next; i < end && this.inFlight.size < limit; i++) {
+      if (this.arrived.has(i) || this.inFlight.has(i) || this.waiting.has(i)) continue;
+      if (i > this.next && ahead + this.sizes[i] > MAX_AHEAD_BYTES) break;
+      if (this.inFlight.size >= 2 && outstanding >= MAX_OUTSTANDING_BYTES) break;
+      ahead += this.sizes[i];
+      outstanding += this.sizes[i];
+      this.fetchChunk(i);
+    }
+  }
+
+  fetchChunk(i) {
+    const entry = { controller: new AbortController(), received: 0 };
+    this.inFlight.set(i, entry);
+    const trouble = this.trouble.get(i);
+    if (trouble) this.retries++;
+    fetchBytes(this.urls[i], {
+      signal: entry.controller.signal,
+      stallMs: this.stallMs,
+      limit: this.sizes[i],
+      // After a failure, past any cache: a proxy or the browser may hold the damaged copy.
+      cache: trouble ? 'reload' : 'default',
+      onProgress: (n) => {
+        entry.received += n;
+        this.networkBytes += n;
+        if (this.inFlight.size >= 2 && this.inFlight.size < MAX_IN_FLIGHT) this.pump(); // outstanding bytes dropped
+      },
+    }).then((bytes) => {
+      if (this.inFlight.get(i) !== entry) return; // dropped meanwhile (pause, stop)
+      this.inFlight.delete(i);
+      if (this.attached) {
+        this.accept(i, bytes);
+      } else {
+        this.arrived.set(i, bytes);
+        this.unchecked.add(i);
+      }
+      this.pump();
+    }, (e) => {
+      if (this.inFlight.get(i) === entry) this.inFlight.delete(i);
+      if (e.kind === 'aborted' || this.stopped) return;
+      if (e.transient) this.retryLater(i, e);
+      else this.failAt(i, `Could not download ${this.part(i)} of the dataset (${this.names[i]}): ${e.message}.`);
+      this.pump();
+    });
+  }
+
+  // Checks chunk i; keeps it for the hand-over, or fetches it again when damaged.
+  accept(i, bytes) {
+    this.arrived.delete(i);
+    let damage;
+    try {
+      damage = this.check(i, bytes);
+    } catch (e) { // the viewer could not even look at it (no memory): stop here
+      this.failAt(i, e.message);
+      return;
+    }
+    if (damage) {
+      this.refused++;
+      this.retryLater(i, { kind: 'damaged', message: damage, transient: true });
+    } else {
+      this.trouble.delete(i);
+      this.arrived.set(i, bytes);
+      this.deliverReady();
+    }
+  }
+
+  retryLater(i, error) {
+    const t = this.trouble.get(i) || { failures: 0, damaged: 0, last: null };
+    t.failures++;
+    t.damaged = error.kind === 'damaged' ? t.damaged + 1 : 0;
+    t.last = error;
+    this.trouble.set(i, t);
+    if (t.damaged >= MAX_DAMAGED) {
+      this.failAt(i, `${this.part(i)[0].toUpperCase()}${this.part(i).slice(1)} of the dataset arrived damaged ` +
+        `${t.damaged} times in a row (${error.message}): the copy on the server does not match its manifest.`);
+      return;
+    }
+    const delay = retryDelayMs(t.failures, error.retryAfterMs);
+    const timer = setTimeout(() => {
+      this.waiting.delete(i);
+      this.pump();
+    }, delay);
+    this.waiting.set(i, { at: performance.now() + delay, timer });
+  }
+
+  // The link is back (the browser's `online` event): every waiting chunk goes now.
+  retryNow() {
+    for (const [i, w] of this.waiting) {
+      clearTimeout(w.timer);
+      this.waiting.delete(i);
+    }
+    this.pump();
+  }
+
+  // Chunk i cannot be had: the chunks before it that are still coming are delivered first,
+  // then the failure is reported. Nothing after it is fetched any more.
+  failAt(i, message) {
+    if (this.failure && this.failure.index <= i) return;
+    this.failure = { index: i, message };
+    for (const [j, e] of [...this.inFlight]) {
+      if (j > i) {
+        e.controller.abort();
+        this.inFlight.delete(j);
+      }
+    }
+    for (const [j, w] of [...this.waiting]) {
+      if (j >= i) {
+        clearTimeout(w.timer);
+        this.waiting.delete(j);
+      }
+    }
+    for (const j of [...this.arrived.keys()]) {
+      if (j > i) {
+        this.arrived.delete(j);
+        this.unchecked.delete(j);
+      }
+    }
+    this.reportFailure();
+  }
+
+  reportFailure() {
+    if (!this.failure || this.next < this.failure.index || this.stopped) return;
+    if (!this.attached && this.failure.index > 0) return; // the chunks before it first
+    const { index, message } = this.failure;
+    this.stop();
+    this.failed(index > 0 ? `${message} Showing the last complete level.` : message);
+  }
+
+  deliverReady() {
+    if (!this.attached) return;
+    while (!this.stopped && this.arrived.has(this.next) && !this.unchecked.has(this.next)) {
+      const i = this.next;
+      const bytes = this.arrived.get(i);
+      this.arrived.delete(i);
+      let accepted;
+      try {
+        accepted = this.deliver(i, bytes);
+      } catch (e) {
+        this.stop();
+        this.failed(e.message);
+        return;
+      }
+      if (!accepted) {
+        this.stop();
+        return;
+      }
+      this.deliveredBytes += bytes.length;
+      this.next++;
+    }
+    if (this.next >= this.allowed) this.stop();
+    this.reportFailure();
+  }
+
+  // Bytes of the dataset in hand: delivered, arrived and partly downloaded.
+  haveBytes() {
+    let have = this.deliveredBytes;
+    for (const b of this.arrived.values()) have += b.length;
+    for (const e of this.inFlight.values()) have += e.received;
+    return have;
+  }
+
+  // What the network side is doing, in plain words, or '' when all is well: the earliest chunk
+  // that failed and is waiting or being fetched again.
+  notice(now = performance.now()) {
+    if (this.stopped || this.failure || this.paused || !this.trouble.size) return '';
+    const i = Math.min(...this.trouble.keys());
+    const { last, failures } = this.trouble.get(i);
+    const what = this.part(i);
+    let cause;
+    if (!navigator.onLine) cause = 'You are offline';
+    else if (last.kind === 'network') cause = 'Connection lost';
+    else if (last.kind === 'stall') cause = `No data for ${Math.round(this.stallMs / 1000)} s`;
+    else if (last.kind === 'damaged') cause = `${what[0].toUpperCase()}${what.slice(1)} arrived damaged (${last.message})`;
+    else cause = `The server answered ${last.message}`;
+    const w = this.waiting.get(i);
+    if (w) return `${cause}: retrying ${what} in ${seconds(w.at - now)}.`;
+    return `${cause}: retrying ${what} now (attempt ${failures + 1}).`;
+  }
+
+  // Pausing stops the network at once: requests under way are dropped (and fetched again on
+  // resume, with their failure counts kept); what arrived completely is kept.
+  setPaused(paused) {
+    this.paused = paused;
+    if (paused) {
+      for (const e of this.inFlight.values()) e.controller.abort();
+      this.inFlight.clear();
+      for (const w of this.waiting.values()) clearTimeout(w.timer);
+      this.waiting.clear();
+    } else {
+      this.pump();
+    }
+  }
+
+  stop() {
+    if (this.stopped) return;
+    this.stopped = true;
+    for (const e of this.inFlight.values()) e.controller.abort();
+    this.inFlight.clear();
+    for (const w of this.waiting.values()) clearTimeout(w.timer);
+    this.waiting.clear();
+    this.done();
+  }
+}
+
+// "2,345 of 16,384 bytes" / "its content does not match the manifest's hash", for check().
+export function damageText(code, got, expected) {
+  if (code === 2) return `${grouped(got)} bytes instead of ${grouped(expected)}`;
+  if (code === 3) return "its content does not match the manifest's hash";
+  return 'not a part of this dataset';
+}
