@@ -33,7 +33,7 @@
 //
 // Memory: per tet 4 bytes (record index) + 1 bit (rebuild's ordering bitmap) + the interval
 // tree (18-28 bytes); per cut tet a 28-byte record; per triangle 17 bytes; per surface vertex
-// about 100 bytes (position, normal, double normal sum, key, counts, hash slots). Measured on
+// about 104 bytes (position, normal, colour, double normal sum, key, counts, hash slots). Measured on
 // Harmonic 64 at λ = 0.1 after 20000 simulated splits: 49 bytes per tet in all.
 // Measured speed there (wasm, node 20, -O3; native in brackets): updateTets 9.7 us per split of
 // 11.6 changed tets (5.7 us), its undo 7.4 us (4.2 us); rebuild 1.0-12.5 ms for 8k-86k triangles

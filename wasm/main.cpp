@@ -124,6 +124,7 @@ struct App {
   bool cameraMoved = false;  // by the user since the last framing; if not, a resize re-frames
   bool cameraPinned = false; // set by the shell (a shared link): the framing keeps it
   bool captureRequested = false;  // the shell wants the next drawn frame (screenshot)
+  bool dragSlice = false;         // the current drag moves the slice (shift + left drag)
   double lastX = 0, lastY = 0;
 
   int redrawFrames = 2;        // frames still to draw; 0 = idle, nothing changed
@@ -180,13 +181,19 @@ void syncCanvasSize() {
 // ---------------------------------------------------------------- mouse -> camera
 // Installed before ImGui's GLFW backend, which chains to them. Camera input only when ImGui
 // does not want the mouse; a drag that started on the canvas keeps going over the panel.
-void onMouseButton(GLFWwindow*, int button, int action, int) {
+// Shift + left drag moves the slice along its normal (up = forward): the whole range over the
+// canvas height.
+void onMouseButton(GLFWwindow* w, int button, int action, int mods) {
   requestRedraw();
   if (action == GLFW_PRESS && g_app.dragButton < 0 && !ImGui::GetIO().WantCaptureMouse) {
     g_app.dragButton = button;
+    const bool shift = (mods & GLFW_MOD_SHIFT) || glfwGetKey(w, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS ||
+                       glfwGetKey(w, GLFW_KEY_RIGHT_SHIFT) == GLFW_PRESS;
+    g_app.dragSlice = button == GLFW_MOUSE_BUTTON_LEFT && shift && g_app.state.sliceOn;
     glfwGetCursorPos(g_app.window, &g_app.lastX, &g_app.lastY);
   } else if (action == GLFW_RELEASE && button == g_app.dragButton) {
     g_app.dragButton = -1;
+    g_app.dragSlice = false;
   }
 }
 
@@ -196,6 +203,14 @@ void onCursorPos(GLFWwindow*, double x, double y) {
   float dx = float(x - g_app.lastX), dy = float(y - g_app.lastY);
   g_app.lastX = x;
   g_app.lastY = y;
+  if (g_app.dragSlice) {
+    ViewerState& s = g_app.state;
+    float lo = 0, hi = 0;
+    sliceOffsetRange(s, lo, hi);
+    const float offset = s.slice.offset() - dy * (hi - lo) / float(std::max(g_app.height, 1));
+    setSlicePlane(s, s.slice.normal(), std::clamp(offset, lo, hi));
+    return;
+  }
   g_app.cameraMoved = true;
   if (g_app.dragButton == GLFW_MOUSE_BUTTON_LEFT)
     g_app.camera.orbit(dx, dy, float(g_app.height));

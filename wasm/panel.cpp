@@ -166,7 +166,12 @@ void levelSection(ViewerState& s, float width, float pixelsPerCssPixel) {
 
 // What the viewer holds now and what the dataset will need, against the limit.
 void memorySection(const ViewerState& s) {
-  section("memory");
+  // Folds away while the slice is on, like the timings (the panel would outgrow the screen).
+  static int lastSliceOn = -1;
+  if (int(s.sliceOn) != lastSliceOn) ImGui::SetNextItemOpen(!s.sliceOn);
+  lastSliceOn = int(s.sliceOn);
+  ImGui::Spacing();
+  if (!ImGui::TreeNodeEx("memory", ImGuiTreeNodeFlags_NoTreePushOnOpen)) return;
   row("in use", formatBytes(memoryInUse(s)) + " (page heap " + formatBytes(s.heapBytes) + ")");
   row("on the GPU", formatBytes(s.gpuBytes));
   if (s.chunksTotal == 0) return;
@@ -276,8 +281,9 @@ void sliceSection(ViewerState& s, float width, float pixelsPerCssPixel) {
   float offset = s.slice.offset();
   if (ImGui::SliderFloat("position", &offset, lo, hi, "%.4g")) setSlicePlane(s, s.slice.normal(), offset);
   s.sliceSliderRect = cssRect(pixelsPerCssPixel);
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("Or shift + drag in the view, or [ and ].");
   ImGui::PopItemWidth();
-  row("slice triangles", grouped(s.slice.surface().triangleCount()));
+  row("triangles", grouped(s.slice.surface().triangleCount()));
 }
 
 }  // namespace
@@ -297,6 +303,17 @@ PanelActions drawPanel(ViewerState& s, float uiScale, float pixelsPerCssPixel) {
   if (s.state == LoadState::Idle) ImGui::TextDisabled("waiting for a dataset");
   if (s.state == LoadState::Complete) ImGui::TextDisabled("complete: every part received and applied");
   if (s.state == LoadState::Error) coloredWrapped(kError, (s.memoryLimited ? "Stopped: " : "Error: ") + s.error);
+  if (ImGui::SmallButton("copy link")) actions.copyLink = true;
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("Copies a link that opens this view: dataset, fields, colours, slice,\nlevel and camera (L).");
+  ImGui::SameLine();
+  if (ImGui::SmallButton("screenshot")) actions.screenshot = true;
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("Saves the picture as a PNG (S).");
+  ImGui::SameLine();
+  if (ImGui::SmallButton("keys (?)")) actions.toggleHelp = true;
+  if (!s.linkNote.empty()) {
+    ImGui::SameLine();
+    ImGui::TextDisabled("%s", s.linkNote.c_str());
+  }
 
   if (haveDataset) {
     downloadSection(s, width, pixelsPerCssPixel);
@@ -336,15 +353,13 @@ PanelActions drawPanel(ViewerState& s, float uiScale, float pixelsPerCssPixel) {
   ImGui::Checkbox("show boundary", &s.showBoundary);
   ImGui::SameLine();
   if (ImGui::Button("reset view")) actions.resetView = true;
-  if (ImGui::Button("copy link")) actions.copyLink = true;
-  if (ImGui::IsItemHovered()) ImGui::SetTooltip("Copies a link that opens this view: dataset, fields, colours, slice,\nlevel and camera.");
-  ImGui::SameLine();
-  if (ImGui::Button("screenshot")) actions.screenshot = true;
-  ImGui::SameLine();
-  if (ImGui::Button("help (?)")) actions.toggleHelp = true;
-  if (!s.linkNote.empty()) ImGui::TextDisabled("%s", s.linkNote.c_str());
 
   ImGui::Separator();
+  // Timings fold away while the slice is on (the panel would outgrow a laptop screen).
+  static int lastSliceOn = -1;
+  if (int(s.sliceOn) != lastSliceOn) ImGui::SetNextItemOpen(!s.sliceOn);
+  lastSliceOn = int(s.sliceOn);
+  if (ImGui::TreeNodeEx("timings", ImGuiTreeNodeFlags_NoTreePushOnOpen)) {
   ImGui::TextDisabled("frames every %.1f ms, longest frame %.0f ms", s.frameMs, s.maxFrameMs);
   if (s.refineSteps)
     ImGui::TextDisabled("last refinement %.1f ms (%u splits)", s.refineMs, s.refineSteps);
@@ -354,6 +369,7 @@ PanelActions drawPanel(ViewerState& s, float uiScale, float pixelsPerCssPixel) {
       ImGui::TextDisabled("first surface at %.2f s, complete at %.1f s", s.firstSurfaceMs / 1000, s.completeMs / 1000);
     else
       ImGui::TextDisabled("first surface at %.2f s", s.firstSurfaceMs / 1000);
+  }
   }
   ImGui::TextDisabled("drag rotates, right-drag pans, wheel zooms; ? for keys");
 
@@ -378,7 +394,7 @@ const Shortcut kShortcuts[] = {
     {"B", "show / hide the domain boundary"},
     {"P", "slice plane on / off"},
     {"X, Y, Z", "slice across the x, y or z axis"},
-    {"[ and ]", "move the slice back / forward"},
+    {"[ and ]", "move the slice back / forward (or shift + drag)"},
     {"C", "colour by: next field (or none)"},
     {"M", "next colour map"},
     {"L", "copy a link to this view"},

@@ -43,6 +43,7 @@ import { fetchBytes, countingResponse, httpError, retryDelayMs, seconds, FetchEr
 import { ChunkLoader, damageText } from './loader.js';
 
 const MANIFEST_LIMIT = 16 << 20; // FORMAT.md §1
+const COLOUR_MAPS = ['viridis', 'magma', 'turbo', 'coolwarm', 'grey'];
 const PAGE_FILE_TRIES = 4;       // the program and the manifest: then the page gives up and says why
 
 const statusBox = document.getElementById('status');
@@ -214,7 +215,6 @@ window.tetstream = {
 // URL parameters: data, field, iso, colour, map, range=LO,HI, slice=NX,NY,NZ,OFFSET (present =
 // on), level (fraction of the full mesh's vertices, absent = newest), cam=TX,TY,TZ,DISTANCE,YAW,
 // PITCH, boundary=0; numbers as the shortest decimals that give back the same float.
-const COLOUR_MAPS = ['viridis', 'magma', 'turbo', 'coolwarm', 'grey'];
 let datasetUrl = params.get('data');
 let pendingLevel = null; // a level asked for before its parts arrived: applied as they do
 
@@ -347,6 +347,11 @@ function syncUrl() {
 
 async function copyLink() {
   const l = link();
+  if (!datasetUrl) {
+    // A dataset from the disk has no address others could open.
+    if (viewer && !shell.aborted) viewer.ccall('ts_set_link_note', null, ['string'], ['no link: opened from the disk']);
+    return null;
+  }
   let note = 'link copied';
   try {
     await navigator.clipboard.writeText(l);
@@ -678,6 +683,11 @@ function packedFolder(list) {
   const base = manifests[0].path.slice(0, -'manifest.json'.length);
   const files = new Map();
   for (const f of list) if (f.path.startsWith(base)) files.set(f.path.slice(base.length), f.file);
+  // Files dropped loose (the manifest and the chunk files selected together, or a DataTransfer
+  // without directory entries): a chunk file is found by its name.
+  for (const [name, file] of [...files]) {
+    if (!name.includes('/') && name !== 'manifest.json' && !files.has(`chunks/${name}`)) files.set(`chunks/${name}`, file);
+  }
   return files;
 }
 
@@ -745,6 +755,7 @@ addEventListener('drop', (e) => {
 const folderInput = document.getElementById('folder-input');
 addEventListener('keydown', (e) => {
   // O: the folder chooser (a key press lets the page open it).
+  if (/^(INPUT|TEXTAREA|SELECT)$/.test(e.target && e.target.tagName)) return; // typing a URL
   if ((e.key === 'o' || e.key === 'O') && !e.ctrlKey && !e.metaKey && !e.altKey && folderInput) folderInput.click();
 });
 if (folderInput) {

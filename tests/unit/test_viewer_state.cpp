@@ -531,3 +531,57 @@ TEST(ViewerState, CameraFramesTheBoundingBox) {
     EXPECT_LT(p.z, 1);
   }
 }
+
+// Colour by field and the slice plane through the model: the colour field is independent of the
+// isovalue's, the slice turned on mid-stream follows the splits locally (no full upload) and ends
+// equal to one made from scratch, and both show in the stats.
+TEST(ViewerState, ColourFieldAndSliceFollowTheStream) {
+  const Packed& p = packedStream();
+  ViewerState s;
+  ASSERT_TRUE(openManifest(s, p.manifest).ok());
+  ASSERT_TRUE(setField(s, "harmonic"));
+  setIsovalue(s, 0.1f);
+  ASSERT_TRUE(setColourField(s, "distance"));
+  EXPECT_FALSE(setColourField(s, "nonsense"));
+  const Range d = s.dataset.manifest.fields[size_t(s.dataset.manifest.findField("distance"))].range;
+  EXPECT_EQ(s.colourMin, d.min);
+  EXPECT_EQ(s.colourMax, d.max);
+  setColourRange(s, 0.9f, 0.2f);
+  EXPECT_EQ(s.colourMin, 0.2f);
+  EXPECT_EQ(s.colourMax, 0.9f);
+  ASSERT_TRUE(addChunk(s, 0, p.chunks[0]).ok());
+  setSliceEnabled(s, true);
+  ASSERT_TRUE(setSlicePlane(s, {0, 0, 2}, 0.3f));
+  EXPECT_GT(s.slice.surface().triangleCount(), 0u);
+  s.slice.surface().clearChanges();
+  for (uint32_t c = 1; c < p.chunks.size(); ++c) {
+    ASSERT_TRUE(addChunk(s, c, p.chunks[c]).ok()) << c;
+    advance(s, g_ticks + 4, fakeNow);
+    EXPECT_FALSE(s.slice.surface().fullUploadNeeded()) << "splits never re-extract the slice";
+  }
+  settle(s);
+  EXPECT_EQ(s.state, LoadState::Complete);
+  expectMatchesFromScratch(s, "complete");
+  // The surface's colours: the distance field interpolated (|p| at a vertex, up to the
+  // interpolation along an edge, which lies inside the sphere through its ends).
+  for (uint32_t i : s.surface.indices()) {
+    const float* q = &s.surface.positions()[3 * size_t(i)];
+    EXPECT_LE(std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]), s.surface.colours()[i] + 1e-4f);
+  }
+  SliceTracker fresh;
+  fresh.setPlane({0, 0, 1}, 0.3f);
+  fresh.rebuild(s.dataset.pm.mesh, {});
+  EXPECT_EQ(s.slice.surface().triangleCount(), fresh.surface().triangleCount());
+  EXPECT_NEAR(s.slice.surface().area(), 4.0, 1e-3);  // the 16-bit grid moves vertices a little
+  EXPECT_NEAR(s.slice.surface().area(), fresh.surface().area(), 1e-9);
+  auto j = stats(s);
+  EXPECT_EQ(j["colourField"], "distance");
+  EXPECT_EQ(j["colourMap"], "viridis");
+  EXPECT_EQ(j["slice"]["on"], true);
+  EXPECT_EQ(j["slice"]["normal"][2].get<double>(), 1.0);
+  EXPECT_EQ(j["slice"]["triangles"].get<uint32_t>(), s.slice.surface().triangleCount());
+  setSliceEnabled(s, false);
+  EXPECT_EQ(s.slice.surface().triangleCount(), 0u);
+  EXPECT_TRUE(setColourField(s, -1));
+  for (uint32_t i : s.surface.indices()) EXPECT_EQ(s.surface.colours()[i], 0.f);
+}
