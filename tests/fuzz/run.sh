@@ -44,6 +44,7 @@ for t in "${TARGETS[@]}"; do
   # Keep a minimal set that covers what the whole work folder covers.
   mkdir -p "$corpus.new"
   build/fuzz/fuzz-"$t" -merge=1 "$corpus.new" "$corpus" "$work" "$seeds" 2>/dev/null >/dev/null
+  cp "$corpus"/regress-* "$corpus.new"/ 2>/dev/null || true  # past findings stay, whatever they cover
   rm -rf "$corpus" && mv "$corpus.new" "$corpus"
   # The corpus is committed: keep the smallest inputs up to CORPUS_KB (regression inputs always).
   budget=$(( ${CORPUS_KB:-400} * 1024 )) used=0
