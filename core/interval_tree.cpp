@@ -109,7 +109,7 @@ void IntervalTree::rebucket() {
     size_t lo = first(b);
     loKey_[b] = b == 0 ? 0 : scratchKeys_[lo];
     k.loMin = b == 0 ? -kInf : intervals_[uint32_t(scratchKeys_[lo])].min;
-    Entry* e = &arena_[k.start];
+    Entry* e = arena_.data() + k.start;
     for (uint32_t i = 0; i < k.count; ++i) {
       uint32_t id = uint32_t(scratchKeys_[lo + i]);
       e[i] = {intervals_[id].max, id};
@@ -199,14 +199,14 @@ void IntervalTree::bucketInsert(Interval iv, uint32_t id) {
     uint32_t cap = std::min(kBucketMax, std::max(kMinSlab, 2 * cap_[b]));
     uint32_t start = allocSlab(cap);
     Bucket& k = buckets_[b];
-    std::memcpy(&arena_[start], arena_.data() + k.start, k.count * sizeof(Entry));
+    std::memcpy(arena_.data() + start, arena_.data() + k.start, k.count * sizeof(Entry));
     deadEntries_ += cap_[b];
     k.start = start;
     cap_[b] = cap;
     if (deadEntries_ > 4096 && 4 * deadEntries_ > arena_.size()) compactArena();
   }
   Bucket& k = buckets_[b];
-  Entry* e = &arena_[k.start];
+  Entry* e = arena_.data() + k.start;
   // After the entries with an equal max, so equal runs stay in insertion order.
   uint32_t pos = uint32_t(std::partition_point(e, e + k.count, [&](const Entry& x) { return x.max >= iv.max; }) - e);
   std::memmove(e + pos + 1, e + pos, (k.count - pos) * sizeof(Entry));
@@ -219,7 +219,7 @@ void IntervalTree::bucketInsert(Interval iv, uint32_t id) {
 void IntervalTree::bucketRemove(Interval iv, uint32_t id) {
   const uint32_t b = findBucket(makeKey(iv.min, id));
   Bucket& k = buckets_[b];
-  Entry* e = &arena_[k.start];
+  Entry* e = arena_.data() + k.start;
   uint32_t pos = uint32_t(std::partition_point(e, e + k.count, [&](const Entry& x) { return x.max > iv.max; }) - e);
   while (pos < k.count && e[pos].id != id) {
     assert(e[pos].max == iv.max);
@@ -237,7 +237,7 @@ void IntervalTree::bucketRemove(Interval iv, uint32_t id) {
 // the upper half gets a new slab and a new header right after.
 void IntervalTree::splitBucket(uint32_t b) {
   const Bucket k = buckets_[b];
-  Entry* e = &arena_[k.start];
+  Entry* e = arena_.data() + k.start;
   scratchKeys_.resize(k.count);
   for (uint32_t i = 0; i < k.count; ++i) scratchKeys_[i] = makeKey(intervals_[e[i].id].min, e[i].id);
   auto mid = scratchKeys_.begin() + k.count / 2;
@@ -257,7 +257,7 @@ void IntervalTree::splitBucket(uint32_t b) {
   buckets_[b].topMax = left ? e[0].max : -kInf;
   const uint32_t cap = slabFor(right);
   const uint32_t start = allocSlab(cap);  // invalidates e
-  std::memcpy(&arena_[start], scratchEntries_.data(), right * sizeof(Entry));
+  std::memcpy(arena_.data() + start, scratchEntries_.data(), right * sizeof(Entry));
   buckets_.insert(buckets_.begin() + b + 1,
                   Bucket{intervals_[uint32_t(median)].min, right ? scratchEntries_[0].max : -kInf, start, right});
   loKey_.insert(loKey_.begin() + b + 1, median);
@@ -274,7 +274,7 @@ void IntervalTree::compactArena() {
   uint32_t write = 0;
   for (uint32_t b : scratchOrder_) {
     Bucket& k = buckets_[b];
-    if (k.start != write) std::memmove(&arena_[write], &arena_[k.start], k.count * sizeof(Entry));
+    if (k.start != write) std::memmove(arena_.data() + write, arena_.data() + k.start, k.count * sizeof(Entry));
     k.start = write;
     write += cap_[b];
   }
@@ -326,7 +326,7 @@ bool IntervalTree::validate() const {
     // The boundary key may belong to an id that has moved since; its min is in the key.
     if (b > 0 && orderedBits(k.loMin) != uint32_t(loKey_[b] >> 32)) return false;
     if (k.count > cap_[b] || k.count > kBucketMax || size_t(k.start) + cap_[b] > arena_.size()) return false;
-    const Entry* e = &arena_[k.start];
+    const Entry* e = arena_.data() + k.start;  // no &arena_[k.start]: start may be the end (UB)
     if (k.topMax != (k.count ? e[0].max : -kInf)) return false;
     for (uint32_t i = 0; i < k.count; ++i) {
       if (i > 0 && e[i - 1].max < e[i].max) return false;
