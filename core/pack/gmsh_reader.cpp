@@ -89,7 +89,6 @@ int vtkTypeOf(const GmshType& t) {
   }
 }
 
-bool isSpace(char c) { return c == ' ' || c == '\n' || c == '\r' || c == '\t' || c == '\f' || c == '\v'; }
 
 // Tag -> index for node or element tags (positive integers, maybe sparse).
 class TagMap {
@@ -165,23 +164,9 @@ struct Gmsh {
   }
 
   // ------------------------------------------------------------ text
-  void skipSpace() {
-    while (pos < s.size() && isSpace(s[pos])) ++pos;
-  }
-  std::string_view token() {
-    skipSpace();
-    size_t b = pos;
-    while (pos < s.size() && !isSpace(s[pos])) ++pos;
-    return s.substr(b, pos - b);
-  }
-  std::string_view line() {
-    size_t e = s.find('\n', pos);
-    if (e == std::string_view::npos) e = s.size();
-    std::string_view l = s.substr(pos, e - pos);
-    pos = std::min(s.size(), e + 1);
-    if (!l.empty() && l.back() == '\r') l.remove_suffix(1);
-    return l;
-  }
+  void skipSpace() { vtkio::skipSpace(s, pos); }
+  std::string_view token() { return nextToken(s, pos); }
+  std::string_view line() { return nextLine(s, pos); }
   Result textInt(const std::string& sec, const std::string& what, int64_t& v) {
     const size_t p = pos;
     int r = parseNextInt(s, pos, v);

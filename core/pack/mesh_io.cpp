@@ -355,10 +355,8 @@ void decodeDoubles(const uint8_t* src, size_t count, ScalarType t, bool bigEndia
   for (size_t i = 0; i < count; ++i) dst[i] = loadAs<double>(src, i, t, bigEndian);
 }
 
-static bool isSpace(char c) { return c == ' ' || c == '\n' || c == '\r' || c == '\t' || c == '\f' || c == '\v'; }
-
-// Finds the next token; returns false at the end of the text.
-static bool nextToken(std::string_view text, size_t& pos, std::string_view& tok) {
+// Finds the next token without consuming it; returns false at the end of the text.
+static bool peekToken(std::string_view text, size_t& pos, std::string_view& tok) {
   while (pos < text.size() && isSpace(text[pos])) ++pos;
   if (pos >= text.size()) return false;
   size_t b = pos;
@@ -385,7 +383,7 @@ static bool parseDoubleToken(std::string_view tok, double& out) {
 
 int parseNextDouble(std::string_view text, size_t& pos, double& out) {
   std::string_view tok;
-  if (!nextToken(text, pos, tok)) return 0;
+  if (!peekToken(text, pos, tok)) return 0;
   if (!parseDoubleToken(tok, out)) return -1;
   pos += tok.size();
   return 1;
@@ -393,7 +391,7 @@ int parseNextDouble(std::string_view text, size_t& pos, double& out) {
 
 int parseNextInt(std::string_view text, size_t& pos, int64_t& out) {
   std::string_view tok;
-  if (!nextToken(text, pos, tok)) return 0;
+  if (!peekToken(text, pos, tok)) return 0;
   std::string_view t = tok;
   if (!t.empty() && t[0] == '+') t.remove_prefix(1);
   auto [p, ec] = std::from_chars(t.data(), t.data() + t.size(), out);

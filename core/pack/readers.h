@@ -89,6 +89,28 @@ inline bool iequals(std::string_view a, std::string_view b) {
   return true;
 }
 
+// Text scanning shared by the ASCII readers: whitespace as in C's isspace; a token is the next
+// run of non-space bytes (empty at the end); a line is the rest of the current line, its '\n'
+// consumed and a trailing '\r' dropped (binary data starts right after it).
+inline bool isSpace(char c) { return c == ' ' || c == '\n' || c == '\r' || c == '\t' || c == '\f' || c == '\v'; }
+inline void skipSpace(std::string_view s, size_t& pos) {
+  while (pos < s.size() && isSpace(s[pos])) ++pos;
+}
+inline std::string_view nextToken(std::string_view s, size_t& pos) {
+  skipSpace(s, pos);
+  const size_t b = pos;
+  while (pos < s.size() && !isSpace(s[pos])) ++pos;
+  return s.substr(b, pos - b);
+}
+inline std::string_view nextLine(std::string_view s, size_t& pos) {
+  size_t e = s.find('\n', pos);
+  if (e == std::string_view::npos) e = s.size();
+  std::string_view line = s.substr(pos, e - pos);
+  pos = std::min(s.size(), e + 1);
+  if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+  return line;
+}
+
 // Untrusted text for a message: at most 40 characters, non-printable bytes as '?'.
 std::string printable(std::string_view s);
 

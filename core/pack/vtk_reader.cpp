@@ -23,7 +23,6 @@ namespace {
 
 using namespace vtkio;
 
-bool isSpace(char c) { return c == ' ' || c == '\n' || c == '\r' || c == '\t' || c == '\f' || c == '\v'; }
 
 // VTK writes names with %XX escapes for spaces and other special characters.
 std::string decodeName(std::string_view s) {
@@ -145,27 +144,9 @@ struct Legacy {
     return fail(st, label + " " + at(p) + ": " + msg);
   }
 
-  void skipSpace() {
-    while (pos < s.size() && isSpace(s[pos])) ++pos;
-  }
-
-  // Next whitespace-delimited token (consumed); empty at the end of the file.
-  std::string_view token() {
-    skipSpace();
-    size_t b = pos;
-    while (pos < s.size() && !isSpace(s[pos])) ++pos;
-    return s.substr(b, pos - b);
-  }
-
-  // The rest of the current line, consuming its '\n' (binary data starts right after it).
-  std::string_view restOfLine() {
-    size_t e = s.find('\n', pos);
-    if (e == std::string_view::npos) e = s.size();
-    std::string_view line = s.substr(pos, e - pos);
-    pos = std::min(s.size(), e + 1);
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    return line;
-  }
+  void skipSpace() { vtkio::skipSpace(s, pos); }
+  std::string_view token() { return nextToken(s, pos); }         // empty at the end of the file
+  std::string_view restOfLine() { return nextLine(s, pos); }     // binary data starts after it
 
   bool peekKeyword(const char* kw) {
     size_t save = pos;
