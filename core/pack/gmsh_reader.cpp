@@ -168,10 +168,18 @@ struct Gmsh {
   std::string_view token() { return nextToken(s, pos); }
   std::string_view line() { return nextLine(s, pos); }
   Result textInt(const std::string& sec, const std::string& what, int64_t& v) {
+    return textNumber(sec, what, v, parseNextInt, "an integer");
+  }
+  Result textDouble(const std::string& sec, const std::string& what, double& v) {
+    return textNumber(sec, what, v, parseNextDouble, "a number");
+  }
+  template <typename T>
+  Result textNumber(const std::string& sec, const std::string& what, T& v, int (*parse)(std::string_view, size_t&, T&),
+                    const char* kind) {
     const size_t p = pos;
-    int r = parseNextInt(s, pos, v);
+    int r = parse(s, pos, v);
     if (r == 0) return error(Status::Truncated, p, sec, "file ends before " + what);
-    if (r < 0) return error(Status::Corrupt, pos, sec, what + ": '" + printable(token()) + "' is not an integer");
+    if (r < 0) return error(Status::Corrupt, pos, sec, what + ": '" + printable(token()) + "' is not " + kind);
     return Result::success();
   }
   Result textCount(const std::string& sec, const std::string& what, uint64_t& v) {
@@ -179,13 +187,6 @@ struct Gmsh {
     if (Result r = textInt(sec, what, x); !r) return r;
     if (x < 0) return error(Status::Corrupt, pos, sec, what + " is negative (" + std::to_string(x) + ")");
     v = uint64_t(x);
-    return Result::success();
-  }
-  Result textDouble(const std::string& sec, const std::string& what, double& v) {
-    const size_t p = pos;
-    int r = parseNextDouble(s, pos, v);
-    if (r == 0) return error(Status::Truncated, p, sec, "file ends before " + what);
-    if (r < 0) return error(Status::Corrupt, pos, sec, what + ": '" + printable(token()) + "' is not a number");
     return Result::success();
   }
 

@@ -216,7 +216,7 @@ struct TextReader {
       char c = s[pos];
       if (c == '#') {
         while (pos < s.size() && s[pos] != '\n') ++pos;
-      } else if (c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v') {
+      } else if (isSpace(c)) {
         ++pos;
       } else {
         break;
@@ -246,25 +246,18 @@ struct TextReader {
     return n;
   }
   // The next token as an integer / a number; Truncated at the end, Corrupt for anything else.
-  Result integer(const std::string& what, int64_t& v) {
+  Result integer(const std::string& what, int64_t& v) { return parsed(what, v, parseNextInt, "an integer"); }
+  Result number(const std::string& what, double& v) { return parsed(what, v, parseNextDouble, "a number"); }
+
+  template <typename T>
+  Result parsed(const std::string& what, T& v, int (*parse)(std::string_view, size_t&, T&), const char* kind) {
     skip();
     const size_t p = pos;
     std::string_view tok = peekToken();
     if (tok.empty()) return fail(Status::Truncated, at(p) + ": file ends before " + what);
     size_t q = 0;
-    if (parseNextInt(tok, q, v) != 1 || q != tok.size())
-      return fail(Status::Corrupt, at(p) + ": " + what + ": '" + printable(tok) + "' is not an integer");
-    pos += tok.size();
-    return Result::success();
-  }
-  Result number(const std::string& what, double& v) {
-    skip();
-    const size_t p = pos;
-    std::string_view tok = peekToken();
-    if (tok.empty()) return fail(Status::Truncated, at(p) + ": file ends before " + what);
-    size_t q = 0;
-    if (parseNextDouble(tok, q, v) != 1 || q != tok.size())
-      return fail(Status::Corrupt, at(p) + ": " + what + ": '" + printable(tok) + "' is not a number");
+    if (parse(tok, q, v) != 1 || q != tok.size())
+      return fail(Status::Corrupt, at(p) + ": " + what + ": '" + printable(tok) + "' is not " + kind);
     pos += tok.size();
     return Result::success();
   }

@@ -5,6 +5,7 @@
 import assert from 'node:assert/strict';
 import { spawnSync } from 'node:child_process';
 import fs from 'node:fs';
+import http from 'node:http';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { chromium } from 'playwright-core';
@@ -25,6 +26,21 @@ const chromiumArgs = [
 // SwiftShader renders in software, so frames are far slower than on a GPU: a generous bound.
 // The real figures go to the test output (t.diagnostic).
 export const MAX_FRAME_MS = 250;
+
+// Listens on 127.0.0.1 with the project's server `files` behind a /slow/... route that serves
+// `slowTo`/... with every chunk `delayMs` late (a slow link, so a test can act mid-stream).
+// onRequest(req) sees every request first. Returns { server, baseUrl }.
+export async function listenWithSlowRoute(files, { slowTo, delayMs, onRequest = () => {} }) {
+  const server = http.createServer((req, res) => {
+    onRequest(req);
+    const slow = /^\/slow(\/.*)$/.exec(req.url);
+    if (!slow) return files.emit('request', req, res);
+    req.url = `${slowTo}${slow[1]}`;
+    setTimeout(() => files.emit('request', req, res), /\.tsc$/.test(req.url) ? delayMs : 0);
+  });
+  await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
+  return { server, baseUrl: `http://127.0.0.1:${server.address().port}` };
+}
 
 export function checkBuilds() {
   assert.ok(fs.existsSync(path.join(webDir, 'tetstream.wasm')), `no viewer build in ${webDir}: build the wasm target first`);

@@ -6,13 +6,12 @@
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import fs from 'node:fs';
-import http from 'node:http';
 import os from 'node:os';
 import path from 'node:path';
 import { createServer } from '../../server/serve.mjs';
 import {
   webDir, outDir, checkBuilds, launchBrowser, cli, readManifest, openViewer as openViewerAt, waitForState,
-  waitForLevel, frames, pictureDifference,
+  waitForLevel, frames, pictureDifference, listenWithSlowRoute,
 } from './support.mjs';
 
 let tmp, pack, server, baseUrl, browser;
@@ -109,14 +108,7 @@ before(async () => {
   cli('pack', vtk, '-o', pack, '--chunk-kb', '8', '--lossless', '--field', 'radius', '--name', 'Two fields');
   const files = createServer({ mounts: [{ prefix: '/two', dir: pack }, { prefix: '/', dir: webDir }] });
   // /slow/... serves /two/... with every chunk 250 ms late (so a test can act mid-stream).
-  server = http.createServer((req, res) => {
-    const slow = /^\/slow(\/.*)$/.exec(req.url);
-    if (!slow) return files.emit('request', req, res);
-    req.url = `/two${slow[1]}`;
-    setTimeout(() => files.emit('request', req, res), /\.tsc$/.test(req.url) ? 250 : 0);
-  });
-  await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
-  baseUrl = `http://127.0.0.1:${server.address().port}`;
+  ({ server, baseUrl } = await listenWithSlowRoute(files, { slowTo: '/two', delayMs: 250 }));
   browser = await launchBrowser();
 });
 

@@ -5,14 +5,13 @@
 //   node --test tests/browser/
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import http from 'node:http';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { createServer } from '../../server/serve.mjs';
 import {
   webDir, outDir, MAX_FRAME_MS, checkBuilds, launchBrowser, cli, readManifest as readManifestOf, assertClose,
-  openViewer as openViewerAt, waitForState, waitForLevel, frameReport, frames, pictureDifference,
+  openViewer as openViewerAt, listenWithSlowRoute, waitForState, waitForLevel, frameReport, frames, pictureDifference,
   cliIso as cliIsoOf,
 } from './support.mjs';
 
@@ -73,15 +72,11 @@ before(async () => {
   });
   // /slow/... serves /data/... with every chunk 300 ms late (a slow link, for pause/resume),
   // and every chunk request is logged.
-  server = http.createServer((req, res) => {
-    if (/\.tsc$/.test(req.url)) chunkRequests.push([Date.now(), req.url]);
-    const slow = /^\/slow(\/.*)$/.exec(req.url);
-    if (!slow) return files.emit('request', req, res);
-    req.url = `/data${slow[1]}`;
-    setTimeout(() => files.emit('request', req, res), /\.tsc$/.test(req.url) ? 300 : 0);
-  });
-  await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
-  baseUrl = `http://127.0.0.1:${server.address().port}`;
+  ({ server, baseUrl } = await listenWithSlowRoute(files, {
+    slowTo: '/data',
+    delayMs: 300,
+    onRequest: (req) => { if (/\.tsc$/.test(req.url)) chunkRequests.push([Date.now(), req.url]); },
+  }));
   browser = await launchBrowser();
 });
 
