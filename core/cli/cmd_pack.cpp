@@ -66,7 +66,7 @@ Runner addPack(CLI::App& app) {
     std::vector<double> weights;
     double baseFraction = 0.01, maxError = -1, maxMemoryGb = 0;
     uint32_t baseVertices = 0, baseTets = 0, chunkKb = 256;
-    int level = 19;
+    int level = 19, threads = 2;
     bool lossless = false, json = false;
     ReadOptions read;
   };
@@ -96,6 +96,8 @@ Runner addPack(CLI::App& app) {
   sub->add_option("--zstd-level", o->level, "zstd compression level")->check(CLI::Range(1, 22))->capture_default_str();
   sub->add_option("--max-memory", o->maxMemoryGb, "refuse meshes that need more memory than this, in GB (default: 90% of RAM)")
       ->check(CLI::PositiveNumber);
+  sub->add_option("--threads", o->threads, "threads for simplification (1 or 2; the output is the same)")
+      ->check(CLI::Range(1, 2))->capture_default_str();
   sub->add_flag("--json", o->json, "print the result as JSON on stdout");
   return [o, me, bv, bt] {
     Stopwatch total;
@@ -114,6 +116,7 @@ Runner addPack(CLI::App& app) {
     opt.field = o->field;
     opt.name = o->name;
     opt.zstdLevel = o->level;
+    opt.threads = o->threads;
     if (!o->weights.empty())
       for (int k = 0; k < 3; ++k) opt.weights[k] = o->weights[size_t(k)];
     opt.baseFraction = o->baseFraction;

@@ -152,6 +152,7 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   so.weightGeometry = opt.weights[0];
   so.weightField = opt.weights[1];
   so.weightShape = opt.weights[2];
+  so.threads = opt.threads;
   so.field = iso;
   so.maxError = opt.maxError;
   so.targetTets = opt.baseTets;

@@ -27,6 +27,7 @@ struct PackOptions {
   bool lossless = false;                  // keep float32 values in split records
   uint32_t chunkKb = 256;                 // largest split chunk, compressed
   double maxMemoryBytes = 0;              // refuse meshes that need more (0: 90% of physical memory)
+  int threads = 2;                        // threads that evaluate collapse costs (1 or 2; same output)
   // Progress for displays: phase ("validate", "simplify", "encode", "write"), items done and
   // planned in that phase (collapses, splits; 0 planned when not countable).
   std::function<void(const char* phase, uint64_t done, uint64_t planned)> progress;

@@ -226,11 +226,11 @@ class Simplifier {
       for (uint32_t x : {a, b, c}) quadric_[x].addSquare(plane, 0.5 * len);
     }
     kappa_.resize(T_);
-    kappaSum_.assign(V_, 0.0);
+    qualitySum_.assign(V_, 0.0);
     for (uint32_t t = 0; t < T_; ++t) {
       kappa_[t] = tetKappa(t);
       if (kappa_[t] >= kKappaCap) ++flatInput_;
-      for (int k = 0; k < 4; ++k) kappaSum_[out_.tets[4 * size_t(t) + k]] += kappa_[t];
+      for (int k = 0; k < 4; ++k) qualitySum_[out_.tets[4 * size_t(t) + k]] += 3.0 / kappa_[t];
     }
     fieldQuadric_.assign(V_, {});
     for (uint32_t t = 0; t < T_; ++t) {
@@ -489,6 +489,7 @@ class Simplifier {
     fq.add(fieldQuadric_[j]);
     const double x5[5] = {P[0], P[1], P[2], double(field_[j]), 1.0};
     double region = fq.weight > 0 ? std::sqrt(std::max(0.0, fq.eval(x5)) / fq.weight) / range_ : 0.0;
+
     double ef = local + region;
     double eg = 0;
     if (boundary_[i]) {
@@ -505,11 +506,11 @@ class Simplifier {
     prepareShape(L);
     const double* P = p(j);
     const double PP = P[0] * P[0] + P[1] * P[1] + P[2] * P[2];
-    double kappaSum = kappaSum_[j];
+    double qualitySum = qualitySum_[j];
     int64_t count = int64_t(star_[j].size());
     for (const StarTet& st : L.star) {
       if (st.other[0] == j || st.other[1] == j || st.other[2] == j) {  // removed by the collapse
-        kappaSum -= st.kappa;
+        qualitySum -= 3.0 / st.kappa;
         --count;
         continue;
       }
@@ -524,10 +525,12 @@ class Simplifier {
       }
       const double kappa = std::sqrt(edges * 0.25 * faces) / det;
       if (3.0 / kappa < L.qualityFloor) return *verdict = CollapseVerdict::LowQuality, kInf;
-      kappaSum += std::min<double>(kappa, kKappaCap);
+      qualitySum += 3.0 / std::min<double>(kappa, kKappaCap);
       ++count;
     }
-    double es = count > 0 ? (kappaSum / double(count) - 3.0) / 3.0 : 0.0;
+    // Mean of (κ − 3)/κ = 1 − 3/κ: the paper's κ − 3, mapped onto [0, 1) so that one sliver
+    // cannot outweigh the field error (see simplify.h).
+    double es = count > 0 ? std::max(0.0, 1.0 - qualitySum / double(count)) : 0.0;
     return lower + opt_.weightShape * es;
   }
 
@@ -916,7 +919,7 @@ class Simplifier {
       if (kappa_[t] >= kKappaCap) ++out_.flatTetsRemoved;
       out_.tetAlive[t] = 0;
       --tetsAlive_;
-      for (int k = 0; k < 4; ++k) kappaSum_[v[k]] -= kappa_[t];
+      for (int k = 0; k < 4; ++k) qualitySum_[v[k]] -= 3.0 / kappa_[t];
       for (int k = 0; k < 4; ++k)
         if (v[k] != i) eraseFrom(star_[v[k]], t);
     }
@@ -929,7 +932,7 @@ class Simplifier {
       star_[j].push_back(t);
       float before = kappa_[t];
       kappa_[t] = tetKappa(t);
-      for (int k = 0; k < 4; ++k) kappaSum_[v[k]] += double(kappa_[t]) - (v[k] == j ? 0.0 : before);
+      for (int k = 0; k < 4; ++k) qualitySum_[v[k]] += 3.0 / kappa_[t] - (v[k] == j ? 0.0 : 3.0 / before);
     }
     star_[i].clear();
     star_[i].shrink_to_fit();
@@ -978,7 +981,7 @@ class Simplifier {
   std::vector<Quadric> quadric_;
   std::vector<float> kappa_, lastCost_;
   std::vector<FieldQuadric> fieldQuadric_;
-  std::vector<double> kappaSum_;  // per vertex: Σ κ over its star
+  std::vector<double> qualitySum_;  // per vertex: Σ 3/κ over its star
   std::vector<uint8_t> queued_;  // per vertex: has an entry in the queue (or in the current round)
   Lane main_;                // scratch of the one-thread parts (link condition, collapse)
   std::vector<Lane> lanes_;  // one per entry of a round (and the two threads of init())

@@ -11,8 +11,10 @@
 //        from the linear fields of all original tets that i and j now stand for, kept as
 //        volume-weighted 4D field quadrics summed on collapse (Garland & Heckbert's attribute
 //        quadrics; our stand-in for eq. (5)'s integral over the original vertices of the region).
-//   E_s  shape error, paper §3.3: mean of κ(S) − 3 over the tets around p_j after the collapse,
-//        divided by 3 (0 for equilateral tets).
+//   E_s  shape error, paper §3.3: the measure κ(S) − 3 normalised as (κ − 3)/κ = 1 − 3/κ, in
+//        [0, 1), averaged over the tets around p_j after the collapse (0: all equilateral).
+//        The paper's unbounded κ − 3 let the shape term outweigh the field wherever a mesh is
+//        anisotropic: on the Blunt Fin CFD grid it made the density error 6.6× larger.
 // Defaults (100, 1, 0.002) keep the boundary first, then the field; tet shape is a
 // tie-breaker; all terms are scale free, so they work for any mesh size and field range.
 //

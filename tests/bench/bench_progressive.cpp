@@ -19,6 +19,7 @@
 
 #include "isosurface.h"
 #include "pack/mesh_io.h"
+#include "tet_quality.h"
 
 using namespace tetstream;
 
@@ -127,10 +128,21 @@ int cmdError(int argc, char** argv) {
   double volO = 0, volA = 0;
   for (uint32_t t = 0; t < orig.tetCount(); ++t) volO += std::abs(tetVolume(orig, t));
   for (uint32_t t = 0; t < approx.tetCount(); ++t) volA += std::abs(tetVolume(approx, t));
+  // Tet shape of the approximation: 3/κ (1 for an equilateral tet, 0 for a flat one).
+  double qSum = 0, qMin = 1;
+  for (uint32_t t = 0; t < approx.tetCount(); ++t) {
+    double c[4][3];
+    for (int k = 0; k < 4; ++k)
+      for (int d = 0; d < 3; ++d) c[k][d] = approx.positions[3 * size_t(approx.tets[4 * size_t(t) + k]) + d];
+    double q = 3.0 / tetShape(c[0], c[1], c[2], c[3]).kappa();
+    qSum += q;
+    qMin = std::min(qMin, q);
+  }
   double rms = std::sqrt(sum2 / orig.vertexCount()), span = double(range.max) - range.min;
   std::printf("{\"tets\": %u, \"vertices\": %u, \"rms\": %.6g, \"max\": %.6g, \"rmsRelative\": %.6g, \"maxRelative\": %.6g, "
-              "\"volumeRatio\": %.6f}\n",
-              approx.tetCount(), approx.vertexCount(), rms, maxErr, rms / span, maxErr / span, volA / volO);
+              "\"volumeRatio\": %.6f, \"meanQuality\": %.4f, \"minQuality\": %.3g}\n",
+              approx.tetCount(), approx.vertexCount(), rms, maxErr, rms / span, maxErr / span, volA / volO,
+              qSum / std::max(1u, approx.tetCount()), qMin);
   return 0;
 }
 

@@ -40,7 +40,19 @@ for t in "${TARGETS[@]}"; do
   build/fuzz/fuzz-"$t" "$work" "$corpus" "$seeds" -max_total_time="$SECONDS_EACH" -rss_limit_mb=1024 \
     -max_len="${MAX_LEN:-8192}" -timeout=10 -artifact_prefix="$found/" -print_final_stats=1 2>build/fuzz/$t.log || true
   grep -E "stat::number_of_executed_units|stat::peak_rss_mb" build/fuzz/$t.log | sed "s/^/  /"
+  # A finding must reproduce: a slow unit or timeout can also come from the machine being busy
+  # (or the fuzzer being paused); one that runs cleanly on its own is reported and dropped.
+  for f in "$found"/*; do
+    [ -e "$f" ] || continue
+    if timeout 60 build/fuzz/fuzz-"$t" "$f" >/dev/null 2>&1; then
+      echo "  not reproduced (dropped): $(basename "$f")"
+      rm "$f"
+    fi
+  done
   ls "$found" | sed "s/^/  finding: /"
+  # The ledger adds up executions across sessions (the goal is counted over all the work).
+  execs=$(awk '/stat::number_of_executed_units/ {print $2}' build/fuzz/$t.log)
+  printf '%s\t%s\t%s\t%s\t%s\n' "$(date -u +%FT%TZ)" "$t" "$SECONDS_EACH" "${execs:-0}" "$(ls "$found" | wc -l)" >> tests/fuzz/executions.tsv
   # Keep a minimal set that covers what the whole work folder covers.
   mkdir -p "$corpus.new"
   build/fuzz/fuzz-"$t" -merge=1 "$corpus.new" "$corpus" "$work" "$seeds" 2>/dev/null >/dev/null

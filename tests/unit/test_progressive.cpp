@@ -6,6 +6,9 @@
 
 #include <algorithm>
 #include <array>
+#include <thread>
+#include <chrono>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -20,6 +23,7 @@
 #include "pack/generators.h"
 #include "pack/packer.h"
 #include "pack/simplify.h"
+#include "pack/work_pool.h"
 #include "quantize.h"
 #include "test_helpers.h"
 #include "validate.h"
@@ -242,6 +246,22 @@ TEST(Progressive, TwoThreadsCollapseExactlyAsOne) {
   EXPECT_EQ(one.log.fieldError, two.log.fieldError);
   EXPECT_EQ(one.tets, two.tets);
   EXPECT_EQ(one.queuePops, two.queuePops);
+}
+
+// Every task of every round runs exactly once, whether the helper takes part or is held up
+// (a helper stuck in a slow task must not make the caller run a task twice or skip one).
+TEST(Progressive, WorkPoolRunsEveryTaskOnce) {
+  WorkPool pool(1);
+  std::vector<std::atomic<int>> runs(8);
+  for (int round = 0; round < 20000; ++round) {
+    const uint32_t n = 1 + uint32_t(round % 8);
+    for (auto& r : runs) r.store(0);
+    pool.run(n, [&](uint32_t k) {
+      if (round % 1000 == 7 && k == 0) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      runs[k].fetch_add(1);
+    });
+    for (uint32_t k = 0; k < 8; ++k) ASSERT_EQ(runs[k].load(), k < n ? 1 : 0) << "round " << round << " task " << k;
+  }
 }
 
 // Planar boundary faces and creases carry zero quadric error, so with the default weights the
