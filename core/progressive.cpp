@@ -6,22 +6,6 @@
 namespace tetstream {
 namespace {
 
-void linkCorner(ProgressiveMesh& pm, uint32_t corner, uint32_t v) {
-  pm.cornerNext[corner] = pm.vertexHead[v];
-  pm.vertexHead[v] = corner;
-}
-
-// Removes from v's list every corner for which drop(corner) holds, keeping the others' order.
-template <typename Pred>
-void unlinkCorners(ProgressiveMesh& pm, uint32_t v, Pred drop) {
-  uint32_t* link = &pm.vertexHead[v];
-  while (*link != kNoCorner) {
-    uint32_t c = *link;
-    if (drop(c)) *link = pm.cornerNext[c];
-    else link = &pm.cornerNext[c];
-  }
-}
-
 // Small arrays (a vertex's star: tens of entries): insertion sort beats introsort's overhead.
 void sortSmall(std::vector<uint32_t>& v) {
   for (size_t i = 1; i < v.size(); ++i) {
@@ -33,7 +17,7 @@ void sortSmall(std::vector<uint32_t>& v) {
 }
 
 uint32_t nextStamp(const ProgressiveMesh& pm) {
-  pm.seen.resize(pm.vertexHead.size(), 0);
+  pm.seen.resize(pm.vertexCount(), 0);
   if (++pm.stamp == 0) {  // wrapped: clear once every 4 billion calls
     std::fill(pm.seen.begin(), pm.seen.end(), 0);
     pm.stamp = 1;
@@ -43,12 +27,80 @@ uint32_t nextStamp(const ProgressiveMesh& pm) {
 
 }  // namespace
 
+void StarPool::clear() {
+  pool_.clear();
+  start_.clear();
+  size_.clear();
+  cls_.clear();
+  free_.clear();
+}
+
+void StarPool::reserve(size_t vertices, size_t corners) {
+  start_.reserve(vertices);
+  size_.reserve(vertices);
+  cls_.reserve(vertices);
+  pool_.reserve(corners + corners * 2 / 5);  // ~1.3 slots per corner (see StarPool), and a margin
+}
+
+uint8_t StarPool::classFor(uint32_t capacity) {
+  uint8_t cls = 0;
+  while (capacityOf(cls) < capacity) ++cls;
+  return cls;
+}
+
+uint32_t StarPool::allocate(uint8_t cls) {
+  if (free_.size() > cls && !free_[cls].empty()) {
+    uint32_t s = free_[cls].back();
+    free_[cls].pop_back();
+    return s;
+  }
+  const uint32_t s = uint32_t(pool_.size());
+  pool_.resize(pool_.size() + capacityOf(cls));
+  return s;
+}
+
+uint32_t StarPool::addVertex(uint32_t capacity) {
+  const uint8_t cls = classFor(std::max<uint32_t>(capacity, 8));
+  start_.push_back(allocate(cls));
+  size_.push_back(0);
+  cls_.push_back(cls);
+  return uint32_t(start_.size() - 1);
+}
+
+void StarPool::popVertex() {
+  const uint8_t cls = cls_.back();
+  if (free_.size() <= cls) free_.resize(cls + 1);
+  free_[cls].push_back(start_.back());
+  start_.pop_back();
+  size_.pop_back();
+  cls_.pop_back();
+}
+
+void StarPool::grow(uint32_t v) {
+  const uint8_t cls = cls_[v];
+  const uint32_t to = allocate(uint8_t(cls + 1));  // may move pool_: copy by index
+  std::copy_n(pool_.begin() + start_[v], size_[v], pool_.begin() + to);
+  if (free_.size() <= cls) free_.resize(cls + 1);
+  free_[cls].push_back(start_[v]);
+  start_[v] = to;
+  cls_[v] = uint8_t(cls + 1);
+}
+
+size_t StarPool::bytes() const {
+  size_t n = pool_.capacity() * 4 + start_.capacity() * 4 + size_.capacity() * 4 + cls_.capacity();
+  for (const auto& f : free_) n += f.capacity() * 4;
+  return n;
+}
+
 void initProgressive(ProgressiveMesh& pm, TetMesh base) {
   pm.mesh = std::move(base);
-  pm.vertexHead.assign(pm.mesh.vertexCount(), kNoCorner);
-  pm.cornerNext.assign(pm.mesh.tets.size(), kNoCorner);
-  // Link in reverse so each list runs in ascending corner order (cheaper sorting later).
-  for (size_t c = pm.mesh.tets.size(); c-- > 0;) linkCorner(pm, uint32_t(c), pm.mesh.tets[c]);
+  const uint32_t V = pm.mesh.vertexCount();
+  std::vector<uint32_t> degree(V, 0);
+  for (uint32_t v : pm.mesh.tets) ++degree[v];
+  pm.stars.clear();
+  pm.stars.reserve(V, pm.mesh.tets.size());
+  for (uint32_t v = 0; v < V; ++v) pm.stars.addVertex(degree[v] + degree[v] / 4);  // room to grow
+  for (size_t c = 0; c < pm.mesh.tets.size(); ++c) pm.stars.add(pm.mesh.tets[c], uint32_t(c));
   pm.splitJ.clear();
   pm.splitTetsBefore.clear();
   pm.baseVertices = pm.mesh.vertexCount();
@@ -57,7 +109,7 @@ void initProgressive(ProgressiveMesh& pm, TetMesh base) {
 
 void starOf(const ProgressiveMesh& pm, uint32_t v, std::vector<uint32_t>& tets) {
   tets.clear();
-  for (uint32_t c = pm.vertexHead[v]; c != kNoCorner; c = pm.cornerNext[c]) tets.push_back(c >> 2);
+  for (uint32_t c : pm.stars.corners(v)) tets.push_back(c >> 2);
   sortSmall(tets);
 }
 
@@ -65,7 +117,7 @@ void neighboursOf(const ProgressiveMesh& pm, uint32_t v, std::vector<uint32_t>& 
   vertices.clear();
   const uint32_t stamp = nextStamp(pm);
   pm.seen[v] = stamp;
-  for (uint32_t c = pm.vertexHead[v]; c != kNoCorner; c = pm.cornerNext[c]) {
+  for (uint32_t c : pm.stars.corners(v)) {
     const uint32_t* t = &pm.mesh.tets[c & ~3u];
     for (int k = 0; k < 4; ++k)
       if (pm.seen[t[k]] != stamp) {
@@ -85,7 +137,7 @@ void applySplit(ProgressiveMesh& pm, const SplitOp& op, std::vector<uint32_t>& c
 
   m.positions.insert(m.positions.end(), op.position, op.position + 3);
   for (size_t f = 0; f < m.fields.size(); ++f) m.fields[f].values.push_back(op.fields[f]);
-  pm.vertexHead.push_back(kNoCorner);
+  pm.stars.addVertex(uint32_t(op.moved.size() + op.newTets.size() / 4));
 
   // T_moved: the j corner of each listed tet becomes an i corner.
   for (uint32_t t : op.moved) {
@@ -94,20 +146,15 @@ void applySplit(ProgressiveMesh& pm, const SplitOp& op, std::vector<uint32_t>& c
     while (k < 4 && v[k] != op.j) ++k;
     assert(k < 4);
     v[k] = i;
+    pm.stars.add(i, 4 * t + uint32_t(k));
     changed.push_back(t);
   }
-  if (!op.moved.empty()) {
-    unlinkCorners(pm, op.j, [&](uint32_t c) { return m.tets[c] == i; });
-    for (uint32_t t : op.moved)
-      for (uint32_t k = 0; k < 4; ++k)
-        if (m.tets[4 * t + k] == i) linkCorner(pm, 4 * t + k, i);
-  }
+  if (!op.moved.empty()) pm.stars.removeIf(op.j, [&](uint32_t c) { return m.tets[c] == i; });
   // T_new: appended tets around the edge (i, j).
   for (size_t n = 0; n + 3 < op.newTets.size(); n += 4) {
     uint32_t t = m.tetCount();
     m.tets.insert(m.tets.end(), op.newTets.begin() + n, op.newTets.begin() + n + 4);
-    pm.cornerNext.insert(pm.cornerNext.end(), 4, kNoCorner);
-    for (uint32_t k = 0; k < 4; ++k) linkCorner(pm, 4 * t + k, m.tets[4 * t + k]);
+    for (uint32_t k = 0; k < 4; ++k) pm.stars.add(m.tets[4 * t + k], 4 * t + k);
     changed.push_back(t);
   }
 }
@@ -120,28 +167,25 @@ void undoSplit(ProgressiveMesh& pm, std::vector<uint32_t>& changed) {
   pm.splitJ.pop_back();
   pm.splitTetsBefore.pop_back();
 
-  // Unlink the new tets' corners from their vertices (one walk per vertex), drop the tets.
+  // Drop the new tets' corners from their vertices (once per vertex), then the tets.
   const uint32_t firstDead = 4 * tetsBefore;
   const uint32_t stamp = nextStamp(pm);
   for (uint32_t c = firstDead; c < m.tets.size(); ++c) {
     uint32_t v = m.tets[c];
     if (v == i || pm.seen[v] == stamp) continue;
     pm.seen[v] = stamp;
-    unlinkCorners(pm, v, [&](uint32_t x) { return x >= firstDead; });
+    pm.stars.removeIf(v, [&](uint32_t x) { return x >= firstDead; });
   }
   m.tets.resize(firstDead);
-  pm.cornerNext.resize(firstDead);
   // The remaining corners of i are the moved tets: give them back to j.
-  for (uint32_t c = pm.vertexHead[i]; c != kNoCorner;) {
-    uint32_t next = pm.cornerNext[c];
-    if (c < firstDead) {
-      m.tets[c] = j;
-      linkCorner(pm, c, j);
-      changed.push_back(c >> 2);
-    }
-    c = next;
+  for (uint32_t k = 0; k < pm.stars.corners(i).size(); ++k) {  // add() may move the pool: no span kept
+    const uint32_t c = pm.stars.corners(i)[k];
+    if (c >= firstDead) continue;
+    m.tets[c] = j;
+    pm.stars.add(j, c);
+    changed.push_back(c >> 2);
   }
-  pm.vertexHead.pop_back();
+  pm.stars.popVertex();
   m.positions.resize(m.positions.size() - 3);
   for (ScalarField& f : m.fields) f.values.pop_back();
 }

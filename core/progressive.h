@@ -2,8 +2,10 @@
 // (paper §3.1, FORMAT.md §4). View side: the viewer and the CLI's reader use it, and so does
 // the packer's encoder, so both sides see identical neighbourhoods.
 //
-// Incidence is kept as flat corner lists: corner c = 4t + k is slot k of tet t; cornerNext[c]
-// links the corners of one vertex, vertexHead[v] starts the list. No per-vertex allocation.
+// Incidence: corner c = 4t + k is slot k of tet t. Each vertex keeps its corners in one block of
+// a shared pool (StarPool below), so walking a star reads one or two cache lines instead of
+// chasing a linked list through the whole mesh: a split reads the star of j twice and a linked
+// list made that half of the streaming time. No per-vertex allocation.
 // Tets are only ever appended (T_new) or have one slot changed (T_moved); undo reverses both.
 #pragma once
 #include <cstdint>
@@ -14,7 +16,46 @@
 
 namespace tetstream {
 
-inline constexpr uint32_t kNoCorner = ~uint32_t(0);
+// Per-vertex corner lists in one flat array. Block sizes go 8, 12, 16, 24, 32, 48, ... (steps of
+// about 1.5); a full block moves to the next size, and freed blocks are kept by size for reuse,
+// so the pool holds about 1.3 slots per corner (1.27 measured on Harmonic 64³, streamed) and
+// never needs compacting. Order within a list is
+// not meaningful (starOf and neighboursOf sort).
+class StarPool {
+ public:
+  void clear();
+  void reserve(size_t vertices, size_t corners);
+  // Appends a vertex with room for `capacity` corners; returns its id.
+  uint32_t addVertex(uint32_t capacity);
+  void popVertex();  // the last one; its block is freed
+  uint32_t vertexCount() const { return uint32_t(start_.size()); }
+  void add(uint32_t v, uint32_t corner) {
+    if (size_[v] == capacityOf(cls_[v])) grow(v);
+    pool_[start_[v] + size_[v]++] = corner;
+  }
+  // Removes every corner for which drop(corner) holds.
+  template <typename Pred>
+  void removeIf(uint32_t v, Pred drop) {
+    uint32_t* c = &pool_[start_[v]];
+    uint32_t n = 0;
+    for (uint32_t k = 0; k < size_[v]; ++k)
+      if (!drop(c[k])) c[n++] = c[k];
+    size_[v] = n;
+  }
+  std::span<const uint32_t> corners(uint32_t v) const { return {pool_.data() + start_[v], size_[v]}; }
+  size_t bytes() const;  // memory held
+
+ private:
+  static uint32_t capacityOf(uint8_t cls) { return (cls & 1 ? 12u : 8u) << (cls >> 1); }
+  static uint8_t classFor(uint32_t capacity);
+  uint32_t allocate(uint8_t cls);
+  void grow(uint32_t v);
+
+  std::vector<uint32_t> pool_;
+  std::vector<uint32_t> start_, size_;
+  std::vector<uint8_t> cls_;
+  std::vector<std::vector<uint32_t>> free_;  // per class: starts of free blocks
+};
 
 // One split, decoded: the new vertex i gets id vertexCount(); `moved` lists tets (ids, all in
 // star(j)) whose j slot becomes i; `newTets` holds 4 vertex ids per recreated tet (using the
@@ -29,8 +70,7 @@ struct SplitOp {
 
 struct ProgressiveMesh {
   TetMesh mesh;
-  std::vector<uint32_t> cornerNext;  // 4 per tet
-  std::vector<uint32_t> vertexHead;  // 1 per vertex
+  StarPool stars;  // the corners around each vertex
   // Undo log, one entry per applied split: the kept vertex and the tet count before the split.
   std::vector<uint32_t> splitJ, splitTetsBefore;
   uint32_t baseVertices = 0, baseTets = 0;

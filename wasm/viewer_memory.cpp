@@ -8,9 +8,9 @@ namespace tetstream::viewer {
 namespace {
 
 // Per-element costs in bytes (see the header for where they come from).
-constexpr double kPerVertex = 12 + 4 + 4;   // position; vertexHead; the de-duplication stamp (seen)
+constexpr double kPerVertex = 12 + 9 + 4;   // position; star block (start, size, class); the de-duplication stamp (seen)
 constexpr double kPerFieldValue = 4;
-constexpr double kPerTet = 16 + 16;         // vertex ids; cornerNext
+constexpr double kPerTet = 16 + 23;         // vertex ids; 4 corners in the star pool at 1.4 slots each
 constexpr double kPerSplit = 4 + 4 + 4;     // undo log (splitJ, splitTetsBefore); record offset
 constexpr double kSurfacePerTet = 56;       // isosurface + interval tree, measured 49 plus margin
 constexpr double kHullPerTriangle = 110;
@@ -54,7 +54,7 @@ uint32_t chunksThatFit(const Manifest& m, uint64_t budgetBytes) {
 uint64_t datasetMemoryBytes(const Dataset& ds) {
   auto bytes = [](const auto& v) { return uint64_t(v.capacity() * sizeof(v[0])); };
   const ProgressiveMesh& pm = ds.pm;
-  uint64_t n = bytes(pm.mesh.positions) + bytes(pm.mesh.tets) + bytes(pm.cornerNext) + bytes(pm.vertexHead) +
+  uint64_t n = bytes(pm.mesh.positions) + bytes(pm.mesh.tets) + pm.stars.bytes() +
                bytes(pm.splitJ) + bytes(pm.splitTetsBefore) + bytes(pm.seen);
   for (const ScalarField& f : pm.mesh.fields) n += bytes(f.values);
   for (const auto& p : ds.payloads) n += bytes(p);

@@ -108,8 +108,7 @@ void reserveLevel(ViewerState& s) {
   pm.mesh.positions.reserve(3 * size_t(last.vertices));
   pm.mesh.tets.reserve(4 * size_t(last.tets));
   for (ScalarField& f : pm.mesh.fields) f.values.reserve(last.vertices);
-  pm.cornerNext.reserve(4 * size_t(last.tets));
-  pm.vertexHead.reserve(last.vertices);
+  pm.stars.reserve(last.vertices, 4 * size_t(last.tets));
   pm.splitJ.reserve(last.vertices);
   pm.splitTetsBefore.reserve(last.vertices);
   s.surface.reserveTets(last.tets);
@@ -650,7 +649,7 @@ void HullTracker::recount(const ProgressiveMesh& pm, uint32_t v) {
   const uint32_t* tets = pm.mesh.tets.data();
   entries_.clear();
   uint64_t parity = 0;
-  for (uint32_t c = pm.vertexHead[v]; c != kNoCorner; c = pm.cornerNext[c]) {
+  for (uint32_t c : pm.stars.corners(v)) {
     const uint32_t t = c >> 2, k = c & 3;
     for (uint32_t f = 0; f < 4; ++f) {
       if (f == k) continue;  // face f is opposite local vertex f: the others contain v

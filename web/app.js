@@ -535,6 +535,7 @@ async function instantiateProgram(imports) {
       type: 'application/wasm',
       stallMs,
       onProgress: (n) => { shell.programBytes += n; },
+      onEnd: programDownloaded,
       onError: (e) => { streamError = e; },
     });
     try {
@@ -781,6 +782,15 @@ function startLoader({ names, sizes }, manifestUrl) {
   loader.pump();
 }
 
+// The program's last byte is in: the link is free for more than the base chunk. Called by the
+// counting stream at once; the resource-timing observer (whenProgramDownloaded) is the fallback
+// and can come hundreds of ms late, while the main thread compiles.
+function programDownloaded() {
+  if (shell.programLoaded) return;
+  shell.programLoaded = true;
+  if (loader) loader.warm();
+}
+
 // Calls back once the browser has every byte of tetstream.wasm (Resource Timing), which is
 // well before the program is compiled: from then on chunks may share the link.
 function whenProgramDownloaded(callback) {
@@ -801,10 +811,7 @@ async function stream(manifestUrl) {
   const viewerPromise = viewerLoad || (viewerLoad = loadViewer());
   const manifestPromise = loadManifest(manifestUrl);
   manifestPromise.catch(() => {}); // awaited below; avoid an "unhandled rejection" meanwhile
-  whenProgramDownloaded(() => {
-    shell.programLoaded = true;
-    if (loader) loader.warm();
-  });
+  whenProgramDownloaded(programDownloaded);
   // The base chunk is fetched as soon as the manifest is in, while the program downloads and
   // compiles: the first picture comes a round trip and a base download sooner.
   manifestPromise.then((bytes) => {

@@ -95,7 +95,10 @@ export class ChunkLoader {
       ahead += this.sizes[j];
       outstanding += Math.max(0, this.sizes[j] - e.received);
     }
-    const limit = this.next === 0 && !this.arrived.has(0) ? MAX_IN_FLIGHT_BEFORE_BASE : MAX_IN_FLIGHT;
+    // Once the program is in, the base has at most a few round trips left: open the other
+    // requests now, as the main thread may be busy starting the program for a while (no
+    // callbacks run then, so requests not opened before it would wait).
+    const limit = this.next === 0 && !this.arrived.has(0) && !this.warmed ? MAX_IN_FLIGHT_BEFORE_BASE : MAX_IN_FLIGHT;
     for (let i = this.next; i < end && this.inFlight.size < limit; i++) {
       if (this.arrived.has(i) || this.inFlight.has(i) || this.waiting.has(i)) continue;
       if (i > this.next && ahead + this.sizes[i] > MAX_AHEAD_BYTES) break;

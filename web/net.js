@@ -116,7 +116,7 @@ export async function fetchBytes(url, { signal, stallMs = STALL_SECONDS * 1000, 
 // read the body themselves (WebAssembly.instantiateStreaming). The returned Response carries
 // `type`; a stall, a broken connection or a cancelled `signal` errors the stream, which rejects
 // the consumer (with its own error type: onError(FetchError) tells what happened).
-export function countingResponse(response, { type, onProgress, onError = () => {}, stallMs = STALL_SECONDS * 1000, signal }) {
+export function countingResponse(response, { type, onProgress, onEnd = () => {}, onError = () => {}, stallMs = STALL_SECONDS * 1000, signal }) {
   const reader = response.body.getReader();
   let timer = 0;
   let controller = null;
@@ -150,6 +150,7 @@ export function countingResponse(response, { type, onProgress, onError = () => {
       if (step.done) {
         clearTimeout(timer);
         ctl.close();
+        onEnd();
         return;
       }
       arm();
