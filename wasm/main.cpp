@@ -281,6 +281,7 @@ void onChar(GLFWwindow*, unsigned int c) {
       if (!m.fields.empty()) setColourField(s, s.colourField + 1 >= int(m.fields.size()) ? -1 : s.colourField + 1);
       break;
     case 'm': case 'M': setColourMap(s, ColourMap((int(s.colourMap) + 1) % kColourMapCount)); break;
+    case 'f': case 'F': fitColourRange(s); break;
     case 'l': case 'L': EM_ASM({ if (Module.onCopyLink) Module.onCopyLink(); }); break;
     case 's': case 'S': EM_ASM({ if (Module.onScreenshot) Module.onScreenshot(); }); break;
     case ' ':
@@ -666,6 +667,11 @@ EMSCRIPTEN_KEEPALIVE int ts_set_colour_map(const char* name) {
 EMSCRIPTEN_KEEPALIVE void ts_set_colour_range(double lo, double hi) {
   requestRedraw();
   setColourRange(g_app.state, float(lo), float(hi));
+}
+
+EMSCRIPTEN_KEEPALIVE int ts_fit_colour_range() {
+  requestRedraw();
+  return fitColourRange(g_app.state) ? 1 : 0;
 }
 
 EMSCRIPTEN_KEEPALIVE void ts_set_slice(int on, double nx, double ny, double nz, double offset) {

@@ -239,7 +239,11 @@ void colourSection(ViewerState& s, float width, float pixelsPerCssPixel) {
     const float speed = float(fr.max - fr.min) / 500.f;
     if (ImGui::DragFloat2("range", range, speed > 0 ? speed : 0.01f, 0, 0, "%.4g")) setColourRange(s, range[0], range[1]);
     ImGui::SameLine();
+    if (ImGui::SmallButton("fit")) fitColourRange(s);
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("the range of the values on the visible surface (F)");
+    ImGui::SameLine(0, 2);
     if (ImGui::SmallButton("reset")) setColourRange(s, float(fr.min), float(fr.max));
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("the field's whole range");
   }
   ImGui::PopItemWidth();
   if (s.colourField >= 0) colourBar(s, width, pixelsPerCssPixel);
@@ -397,6 +401,7 @@ const Shortcut kShortcuts[] = {
     {"[ and ]", "move the slice back / forward (or shift + drag)"},
     {"C", "colour by: next field (or none)"},
     {"M", "next colour map"},
+    {"F", "fit the colour range to the visible surface"},
     {"L", "copy a link to this view"},
     {"S", "save a screenshot (PNG)"},
     {"Space", "pause / resume the download"},

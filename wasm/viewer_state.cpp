@@ -1,6 +1,7 @@
 #include "viewer_state.h"
 
 #include <algorithm>
+#include <limits>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -391,6 +392,29 @@ void setColourRange(ViewerState& s, float lo, float hi) {
   if (lo > hi) std::swap(lo, hi);
   s.colourMin = lo;
   s.colourMax = hi;
+}
+
+bool fitColourRange(ViewerState& s) {
+  if (s.colourField < 0) return false;
+  float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+  auto cover = [&](const IncrementalIsosurface& surface) {
+    std::span<const float> colours = surface.colours();
+    for (uint32_t v : surface.indices()) {  // live vertices only: free slots hold stale values
+      lo = std::min(lo, colours[v]);
+      hi = std::max(hi, colours[v]);
+    }
+  };
+  cover(s.surface);
+  if (s.sliceOn && s.slice.built()) cover(s.slice.surface());
+  if (!(lo <= hi)) return false;
+  if (lo == hi) {  // a flat colour: a small range around it, so the map still shows where it is
+    const Range fr = s.dataset.manifest.fields[size_t(s.colourField)].range;
+    const float pad = std::max(1e-6f * std::abs(lo), float(fr.max - fr.min) * 1e-3f);
+    lo -= pad;
+    hi += pad;
+  }
+  setColourRange(s, lo, hi);
+  return true;
 }
 
 void setSliceEnabled(ViewerState& s, bool on) {

@@ -272,6 +272,10 @@ bool setColourField(ViewerState& s, std::string_view name);
 void setColourMap(ViewerState& s, ColourMap map);
 // Non-finite values are ignored; lo > hi are swapped.
 void setColourRange(ViewerState& s, float lo, float hi);
+// Sets the colour range to the colour field's values on what is shown (the isosurface and, when
+// on, the slice): a surface that spans a small part of the field's range gets the whole colour
+// map. False (range unchanged) when no colour field is chosen or nothing is shown.
+bool fitColourRange(ViewerState& s);
 
 // The slice plane: on/off and the plane n·p = offset (n normalised; a zero normal is refused).
 // Turning it on without a colour field colours by the isovalue's field.

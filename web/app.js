@@ -33,6 +33,7 @@
 //                       the range becomes the field's range. true when the field exists
 //   setColourMap(name)   -> viridis, magma, turbo, coolwarm, grey; true when known
 //   setColourRange(lo, hi) -> the values at the colour map's two ends
+//   fitColourRange()     -> the range of the colour values on the visible surface; false if none
 //   (stats() has colourField, colourMap, colourRange: [lo, hi])
 //   setLevel(f)      -> level target: fraction f of the full mesh's vertices, clamped to what has
 //                       been received (0 = base mesh; 1 = newest, and it then follows new data)
@@ -177,6 +178,9 @@ window.tetstream = {
   },
   setColourRange(lo, hi) {
     if (viewer) viewer._ts_set_colour_range(Number(lo), Number(hi));
+  },
+  fitColourRange() {
+    return viewer ? viewer._ts_fit_colour_range() === 1 : false;
   },
   setLevel(fraction) {
     setLevel(fraction);

@@ -144,6 +144,20 @@ test('colour by a second field with a colour bar, and a slice plane drawn with t
   const greenBefore = await countGreen(page, plain);
   t.diagnostic(`green pixels: ${green} coloured by height, ${greenBefore} before`);
   assert.ok(green > 30000 && green > 20 * greenBefore, `the map's colours show (${green} vs ${greenBefore})`);
+  // "fit" (button, F key or API): the range of the values on the surface, inside the field's.
+  assert.equal(await page.evaluate(() => window.tetstream.fitColourRange()), true);
+  s = await page.evaluate(() => window.tetstream.stats());
+  t.diagnostic(`fitted colour range ${s.colourRange} (field ${height.min} .. ${height.max})`);
+  assert.ok(s.colourRange[0] >= Math.fround(height.min) && s.colourRange[1] <= Math.fround(height.max) &&
+    s.colourRange[1] - s.colourRange[0] < 0.9 * (height.max - height.min), `fitted ${s.colourRange}`);
+  await frames(page);
+  await page.screenshot({ path: path.join(outDir, 'view-colour-fit.png') });
+  await page.evaluate((h) => window.tetstream.setColourRange(h.min, h.max), height);
+  await page.keyboard.press('f');
+  await frames(page);
+  const byKey = await page.evaluate(() => window.tetstream.stats());
+  assert.deepEqual(byKey.colourRange, s.colourRange, 'the F key fits too');
+  await page.evaluate((h) => window.tetstream.setColourRange(h.min, h.max), height);
 
   // The slice z = 0.3 through the box: a 2 x 2 square (lossless pack: the original grid).
   assert.equal(await page.evaluate(() => window.tetstream.setSlice({ on: true, normal: [0, 0, 1], offset: 0.3 })), true);

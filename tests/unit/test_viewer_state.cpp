@@ -585,3 +585,38 @@ TEST(ViewerState, ColourFieldAndSliceFollowTheStream) {
   EXPECT_TRUE(setColourField(s, -1));
   for (uint32_t i : s.surface.indices()) EXPECT_EQ(s.surface.colours()[i], 0.f);
 }
+
+// "fit": the colour range becomes the colour field's range over the shown triangles' vertices,
+// computed here from the triangles themselves; with the slice on it covers the slice too.
+TEST(ViewerState, FitColourRangeCoversWhatIsShown) {
+  const Packed& p = packedStream();
+  ViewerState s;
+  ASSERT_TRUE(openManifest(s, p.manifest).ok());
+  EXPECT_FALSE(fitColourRange(s)) << "no colour field yet";
+  ASSERT_TRUE(setField(s, "harmonic"));
+  setIsovalue(s, 0.1f);
+  ASSERT_TRUE(setColourField(s, "distance"));
+  for (uint32_t c = 0; c < p.chunks.size(); ++c) ASSERT_TRUE(addChunk(s, c, p.chunks[c]).ok()) << c;
+  settle(s);
+  auto rangeOf = [](const IncrementalIsosurface& x, float& lo, float& hi) {
+    for (uint32_t t = 0; t < x.triangleCount(); ++t)
+      for (int k = 0; k < 3; ++k) {
+        float c = x.colours()[x.indices()[3 * size_t(t) + k]];
+        lo = std::min(lo, c);
+        hi = std::max(hi, c);
+      }
+  };
+  float lo = 1e30f, hi = -1e30f;
+  rangeOf(s.surface, lo, hi);
+  ASSERT_TRUE(fitColourRange(s));
+  EXPECT_EQ(s.colourMin, lo);
+  EXPECT_EQ(s.colourMax, hi);
+  const Range d = s.dataset.manifest.fields[size_t(s.dataset.manifest.findField("distance"))].range;
+  EXPECT_GT(s.colourMin, d.min) << "the surface spans part of the field's range";
+  setSliceEnabled(s, true);
+  ASSERT_TRUE(setSlicePlane(s, {0, 0, 1}, 0.3f));
+  rangeOf(s.slice.surface(), lo, hi);
+  ASSERT_TRUE(fitColourRange(s));
+  EXPECT_EQ(s.colourMin, lo);
+  EXPECT_EQ(s.colourMax, hi);
+}
