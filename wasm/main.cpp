@@ -147,6 +147,10 @@ constexpr double kInteractiveSliceMs = 4.0;
 // Download progress alone (no new level) redraws the panel at most this often: each drawn frame
 // costs a software GPU tens of ms that the first surface and refinement need more.
 constexpr double kProgressRedrawMs = 250.0;
+// On a software GL the GPU process renders each frame on the same CPU cores the refinement runs
+// on (~100 ms a frame for Harmonic 64 in SwiftShader), so a level that is only refining, with
+// nobody touching the view, is redrawn at most this often; input still redraws at once.
+constexpr double kSoftwareRefineRedrawMs = 200.0;
 
 App g_app;
 
@@ -436,7 +440,7 @@ extern "C" EMSCRIPTEN_KEEPALIVE void ts_work() {
   const double start = emscripten_get_now();
   const double deadline = start + (interacting() ? kInteractiveSliceMs : kSliceMs);
   if (refining(s)) {
-    if (advance(s, deadline, emscripten_get_now)) requestRedraw();
+    advance(s, deadline, emscripten_get_now);  // marks what changed; frame() redraws it
   } else {
     growTree(s, deadline, emscripten_get_now);
   }
@@ -465,7 +469,11 @@ void frame() {
   if (downloading(s) && start - a.lastDrawStart >= kProgressRedrawMs) requestRedraw(1);  // progress and rate move
   // Draw only when something changed: on a software GL (SwiftShader) or a slow GPU a frame can
   // take tens of milliseconds of main-thread time that downloading and decoding need more.
-  if (s.surfaceDirty || s.hullDirty || s.sliceDirty || s.frameRequested || a.dragButton >= 0) requestRedraw();
+  const bool overPanel = ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureMouse;  // keep the panel live
+  const bool refinedOnly = a.softwareGl && refining(s) && !interacting() && !overPanel && !s.frameRequested &&
+                          s.surfaceReady && s.firstSurfaceMs >= 0 && start - a.lastDrawStart < kSoftwareRefineRedrawMs;
+  if (((s.surfaceDirty || s.hullDirty || s.sliceDirty) && !refinedOnly) || s.frameRequested || a.dragButton >= 0)
+    requestRedraw();
   // The first surface is drawn at once, even behind a frame the GPU has not finished.
   const bool firstSurface = s.surfaceReady && s.firstSurfaceMs < 0;
   if (a.redrawFrames > 0 && (firstSurface || !gpuBusy(start))) {

@@ -60,7 +60,7 @@ function recordFrames() {
     const s = window.tetstream && window.tetstream.stats();
     if (!s) return;
     window.__samples.push([performance.now(), s.bytesReceived || 0, s.bytesDownloaded || 0, s.programBytesReceived || 0,
-      s.splitsApplied || 0, s.splitsTotal || 0, s.level || 0]);
+      s.splitsApplied || 0, s.splitsTotal || 0, s.level || 0, s.drawMs || 0, s.uploadBytes || 0, s.refineMs || 0]);
     if (s.state === 'complete' || s.state === 'error') clearInterval(sample);
   }, 50);
 }
@@ -98,7 +98,7 @@ async function measure(browser, url) {
       framesOver33: streaming.filter((d) => d > 33).length,
       frameP95: streaming.length ? streaming[Math.floor(0.95 * (streaming.length - 1))] : 0,
       frameMax: streaming.length ? streaming[streaming.length - 1] : 0,
-      maxFrameMs: s.maxFrameMs, maxRefineMs: s.maxRefineMs, maxDrawMs: s.maxDrawMs,
+      maxFrameMs: s.maxFrameMs, maxRefineMs: s.maxRefineMs, maxDrawMs: s.maxDrawMs, gpu: s.gpu ?? null, uploads: { bytes: s.uploadBytes, full: s.fullUploads, partial: s.partialUploads, grown: s.grownUploads },
       heapMB: s.memory.heapBytes / 1048576, dataMB: s.memory.dataBytes / 1048576, gpuMB: s.memory.gpuBytes / 1048576,
     };
   });
@@ -157,7 +157,7 @@ async function main() {
   try {
     for (const [name, dir] of datasets) {
       for (let run = 0; run < runs; run++) {
-        const r = await measure(browser, `${base}/index.html?data=/data/${path.basename(dir)}/manifest.json`);
+        const r = await measure(browser, `${base}/index.html?data=/data/${path.basename(dir)}/manifest.json${process.env.EXTRA_QUERY || ''}`);
         r.dataset = name;
         results.push(r);
         console.log(report(r));
