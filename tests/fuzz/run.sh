@@ -52,7 +52,8 @@ for t in "${TARGETS[@]}"; do
   ls "$found" | sed "s/^/  finding: /"
   # The ledger adds up executions across sessions (the goal is counted over all the work).
   execs=$(awk '/stat::number_of_executed_units/ {print $2}' build/fuzz/$t.log)
-  printf '%s\t%s\t%s\t%s\t%s\n' "$(date -u +%FT%TZ)" "$t" "$SECONDS_EACH" "${execs:-0}" "$(ls "$found" | wc -l)" >> tests/fuzz/executions.tsv
+  ran=$(grep -oE 'Done [0-9]+ runs in [0-9]+ second' build/fuzz/$t.log | awk '{print $5}' | tail -1)
+  printf '%s\t%s\t%s\t%s\t%s\n' "$(date -u +%FT%TZ)" "$t" "${ran:-$SECONDS_EACH}" "${execs:-0}" "$(ls "$found" | wc -l)" >> tests/fuzz/executions.tsv
   # Keep a minimal set that covers what the whole work folder covers.
   mkdir -p "$corpus.new"
   build/fuzz/fuzz-"$t" -merge=1 "$corpus.new" "$corpus" "$work" "$seeds" 2>/dev/null >/dev/null
