@@ -37,8 +37,11 @@ for t in "${TARGETS[@]}"; do
   esac
   echo "fuzz: $t for ${SECONDS_EACH}s"
   # -rss_limit_mb: a parser that allocates more than this on a small input is a finding.
+  # -timeout is wall time: a fuzzer run under `nice` on a busy machine can be starved for many
+  # seconds, which at 10 s ended runs early with timeouts that did not reproduce.
   build/fuzz/fuzz-"$t" "$work" "$corpus" "$seeds" -max_total_time="$SECONDS_EACH" -rss_limit_mb=1024 \
-    -max_len="${MAX_LEN:-8192}" -timeout=10 -artifact_prefix="$found/" -print_final_stats=1 2>build/fuzz/$t.log || true
+    -max_len="${MAX_LEN:-8192}" -timeout=60 -report_slow_units=60 -artifact_prefix="$found/" -print_final_stats=1 \
+    2>build/fuzz/$t.log || true
   grep -E "stat::number_of_executed_units|stat::peak_rss_mb" build/fuzz/$t.log | sed "s/^/  /"
   # A finding must reproduce: a slow unit or timeout can also come from the machine being busy
   # (or the fuzzer being paused); one that runs cleanly on its own is reported and dropped.
