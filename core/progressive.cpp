@@ -67,10 +67,13 @@ uint32_t StarPool::addVertex(uint32_t capacity) {
   return uint32_t(start_.size() - 1);
 }
 
-void StarPool::popVertex() {
-  const uint8_t cls = cls_.back();
+void StarPool::release(uint32_t start, uint8_t cls) {
   if (free_.size() <= cls) free_.resize(cls + 1);
-  free_[cls].push_back(start_.back());
+  free_[cls].push_back(start);
+}
+
+void StarPool::popVertex() {
+  release(start_.back(), cls_.back());
   start_.pop_back();
   size_.pop_back();
   cls_.pop_back();
@@ -80,8 +83,7 @@ void StarPool::grow(uint32_t v) {
   const uint8_t cls = cls_[v];
   const uint32_t to = allocate(uint8_t(cls + 1));  // may move pool_: copy by index
   std::copy_n(pool_.begin() + start_[v], size_[v], pool_.begin() + to);
-  if (free_.size() <= cls) free_.resize(cls + 1);
-  free_[cls].push_back(start_[v]);
+  release(start_[v], cls);
   start_[v] = to;
   cls_[v] = uint8_t(cls + 1);
 }

@@ -19,8 +19,7 @@ namespace tetstream {
 // Per-vertex corner lists in one flat array. Block sizes go 8, 12, 16, 24, 32, 48, ... (steps of
 // about 1.5); a full block moves to the next size, and freed blocks are kept by size for reuse,
 // so the pool holds about 1.3 slots per corner (1.27 measured on Harmonic 64³, streamed) and
-// never needs compacting. Order within a list is
-// not meaningful (starOf and neighboursOf sort).
+// never needs compacting. Order within a list is not meaningful (starOf and neighboursOf sort).
 class StarPool {
  public:
   void clear();
@@ -49,6 +48,7 @@ class StarPool {
   static uint32_t capacityOf(uint8_t cls) { return (cls & 1 ? 12u : 8u) << (cls >> 1); }
   static uint8_t classFor(uint32_t capacity);
   uint32_t allocate(uint8_t cls);
+  void release(uint32_t start, uint8_t cls);
   void grow(uint32_t v);
 
   std::vector<uint32_t> pool_;

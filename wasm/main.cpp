@@ -471,7 +471,7 @@ void frame() {
   // take tens of milliseconds of main-thread time that downloading and decoding need more.
   const bool overPanel = ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureMouse;  // keep the panel live
   const bool refinedOnly = a.softwareGl && refining(s) && !interacting() && !overPanel && !s.frameRequested &&
-                          s.surfaceReady && s.firstSurfaceMs >= 0 && start - a.lastDrawStart < kSoftwareRefineRedrawMs;
+                          s.firstSurfaceMs >= 0 && start - a.lastDrawStart < kSoftwareRefineRedrawMs;
   if (((s.surfaceDirty || s.hullDirty || s.sliceDirty) && !refinedOnly) || s.frameRequested || a.dragButton >= 0)
     requestRedraw();
   // The first surface is drawn at once, even behind a frame the GPU has not finished.
@@ -634,9 +634,11 @@ EMSCRIPTEN_KEEPALIVE int ts_add_chunk(int index, const uint8_t* bytes, int len) 
   return addChunk(g_app.state, uint32_t(index), std::span<const uint8_t>(bytes, size_t(len))).ok() ? 1 : 0;
 }
 
-EMSCRIPTEN_KEEPALIVE void ts_download_progress(double networkBytes, double datasetBytes) {
-  if (!(networkBytes >= 0) || !(datasetBytes >= 0)) return;
-  noteDownload(g_app.state, uint64_t(networkBytes), uint64_t(datasetBytes), emscripten_get_now());
+// timeMs: performance.now() when the figures were taken (samples taken before the viewer had the
+// dataset come late).
+EMSCRIPTEN_KEEPALIVE void ts_download_progress(double networkBytes, double datasetBytes, double timeMs) {
+  if (!(networkBytes >= 0) || !(datasetBytes >= 0) || !(timeMs >= 0)) return;
+  noteDownload(g_app.state, uint64_t(networkBytes), uint64_t(datasetBytes), std::min(timeMs, emscripten_get_now()));
 }
 
 EMSCRIPTEN_KEEPALIVE void ts_set_paused(int paused) {

@@ -1,10 +1,10 @@
 #include "viewer_state.h"
 
 #include <algorithm>
-#include <limits>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <functional>
 
 #include <nlohmann/json.hpp>

@@ -773,6 +773,7 @@ if (folderInput) {
 function startLoader({ names, sizes }, manifestUrl) {
   let resolve;
   loaderDone = new Promise((r) => { resolve = r; });
+  earlyProgress = [];
   loader = new ChunkLoader({
     urls: names.map((name) => chunkUrl(name, manifestUrl)),
     names,
@@ -786,27 +787,12 @@ function startLoader({ names, sizes }, manifestUrl) {
   loader.pump();
 }
 
-// The program's last byte is in: the link is free for more than the base chunk. Called by the
-// counting stream at once; the resource-timing observer (whenProgramDownloaded) is the fallback
-// and can come hundreds of ms late, while the main thread compiles.
+// The program's last byte is in (the counting stream's end, on every attempt): the link is free
+// for more than the base chunk, well before the program has compiled.
 function programDownloaded() {
   if (shell.programLoaded) return;
   shell.programLoaded = true;
   if (loader) loader.warm();
-}
-
-// Calls back once the browser has every byte of tetstream.wasm (Resource Timing), which is
-// well before the program is compiled: from then on chunks may share the link.
-function whenProgramDownloaded(callback) {
-  const done = () => performance.getEntriesByType('resource').some((e) => /\/tetstream\.wasm$/.test(e.name));
-  if (done()) return callback();
-  if (!window.PerformanceObserver) return;
-  const observer = new PerformanceObserver(() => {
-    if (!done()) return;
-    observer.disconnect();
-    callback();
-  });
-  observer.observe({ type: 'resource' });
 }
 
 let viewerLoad = null; // the program is loaded once, whatever number of datasets the page opens
@@ -815,7 +801,6 @@ async function stream(manifestUrl) {
   const viewerPromise = viewerLoad || (viewerLoad = loadViewer());
   const manifestPromise = loadManifest(manifestUrl);
   manifestPromise.catch(() => {}); // awaited below; avoid an "unhandled rejection" meanwhile
-  whenProgramDownloaded(programDownloaded);
   // The base chunk is fetched as soon as the manifest is in, while the program downloads and
   // compiles: the first picture comes a round trip and a base download sooner.
   manifestPromise.then((bytes) => {
@@ -874,6 +859,7 @@ async function stream(manifestUrl) {
     },
     deliver(i, bytes) {
       const ok = withWasmBytes(bytes, (ptr, len) => viewer._ts_add_chunk(i, ptr, len));
+      reportProgress(); // the rate counts these bytes now, not at the next status tick
       startViewer(); // the base is in: show it as soon as possible
       const after = stats();
       if (ok && after.state !== 'error') return true;
@@ -887,10 +873,21 @@ async function stream(manifestUrl) {
   await loaderDone;
 }
 
-// Network figures for the viewer's panel (rate, bytes, time left).
+// Network figures for the viewer's panel (rate, bytes, time left). The loader starts while the
+// program compiles: what it takes in meanwhile is kept with its times and handed over once the
+// viewer has the dataset, so the first chunks do not arrive as one burst with no rate.
+let earlyProgress = [];
 function reportProgress() {
-  if (!loader || !viewer || shell.aborted) return;
-  viewer._ts_download_progress(loader.networkBytes, loader.haveBytes());
+  if (!loader || shell.aborted) return;
+  const sample = [loader.networkBytes, loader.haveBytes(), performance.now()];
+  if (!viewer || !loader.attached) {
+    earlyProgress.push(sample);
+    if (earlyProgress.length > 40) earlyProgress.shift();
+    return;
+  }
+  for (const early of earlyProgress) viewer._ts_download_progress(...early);
+  earlyProgress = [];
+  viewer._ts_download_progress(...sample);
 }
 
 // A page file being fetched again, or the chunk loader's notice.

@@ -489,7 +489,6 @@ class Simplifier {
     fq.add(fieldQuadric_[j]);
     const double x5[5] = {P[0], P[1], P[2], double(field_[j]), 1.0};
     double region = fq.weight > 0 ? std::sqrt(std::max(0.0, fq.eval(x5)) / fq.weight) / range_ : 0.0;
-
     double ef = local + region;
     double eg = 0;
     if (boundary_[i]) {

@@ -15,6 +15,8 @@
 //                   95th percentile, longest; the viewer's own longest frame callback and
 //                   refinement slice
 // Writes build/bench/stream.json. Not a test: nothing is asserted; single runs unless --runs.
+// EXTRA_QUERY (environment) is appended to the viewer's URL, e.g. "&boundary=0"; VW and VH set
+// the window size (default 1280 x 800).
 import fs from 'node:fs';
 import path from 'node:path';
 import { createServer } from '../../server/serve.mjs';

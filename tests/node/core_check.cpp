@@ -81,48 +81,41 @@ int streamBench(const std::string& dir, float iso) {
   for (uint32_t c = 1; c < files.size(); ++c)
     if (!readAll(dir + "/" + ds.manifest.chunks[c].file, files[c])) return 1;
   const int field = ds.manifest.findField(ds.manifest.isoField);
-  IncrementalIsosurface inc;
-  inc.rebuild(ds.pm.mesh, ds.pm.mesh.fields[size_t(field)].values, iso);
+  // As the viewer does: receive each chunk, then splits in batches with a local update each.
+  // `surface` is already built on the base; returns false on a bad chunk or record.
   std::vector<uint32_t> changed;
   bool reached;
-  // As the viewer does: receive each chunk, then splits in batches with a local update each.
+  auto streamAll = [&](Dataset& d, IncrementalIsosurface& surface) {
+    for (uint32_t c = 1; c < files.size(); ++c) {
+      if (Result r = receiveChunk(d, c, files[c]); !r) {
+        std::fprintf(stderr, "error: %s\n", r.message.c_str());
+        return false;
+      }
+      while (d.splitsApplied() < d.splitsReceived()) {
+        changed.clear();
+        if (!stepTowards(d, ~0u, 64, changed, &reached)) return false;
+        surface.updateTets(d.pm.mesh, d.pm.mesh.fields[size_t(field)].values, changed);
+        surface.clearChanges();
+      }
+    }
+    return true;
+  };
+  IncrementalIsosurface inc;
+  inc.rebuild(ds.pm.mesh, ds.pm.mesh.fields[size_t(field)].values, iso);
   auto t0 = Clock::now();
-  for (uint32_t c = 1; c < files.size(); ++c) {
-    if (Result r = receiveChunk(ds, c, files[c]); !r) {
-      std::fprintf(stderr, "error: %s\n", r.message.c_str());
-      return 1;
-    }
-    while (ds.splitsApplied() < ds.splitsReceived()) {
-      changed.clear();
-      if (Result r = stepTowards(ds, ~0u, 64, changed, &reached); !r) return 1;
-      inc.updateTets(ds.pm.mesh, ds.pm.mesh.fields[size_t(field)].values, changed);
-      inc.clearChanges();
-    }
-  }
+  if (!streamAll(ds, inc)) return 1;
   const double streamMs = msSince(t0);
   const uint32_t splits = ds.splitsApplied(), finalTriangles = inc.triangleCount();
   // The same stream as the viewer runs it: the interval tree deferred until the level settles
   // (IncrementalIsosurface::setTreeDeferred), so only the surface follows each split.
-  double viewerMs = 0;
-  {
-    Dataset fresh;
-    if (!loadPackedDir(dir, fresh, 1)) return 1;
-    IncrementalIsosurface surface;
-    surface.setTreeDeferred(true);
-    surface.rebuild(fresh.pm.mesh, fresh.pm.mesh.fields[size_t(field)].values, iso);
-    auto v0 = Clock::now();
-    for (uint32_t c = 1; c < files.size(); ++c) {
-      if (!receiveChunk(fresh, c, files[c])) return 1;
-      while (fresh.splitsApplied() < fresh.splitsReceived()) {
-        changed.clear();
-        if (!stepTowards(fresh, ~0u, 64, changed, &reached)) return 1;
-        surface.updateTets(fresh.pm.mesh, fresh.pm.mesh.fields[size_t(field)].values, changed);
-        surface.clearChanges();
-      }
-    }
-    viewerMs = msSince(v0);
-    if (surface.triangleCount() != finalTriangles) return 1;
-  }
+  Dataset fresh;
+  if (!loadPackedDir(dir, fresh, 1)) return 1;
+  IncrementalIsosurface surface;
+  surface.setTreeDeferred(true);
+  surface.rebuild(fresh.pm.mesh, fresh.pm.mesh.fields[size_t(field)].values, iso);
+  t0 = Clock::now();
+  if (!streamAll(fresh, surface) || surface.triangleCount() != finalTriangles) return 1;
+  const double viewerMs = msSince(t0);
   t0 = Clock::now();
   while (ds.splitsApplied() > 0) {  // the level slider all the way down
     changed.clear();
