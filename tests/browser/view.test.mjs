@@ -79,6 +79,8 @@ async function waitSettled(page, timeout = 120000) {
     const s = window.tetstream.stats();
     return s.state === 'error' || (s.chunksReceived === s.chunksTotal && s.chunksTotal > 0 && s.splitsApplied === s.targetSplits);
   }, null, { timeout });
+  // The status box fades in again when the level moves off complete: pictures wait for the fade.
+  await page.waitForFunction(() => document.getAnimations().every((a) => a.playState !== 'running'), null, { timeout });
   await frames(page, 4);
   return page.evaluate(() => window.tetstream.stats());
 }
