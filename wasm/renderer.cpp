@@ -306,6 +306,9 @@ void destroyRenderer(Renderer& r) {
   glDeleteTextures(1, &r.colourMapTexture);
   GLuint vaos[5] = {r.iso.vao, r.slice.vao, r.hullVao, r.lineVao, r.emptyVao};
   glDeleteVertexArrays(5, vaos);
+  GLuint renderbuffers[2] = {r.reduced.colour, r.reduced.depth};
+  glDeleteRenderbuffers(2, renderbuffers);
+  glDeleteFramebuffers(1, &r.reduced.framebuffer);
   r = Renderer{};
 }
 
@@ -438,6 +441,43 @@ void drawScene(const Renderer& r, const FrameParams& p) {
   }
   glBindVertexArray(0);
   glUseProgram(0);
+}
+
+void drawSceneScaled(Renderer& r, const FrameParams& p, float scale) {
+  const int w = std::max(1, int(std::lround(p.framebufferWidth * scale)));
+  const int h = std::max(1, int(std::lround(p.framebufferHeight * scale)));
+  if (scale >= 1.f || (w == p.framebufferWidth && h == p.framebufferHeight)) return drawScene(r, p);
+  ReducedTarget& t = r.reduced;
+  if (!t.framebuffer) {
+    glGenFramebuffers(1, &t.framebuffer);
+    glGenRenderbuffers(1, &t.colour);
+    glGenRenderbuffers(1, &t.depth);
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, t.framebuffer);
+  if (t.width != w || t.height != h) {
+    glBindRenderbuffer(GL_RENDERBUFFER, t.colour);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, w, h);
+    glBindRenderbuffer(GL_RENDERBUFFER, t.depth);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, w, h);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, t.colour);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t.depth);
+    t.width = w;
+    t.height = h;
+  }
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    return drawScene(r, p);  // full resolution, as without the target
+  }
+  FrameParams reduced = p;
+  reduced.framebufferWidth = w;
+  reduced.framebufferHeight = h;
+  drawScene(r, reduced);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, t.framebuffer);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+  glDisable(GL_SCISSOR_TEST);
+  glBlitFramebuffer(0, 0, w, h, 0, 0, p.framebufferWidth, p.framebufferHeight, GL_COLOR_BUFFER_BIT, GL_LINEAR);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glViewport(0, 0, p.framebufferWidth, p.framebufferHeight);
 }
 
 }  // namespace tetstream::viewer

@@ -40,7 +40,14 @@ struct SurfaceGpu {
   int32_t indexCount = 0;
 };
 
+// Where a frame's scene is drawn at reduced resolution before it is scaled up to the canvas.
+struct ReducedTarget {
+  uint32_t framebuffer = 0, colour = 0, depth = 0;  // renderbuffers
+  int width = 0, height = 0;
+};
+
 struct Renderer {
+  ReducedTarget reduced;
   uint32_t isoProgram = 0, hullProgram = 0, lineProgram = 0, backgroundProgram = 0;
   uint32_t hullVao = 0, lineVao = 0, emptyVao = 0;
   SurfaceGpu iso, slice;
@@ -87,5 +94,11 @@ uint64_t gpuBufferBytes(const Renderer& r);
 
 // Clears to the background gradient and draws surface, then hull and crease lines.
 void drawScene(const Renderer& r, const FrameParams& p);
+
+// drawScene at `scale` (< 1) of the framebuffer's width and height into an offscreen target,
+// then scaled up (linear filter) onto the canvas; at scale >= 1 simply drawScene. On a software
+// GL the fragments are most of a frame's cost, and that CPU time is taken from refinement.
+// Only for a single-sampled canvas (a blit cannot resolve into a multisampled one).
+void drawSceneScaled(Renderer& r, const FrameParams& p, float scale);
 
 }  // namespace tetstream::viewer

@@ -318,6 +318,7 @@ bool advance(ViewerState& s, double deadlineMs, Clock now) {
   if (s.sliceOn) s.sliceDirty = true;
   s.refineMs = now() - t0;
   s.maxRefineMs = std::max(s.maxRefineMs, s.refineMs);
+  s.refineTotalMs += s.refineMs;
   s.refineSteps = steps;
   updateState(s);
   return true;
@@ -883,6 +884,7 @@ std::string statsJson(const ViewerState& s) {
       {"extractMs", s.extractMs},
       {"refineMs", s.refineMs},
       {"maxRefineMs", s.maxRefineMs},
+      {"refineTotalMs", s.refineTotalMs},
       {"refineSteps", s.refineSteps},
       {"frameMs", s.frameMs},
       {"maxFrameMs", s.maxFrameMs},
@@ -890,6 +892,7 @@ std::string statsJson(const ViewerState& s) {
       {"drawMs", s.drawMs},
       {"treeTets", s.surface.treeCoverage()},
       {"maxDrawMs", s.maxDrawMs},
+      {"drawTotalMs", s.drawTotalMs},
       {"uploadBytes", s.uploadBytes},
       {"fullUploads", s.fullUploads},
       {"partialUploads", s.partialUploads},

@@ -197,12 +197,14 @@ struct ViewerState {
   double extractMs = 0;        // duration of the last full extraction (rebuild)
   double refineMs = 0;         // refinement work in the last frame that did any
   double maxRefineMs = 0;      // longest refinement work in one frame
+  double refineTotalMs = 0;    // all refinement work so far (the main thread's share, for benchmarks)
   uint32_t refineSteps = 0;    // splits applied or undone in the last frame that did any
   // Set by the main loop, counted from the first surface on (before it, start-up work such as
   // WebGL and ImGui set-up is not the viewer's frame rate):
   double frameMs = 0;          // smoothed interval between frame callbacks
   double maxFrameMs = 0;       // longest frame callback (uploads, drawing, UI)
   double drawMs = 0, maxDrawMs = 0;  // the last / longest drawn frame's callback
+  double drawTotalMs = 0;            // all drawn frames' callbacks so far
   double maxFrameGapMs = 0;    // longest interval between two frame callbacks (browser included)
   uint64_t uploadBytes = 0;    // GPU bytes uploaded in all (renderer)
   uint32_t fullUploads = 0, partialUploads = 0;
@@ -323,8 +325,8 @@ double secondsLeft(const ViewerState& s);        // at the current rate; < 0 whe
 //  fields:[{name,min,max}], chunksReceived, chunksApplied, chunksTotal, bytesReceived,
 //  bytesDownloaded, bytesTotal, rateBytesPerSec, secondsLeft, splitsApplied, splitsReceived,
 //  splitsTotal, targetSplits, level, live, paused, fieldError, baseVertices, hullTriangles,
-//  hullLines, firstSurfaceMs, completeMs, extractMs, refineMs, maxRefineMs, refineSteps,
-//  frameMs, maxFrameMs, maxFrameGapMs, drawMs, maxDrawMs, treeTets (tets the interval tree covers), uploadBytes, fullUploads, partialUploads,
+//  hullLines, firstSurfaceMs, completeMs, extractMs, refineMs, maxRefineMs, refineTotalMs, refineSteps,
+//  frameMs, maxFrameMs, maxFrameGapMs, drawMs, maxDrawMs, drawTotalMs, treeTets (tets the interval tree covers), uploadBytes, fullUploads, partialUploads,
 //  grownUploads (full uploads because a buffer grew), showBoundary,
 //  notice, chunksAllowed, memoryLimited, memory:{heapBytes, dataBytes, gpuBytes, limitBytes,
 //  neededBytes, allowedBytes}, sliderRect:{x,y,w,h}, levelSliderRect:{x,y,w,h},

@@ -100,7 +100,8 @@ async function measure(browser, url) {
       framesOver33: streaming.filter((d) => d > 33).length,
       frameP95: streaming.length ? streaming[Math.floor(0.95 * (streaming.length - 1))] : 0,
       frameMax: streaming.length ? streaming[streaming.length - 1] : 0,
-      maxFrameMs: s.maxFrameMs, maxRefineMs: s.maxRefineMs, maxDrawMs: s.maxDrawMs, gpu: s.gpu ?? null, uploads: { bytes: s.uploadBytes, full: s.fullUploads, partial: s.partialUploads, grown: s.grownUploads },
+      maxFrameMs: s.maxFrameMs, maxRefineMs: s.maxRefineMs, maxDrawMs: s.maxDrawMs,
+      refineTotalMs: s.refineTotalMs, drawTotalMs: s.drawTotalMs, gpu: s.gpu ?? null, uploads: { bytes: s.uploadBytes, full: s.fullUploads, partial: s.partialUploads, grown: s.grownUploads },
       heapMB: s.memory.heapBytes / 1048576, dataMB: s.memory.dataBytes / 1048576, gpuMB: s.memory.gpuBytes / 1048576,
     };
   });
@@ -122,6 +123,8 @@ function report(r) {
     `  frames while streaming: ${r.frames}, ${r.framesOver33} over 33 ms, p95 ${r.frameP95.toFixed(1)} ms, ` +
       `longest ${r.frameMax.toFixed(1)} ms; viewer: longest callback ${r.maxFrameMs.toFixed(1)} ms, ` +
       `refinement ${r.maxRefineMs.toFixed(1)} ms, drawing ${(r.maxDrawMs ?? 0).toFixed(1)} ms`,
+    `  main thread from navigation to complete (${f(r.completeMs)} ms): refinement ${f(r.refineTotalMs)} ms ` +
+      `(${f(r.splits / r.refineTotalMs * 1000)} splits/s), drawing ${f(r.drawTotalMs)} ms`,
     `  memory: heap ${r.heapMB.toFixed(0)} MB, data ${r.dataMB.toFixed(1)} MB, GPU ${r.gpuMB.toFixed(1)} MB` +
       (r.state !== 'complete' ? `\n  ENDED IN ${r.state}: ${r.error}` : '') +
       (r.pageErrors.length ? `\n  PAGE ERRORS: ${r.pageErrors.join('; ')}` : ''),

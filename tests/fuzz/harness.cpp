@@ -165,7 +165,7 @@ void splitChunk(const uint8_t* data, size_t size) {
   const Context& ctx = context();
   const uint32_t splitChunks = uint32_t(ctx.files.size() - 1);
   const uint32_t index = 1 + (data[0] >> 1) % splitChunks;
-  Dataset ds;
+  static Dataset ds;  // reused: its zstd context was a tenth of the time when made per input
   openAt(ds, index);
   const uint32_t splitsBefore = ds.splitsApplied(), tetsBefore = ds.pm.mesh.tetCount();
   const uint32_t verticesBefore = ds.pm.mesh.vertexCount();
@@ -201,8 +201,8 @@ void splitChunk(const uint8_t* data, size_t size) {
 
 void baseChunk(const uint8_t* data, size_t size) {
   const Context& ctx = context();
-  Dataset ds;
-  FUZZ_CHECK(openDataset(ds, ctx.manifestJson));
+  static Dataset ds;  // the manifest parsed once (half of the time when parsed per input)
+  openAt(ds, 0);
   std::vector<uint8_t> file = chunkFromPayload(ChunkKind::Base, 0, data, size, ds.manifest.chunks[0]);
   if (!receiveChunk(ds, 0, file)) {
     FUZZ_CHECK(ds.chunksReceived == 0);
@@ -243,7 +243,7 @@ bool runTarget(const std::string& name, const uint8_t* data, size_t size) {
   if (name == "manifest") manifest(data, size);
   else if (name == "split-chunk") splitChunk(data, size);
   else if (name == "base-chunk") baseChunk(data, size);
-  else if (name.starts_with("mesh-") && name.size() > 5) meshFile(("." + name.substr(5)).c_str(), data, size);
+  else if (name.starts_with("mesh-") && name.size() > 5) meshFile(std::string(".").append(name, 5).c_str(), data, size);
   else if (name == "pair-tetgen" || name == "pair-medit" || name == "pair-plot3d") twoFiles(name.c_str() + 5, data, size);
   else return false;
   return true;
