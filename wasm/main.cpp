@@ -388,6 +388,7 @@ void drawFrame() {
     scale = float(std::min(1.0, std::sqrt(kReducedPixels / (double(a.width) * a.height))));
   drawSceneScaled(a.renderer, p, scale);
   a.reducedShown = scale < 1.f;
+  s.reducedFrames += a.reducedShown ? 1 : 0;
   ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
   if (a.captureRequested) {
     // Read back in the same task as the drawing (the drawing buffer is not preserved after).
@@ -534,6 +535,7 @@ bool initPlatform(std::string& error) {
     }
   }) != 0;
   glfwWindowHint(GLFW_SAMPLES, g_app.softwareGl ? 0 : 4);
+  g_app.state.softwareGl = g_app.softwareGl;
   double cssW = 0, cssH = 0;
   emscripten_get_element_css_size("#canvas", &cssW, &cssH);
   g_app.pixelRatio = std::max(1.0, emscripten_get_device_pixel_ratio());

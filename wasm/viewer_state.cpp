@@ -893,6 +893,8 @@ std::string statsJson(const ViewerState& s) {
       {"treeTets", s.surface.treeCoverage()},
       {"maxDrawMs", s.maxDrawMs},
       {"drawTotalMs", s.drawTotalMs},
+      {"reducedFrames", s.reducedFrames},
+      {"softwareGl", s.softwareGl},
       {"uploadBytes", s.uploadBytes},
       {"fullUploads", s.fullUploads},
       {"partialUploads", s.partialUploads},

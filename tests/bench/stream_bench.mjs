@@ -101,7 +101,7 @@ async function measure(browser, url) {
       frameP95: streaming.length ? streaming[Math.floor(0.95 * (streaming.length - 1))] : 0,
       frameMax: streaming.length ? streaming[streaming.length - 1] : 0,
       maxFrameMs: s.maxFrameMs, maxRefineMs: s.maxRefineMs, maxDrawMs: s.maxDrawMs,
-      refineTotalMs: s.refineTotalMs, drawTotalMs: s.drawTotalMs, gpu: s.gpu ?? null, uploads: { bytes: s.uploadBytes, full: s.fullUploads, partial: s.partialUploads, grown: s.grownUploads },
+      refineTotalMs: s.refineTotalMs, drawTotalMs: s.drawTotalMs, softwareGl: s.softwareGl, reducedFrames: s.reducedFrames, uploads: { bytes: s.uploadBytes, full: s.fullUploads, partial: s.partialUploads, grown: s.grownUploads },
       heapMB: s.memory.heapBytes / 1048576, dataMB: s.memory.dataBytes / 1048576, gpuMB: s.memory.gpuBytes / 1048576,
     };
   });
