@@ -560,7 +560,7 @@ bool initPlatform(std::string& error) {
     return false;
   }
   std::printf("tetstream viewer: %s%s\n", info.c_str(), g_app.softwareGl ? " | software rasterizer: no MSAA" : "");
-  warmUpRenderer(g_app.renderer);
+  warmUpRenderer(g_app.renderer, g_app.softwareGl);
 
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();

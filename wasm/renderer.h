@@ -69,7 +69,8 @@ void destroyRenderer(Renderer& r);
 // Draws one clipped-away triangle through every program and state drawScene uses, so that the
 // GL implementation compiles its pipelines now (while the dataset downloads) and not at the
 // first surface (~0.3 s on SwiftShader).
-void warmUpRenderer(Renderer& r);
+// reducedToo: also through drawSceneScaled's offscreen target (a software GL uses it).
+void warmUpRenderer(Renderer& r, bool reducedToo);
 
 // Sends what changed since the model's last clearChanges(); the caller clears them afterwards.
 void uploadSurface(Renderer& r, const IncrementalIsosurface& surface);

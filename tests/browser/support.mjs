@@ -132,7 +132,8 @@ export async function waitForLevel(page, timeout = 120000) {
 }
 
 export function frameReport(s) {
-  return `max frame callback ${s.maxFrameMs.toFixed(1)} ms, max gap between frames ${s.maxFrameGapMs.toFixed(1)} ms, ` +
+  return `max frame callback ${s.maxFrameMs.toFixed(1)} ms (drawing ${s.maxDrawMs.toFixed(1)} ms; ${s.reducedFrames} reduced frames), ` +
+    `max gap between frames ${s.maxFrameGapMs.toFixed(1)} ms, ` +
     `max refinement slice ${s.maxRefineMs.toFixed(1)} ms; uploads ${s.partialUploads} partial / ${s.fullUploads} full ` +
     `(${s.grownUploads} to grow a buffer), ` +
     `${(s.uploadBytes / 1048576).toFixed(1)} MB`;
