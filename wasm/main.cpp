@@ -320,6 +320,9 @@ void notifyPause() {
 // ---------------------------------------------------------------- drawing
 bool interacting();  // below, with the refinement slices
 
+// Whether a software GL draws this frame's scene at reduced resolution (see kReducedPixels).
+bool reducedWanted(const ViewerState& s) { return g_app.softwareGl && (refining(s) || interacting()); }
+
 void drawFrame() {
   App& a = g_app;
   ViewerState& s = a.state;
@@ -384,7 +387,7 @@ void drawFrame() {
   p.showSlice = s.sliceOn;
   setColourMap(a.renderer, s.colourMap);
   float scale = 1.f;
-  if (a.softwareGl && !a.captureRequested && (refining(s) || interacting()))
+  if (!a.captureRequested && reducedWanted(s))
     scale = float(std::min(1.0, std::sqrt(kReducedPixels / (double(a.width) * a.height))));
   drawSceneScaled(a.renderer, p, scale);
   a.reducedShown = scale < 1.f;
@@ -488,7 +491,7 @@ void frame() {
                           s.firstSurfaceMs >= 0 && start - a.lastDrawStart < kSoftwareRefineRedrawMs;
   if (((s.surfaceDirty || s.hullDirty || s.sliceDirty) && !refinedOnly) || s.frameRequested || a.dragButton >= 0)
     requestRedraw();
-  if (a.reducedShown && !refining(s) && !interacting()) requestRedraw(1);  // the still frame, full size
+  if (a.reducedShown && !reducedWanted(s)) requestRedraw(1);  // the still frame, full size
   // The first surface is drawn at once, even behind a frame the GPU has not finished.
   const bool firstSurface = s.surfaceReady && s.firstSurfaceMs < 0;
   if (a.redrawFrames > 0 && (firstSurface || !gpuBusy(start))) {

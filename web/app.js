@@ -65,6 +65,7 @@ const maxMemoryMB = positiveParam('maxMemoryMB');
 let viewer = null; // the Emscripten module once it is instantiated
 let viewerStarted = false;
 let loader = null;
+let earlyProgress = []; // [networkBytes, datasetBytes, time] taken before the viewer had the dataset
 // What stats() says before the module runs, and the shell's own figures. programTotal: bytes of
 // tetstream.wasm uncompressed, from index.html (the build writes it: a compressed response's
 // Content-Length would not tell).
@@ -874,9 +875,8 @@ async function stream(manifestUrl) {
 }
 
 // Network figures for the viewer's panel (rate, bytes, time left). The loader starts while the
-// program compiles: what it takes in meanwhile is kept with its times and handed over once the
-// viewer has the dataset, so the first chunks do not arrive as one burst with no rate.
-let earlyProgress = [];
+// program compiles: what it takes in meanwhile is kept with its times (earlyProgress) and handed
+// over once the viewer has the dataset, so the first chunks do not arrive as one burst with no rate.
 function reportProgress() {
   if (!loader || shell.aborted) return;
   const sample = [loader.networkBytes, loader.haveBytes(), performance.now()];
