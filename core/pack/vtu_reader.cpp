@@ -479,6 +479,14 @@ Result readPiece(Vtu& vtu, GridKind kind, const Grid& whole, pugi::xml_node piec
     return fail(Status::TooLarge,
                 where + ": " + std::to_string(vertexBase + np) + " points; tetstream indexes vertices with 32 bits");
 
+  // ImageData's geometry costs nothing to declare: read its arrays first, so a file that does not
+  // carry the values for its extent stops before a grid is built for it.
+  if (kind == GridKind::Image) {
+    if (Result r = readPieceData(vtu, piece, where, np, nc, report, notePieceConversions, pr); !r) return r;
+    if (pr.fields.empty() && pr.cellArrays.empty())
+      return fail(Status::MissingField, where + ": the image has no numeric PointData or CellData arrays to show");
+  }
+
   // Points
   if (kind == GridKind::Image) {
     mesh.positions.reserve(mesh.positions.size() + 3 * np);
@@ -533,6 +541,7 @@ Result readPiece(Vtu& vtu, GridKind kind, const Grid& whole, pugi::xml_node piec
     ends = {};
     if (Result r = appendVtkCells(where, conn, offsets, types, vertexBase, np, soup); !r) return r;
   }
+  if (kind == GridKind::Image) return Result::success();
   return readPieceData(vtu, piece, where, np, nc, report, notePieceConversions, pr);
 }
 

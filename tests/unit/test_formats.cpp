@@ -571,6 +571,10 @@ TEST(FormatBadInput, StructuredAndPlot3d) {
   for (size_t at; (at = big.find("Extent=\"0 3 0 2 0 2\"")) != std::string::npos;)
     big.replace(at, 20, "Extent=\"0 300 0 2000 0 2000\"");
   EXPECT_FAILS(readBytes(big, "a.vti"), Status::Truncated, "Extent declares");
+  // An image with no values: refused before a grid is built for its extent.
+  std::string empty = vti;
+  empty.erase(empty.find("    <PointData"), empty.find("  </Piece>") - empty.find("    <PointData"));
+  EXPECT_FAILS(readBytes(empty, "a.vti"), Status::MissingField, "no numeric PointData or CellData arrays");
 
   EXPECT_FAILS(readBytes(std::string(100, 'x'), "a.xyz"), Status::Corrupt, "no layout");
   EXPECT_FAILS(readBytes("abc", "a.xyz"), Status::Truncated, "too short for a PLOT3D grid header");
