@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cstring>
 
 namespace tetstream {
 namespace {
@@ -23,6 +24,15 @@ uint32_t nextStamp(const ProgressiveMesh& pm) {
     pm.stamp = 1;
   }
   return pm.stamp;
+}
+
+// Bitwise, so that a NaN value (kept in lossless streams) compares equal to itself.
+bool sameBits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+// Appends the tets around v with ids below `end` (those a split did not create).
+void listOldTetsAround(const ProgressiveMesh& pm, uint32_t v, uint32_t end, std::vector<uint32_t>& out) {
+  for (uint32_t c : pm.stars.corners(v))
+    if ((c >> 2) < end) out.push_back(c >> 2);
 }
 
 }  // namespace
@@ -105,6 +115,7 @@ void initProgressive(ProgressiveMesh& pm, TetMesh base) {
   for (size_t c = 0; c < pm.mesh.tets.size(); ++c) pm.stars.add(pm.mesh.tets[c], uint32_t(c));
   pm.splitJ.clear();
   pm.splitTetsBefore.clear();
+  pm.splitJValues.clear();
   pm.baseVertices = pm.mesh.vertexCount();
   pm.baseTets = pm.mesh.tetCount();
 }
@@ -139,6 +150,15 @@ void applySplit(ProgressiveMesh& pm, const SplitOp& op, std::vector<uint32_t>& c
 
   m.positions.insert(m.positions.end(), op.position, op.position + 3);
   for (size_t f = 0; f < m.fields.size(); ++f) m.fields[f].values.push_back(op.fields[f]);
+  bool jValuesChange = false;
+  for (size_t f = 0; f < m.fields.size(); ++f) {
+    float& value = m.fields[f].values[op.j];
+    pm.splitJValues.push_back(value);
+    if (op.jFields && !sameBits(value, op.jFields[f])) {
+      value = op.jFields[f];
+      jValuesChange = true;
+    }
+  }
   pm.stars.addVertex(uint32_t(op.moved.size() + op.newTets.size() / 4));
 
   // T_moved: the j corner of each listed tet becomes an i corner.
@@ -159,6 +179,7 @@ void applySplit(ProgressiveMesh& pm, const SplitOp& op, std::vector<uint32_t>& c
     for (uint32_t k = 0; k < 4; ++k) pm.stars.add(m.tets[4 * t + k], 4 * t + k);
     changed.push_back(t);
   }
+  if (jValuesChange) listOldTetsAround(pm, op.j, pm.splitTetsBefore.back(), changed);
 }
 
 void undoSplit(ProgressiveMesh& pm, std::vector<uint32_t>& changed) {
@@ -168,6 +189,15 @@ void undoSplit(ProgressiveMesh& pm, std::vector<uint32_t>& changed) {
   const uint32_t i = m.vertexCount() - 1;
   pm.splitJ.pop_back();
   pm.splitTetsBefore.pop_back();
+  const size_t F = m.fields.size();
+  bool jValuesChange = false;
+  for (size_t f = 0; f < F; ++f) {
+    float& value = m.fields[f].values[j];
+    const float before = pm.splitJValues[pm.splitJValues.size() - F + f];
+    jValuesChange |= !sameBits(value, before);
+    value = before;
+  }
+  pm.splitJValues.resize(pm.splitJValues.size() - F);
 
   // Drop the new tets' corners from their vertices (once per vertex), then the tets.
   const uint32_t firstDead = 4 * tetsBefore;
@@ -179,6 +209,8 @@ void undoSplit(ProgressiveMesh& pm, std::vector<uint32_t>& changed) {
     pm.stars.removeIf(v, [&](uint32_t x) { return x >= firstDead; });
   }
   m.tets.resize(firstDead);
+  // j's own tets (before the moved ones come back) when its values changed back.
+  if (jValuesChange) listOldTetsAround(pm, j, tetsBefore, changed);
   // The remaining corners of i are the moved tets: give them back to j.
   for (uint32_t k = 0; k < pm.stars.corners(i).size(); ++k) {  // add() may move the pool: no span kept
     const uint32_t c = pm.stars.corners(i)[k];

@@ -59,13 +59,15 @@ class StarPool {
 
 // One split, decoded: the new vertex i gets id vertexCount(); `moved` lists tets (ids, all in
 // star(j)) whose j slot becomes i; `newTets` holds 4 vertex ids per recreated tet (using the
-// new id for i); `position` 3 floats; `fields` one value per field.
+// new id for i); `position` 3 floats; `fields` one value per field; `jFields`, when given, the
+// values j takes back (one per field: the packer fits j's value to the region it stood for).
 struct SplitOp {
   uint32_t j = 0;
   std::span<const uint32_t> moved;
   std::span<const uint32_t> newTets;
   const float* position = nullptr;
   const float* fields = nullptr;
+  const float* jFields = nullptr;
 };
 
 struct ProgressiveMesh {
@@ -73,6 +75,7 @@ struct ProgressiveMesh {
   StarPool stars;  // the corners around each vertex
   // Undo log, one entry per applied split: the kept vertex and the tet count before the split.
   std::vector<uint32_t> splitJ, splitTetsBefore;
+  std::vector<float> splitJValues;  // per applied split, j's field values before it (one per field)
   uint32_t baseVertices = 0, baseTets = 0;
   // Scratch for de-duplicating vertices without sorting: a stamp per vertex.
   mutable std::vector<uint32_t> seen;
@@ -94,11 +97,12 @@ void neighboursOf(const ProgressiveMesh& pm, uint32_t v, std::vector<uint32_t>& 
 
 // Applies a split. Preconditions (asserted; the decoder validates untrusted data first):
 // j exists, every moved tet contains j, new tets reference existing vertices or the new one.
-// Appends the ids of every tet whose vertices changed (moved, then new) to `changed`.
+// Appends the ids of every tet whose vertices changed (moved, then new) to `changed`, and when
+// j's values change, every other tet around j too (isosurface_incremental.h's contract).
 void applySplit(ProgressiveMesh& pm, const SplitOp& op, std::vector<uint32_t>& changed);
 
-// Undoes the last applied split. Appends the moved tet ids to `changed`; the removed tets are
-// those with id >= tetCount() afterwards.
+// Undoes the last applied split. Appends the moved tet ids to `changed` (and the other tets
+// around j when its values change back); the removed tets are those with id >= tetCount() afterwards.
 void undoSplit(ProgressiveMesh& pm, std::vector<uint32_t>& changed);
 
 }  // namespace tetstream

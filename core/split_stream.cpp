@@ -17,8 +17,9 @@ Result beginSplits(SplitReader& r, std::span<const uint8_t> payload, const Chunk
   if (!r.in.u32(count) || !r.in.u32(flags)) return fail(Status::Truncated, "split chunk: payload shorter than its header");
   if (count != info.splits)
     return corrupt(std::to_string(count) + " splits where the manifest says " + std::to_string(info.splits));
-  if (flags & ~kSplitFlagLossless) return fail(Status::Unsupported, "split chunk: unknown flags");
+  if (flags & ~(kSplitFlagLossless | kSplitFlagKeptValues)) return fail(Status::Unsupported, "split chunk: unknown flags");
   r.lossless = flags & kSplitFlagLossless;
+  r.keptValues = flags & kSplitFlagKeptValues;
   if (r.lossless != m.lossless) return corrupt("lossless flag differs from the manifest");
   r.remaining = count;
   r.prevJ = 0;
@@ -87,10 +88,13 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
   float position[3];
   const size_t F = pm.mesh.fields.size();
   r.fields.resize(F);
+  r.jFields.resize(r.keptValues ? F : 0);
   if (r.lossless) {
     for (float& x : position)
       if (!r.in.f32(x)) return fail(Status::Truncated, "split chunk: record ends early");
     for (float& x : r.fields)
+      if (!r.in.f32(x)) return fail(Status::Truncated, "split chunk: record ends early");
+    for (float& x : r.jFields)
       if (!r.in.f32(x)) return fail(Status::Truncated, "split chunk: record ends early");
     for (float x : position)
       if (!std::isfinite(x)) return fail(Status::NonFinite, "split chunk: a vertex position is not finite");
@@ -108,10 +112,12 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
       if (!predicted(q.position[k], pj[k], position[k])) return corrupt("a position leaves the grid or the record ends early");
     for (size_t f = 0; f < F; ++f)
       if (!predicted(q.field[f], pm.mesh.fields[f].values[j], r.fields[f])) return corrupt("a field value leaves its range or the record ends early");
+    for (size_t f = 0; f < r.jFields.size(); ++f)
+      if (!predicted(q.field[f], pm.mesh.fields[f].values[j], r.jFields[f])) return corrupt("a field value leaves its range or the record ends early");
   }
   if (r.remaining == 1 && !r.in.atEnd()) return corrupt("bytes after the last split");
 
-  SplitOp op{j, r.moved, r.newTets, position, r.fields.data()};
+  SplitOp op{j, r.moved, r.newTets, position, r.fields.data(), r.keptValues ? r.jFields.data() : nullptr};
   applySplit(pm, op, changed);
   r.prevJ = j;
   --r.remaining;

@@ -15,6 +15,7 @@
 namespace tetstream {
 
 inline constexpr uint32_t kSplitFlagLossless = 1;
+inline constexpr uint32_t kSplitFlagKeptValues = 2;  // records also carry j's values after the split
 
 // How a split record lists its recreated tets (i, j, a, b) (FORMAT.md §4).
 enum class RingMode : uint32_t {
@@ -29,9 +30,10 @@ struct SplitReader {
   uint32_t remaining = 0;  // records left in the chunk
   uint32_t prevJ = 0;
   bool lossless = false;
+  bool keptValues = false;
   // scratch, reused across records
   std::vector<uint32_t> star, candidates, moved, newTets, ring;
-  std::vector<float> fields;
+  std::vector<float> fields, jFields;
 };
 
 // Starts reading a split chunk's payload (after the chunk header). The payload must outlive

@@ -67,7 +67,7 @@ Runner addPack(CLI::App& app) {
     double baseFraction = 0.01, maxError = -1, maxMemoryGb = 0;
     uint32_t baseVertices = 0, baseTets = 0, chunkKb = 256;
     int level = 19, threads = 2;
-    bool lossless = false, json = false;
+    bool lossless = false, json = false, samples = false;
     ReadOptions read;
   };
   auto o = std::make_shared<Opts>();
@@ -91,6 +91,9 @@ Runner addPack(CLI::App& app) {
   me->excludes(bf);
   me->excludes(bv);
   sub->add_flag("--lossless", o->lossless, "keep exact float32 positions and fields (default: 16-bit grid)");
+  sub->add_flag("--samples", o->samples,
+                "coarse levels keep the input's values at their vertices (default: values fitted to the region "
+                "each vertex stands for, which lowers the field error; the full level is the input either way)");
   sub->add_option("--chunk-kb", o->chunkKb, "largest split chunk in KB; the first chunks are smaller")
       ->check(CLI::Range(1u, 65536u))->capture_default_str();
   sub->add_option("--zstd-level", o->level, "zstd compression level")->check(CLI::Range(1, 22))->capture_default_str();
@@ -117,6 +120,7 @@ Runner addPack(CLI::App& app) {
     opt.name = o->name;
     opt.zstdLevel = o->level;
     opt.threads = o->threads;
+    opt.fitValues = !o->samples;
     if (!o->weights.empty())
       for (int k = 0; k < 3; ++k) opt.weights[k] = o->weights[size_t(k)];
     opt.baseFraction = o->baseFraction;
@@ -149,6 +153,7 @@ Runner addPack(CLI::App& app) {
                  {"bitsPerTet", bitsPerTet}, {"bytesPerSplit", bytesPerSplit},
                  {"baseFieldError", m.chunks[0].fieldError}, {"stopReason", s.stopReason},
                  {"flatTetsRemoved", s.flatTetsRemoved}, {"flatTetsLeft", s.flatTetsLeft},
+                 {"queuePops", s.queuePops}, {"requeued", s.requeued}, {"costEvaluations", s.costEvaluations},
                  {"readMs", readMs}, {"simplifyMs", s.simplifyMs}, {"encodeMs", s.encodeMs}, {"writeMs", s.writeMs},
                  {"ms", total.ms()}, {"peakMemoryMB", peakMemoryMB()}, {"notes", notes}});
       return 0;

@@ -153,6 +153,7 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   so.weightField = opt.weights[1];
   so.weightShape = opt.weights[2];
   so.threads = opt.threads;
+  so.fitValues = opt.fitValues;
   so.field = iso;
   so.maxError = opt.maxError;
   so.targetTets = opt.baseTets;
@@ -171,6 +172,9 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   summary.stopReason = simplified.stopReason;
   summary.flatTetsRemoved = simplified.flatTetsRemoved;
   summary.flatTetsLeft = simplified.flatTetsLeft;
+  summary.queuePops = simplified.queuePops;
+  summary.requeued = simplified.requeued;
+  summary.costEvaluations = simplified.costEvaluations;
 
   t0 = std::chrono::steady_clock::now();
   progress("encode", 0, simplified.log.size());

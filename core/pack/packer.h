@@ -25,6 +25,7 @@ struct PackOptions {
   uint32_t baseTets = 0;                  // stop earlier once the base has this many tets
   double maxError = std::numeric_limits<double>::infinity();  // stop simplifying at this cost
   bool lossless = false;                  // keep float32 values in split records
+  bool fitValues = true;                  // coarse levels get fitted values (SimplifyOptions::fitValues)
   uint32_t chunkKb = 256;                 // largest split chunk, compressed
   double maxMemoryBytes = 0;              // refuse meshes that need more (0: 90% of physical memory)
   int threads = 2;                        // threads that evaluate collapse costs (1 or 2; same output)
@@ -38,6 +39,7 @@ struct PackSummary {
   uint64_t flippedTets = 0;          // negatively oriented tets re-oriented (FORMAT.md §3)
   uint32_t baseVertices = 0, baseTets = 0, splits = 0;
   uint32_t flatTetsRemoved = 0, flatTetsLeft = 0;
+  uint64_t queuePops = 0, requeued = 0, costEvaluations = 0;  // simplifier work, for benchmarks
   std::string stopReason;            // why simplification stopped
   double simplifyMs = 0, encodeMs = 0, writeMs = 0;
   std::vector<std::string> notes;    // what the packer changed or found, in plain words

@@ -179,6 +179,10 @@ class Simplifier {
     }
     out_.log.movedBegin.push_back(uint32_t(out_.log.moved.size()));
     out_.log.removedBegin.push_back(uint32_t(out_.log.removed.size()));
+    if (fitOn_) {
+      out_.values = fit_;
+      out_.valuesField = opt_.field;
+    }
     return Result::success();
   }
 
@@ -190,8 +194,12 @@ class Simplifier {
     pos_.resize(3 * size_t(V_));
     for (size_t k = 0; k < pos_.size(); ++k) pos_[k] = mesh_.positions[k];
     field_ = mesh_.fields[size_t(opt_.field)].values.data();
+    fit_ = mesh_.fields[size_t(opt_.field)].values;
+    fitOn_ = opt_.fitValues;
     Range r = computeRange(mesh_.fields[size_t(opt_.field)].values);
     range_ = r.max > r.min ? double(r.max) - r.min : 1.0;
+    fieldMin_ = r.min;
+    fieldMax_ = r.max;
     diag_ = computeBounds(mesh_.positions).diagonal();
     if (!(diag_ > 0)) diag_ = 1;
 
@@ -262,6 +270,9 @@ class Simplifier {
     }
     queued_.assign(V_, 0);
     changed_.assign(V_, 0);
+    meanWeight_ = 0;
+    for (const FieldQuadric& f : fieldQuadric_) meanWeight_ += f.weight;
+    meanWeight_ = meanWeight_ > 0 ? meanWeight_ / alive_ : 1.0;
     lastCost_.assign(V_, float(kInf));
     // Every vertex's first cost, on two threads (each with its own scratch lane; the mesh is
     // only read), then queued in vertex order so the result does not depend on the threads.
@@ -284,6 +295,22 @@ class Simplifier {
         heap_.push({lastCost_[v], v});
         queued_[v] = 1;
       }
+  }
+
+  // Whether j's value is fitted after a collapse whose region has field quadric f: only once the
+  // region covers kMinFitSpread mean vertex shares. Below that the fit gains little (Harmonic 64³
+  // at 30% of the tets: RMS 0.00031 instead of 0.00029) while every split that changes j's value
+  // costs the viewer an update of all tets around j; this way about a third of the splits do.
+  bool fitsRegion(const FieldQuadric& f) const { return fitOn_ && f.weight >= kMinFitSpread * meanWeight_; }
+  static constexpr double kMinFitSpread = 4;
+
+  // The value s at x that minimises the field quadric (x, s): its derivative in s is zero.
+  // (q is the upper triangle of the 5×5 form: q[12] is (s, s), q[3], q[7], q[10] are (x, s),
+  // (y, s), (z, s), q[13] is (s, 1).) Kept inside the field's range, which the stream's
+  // quantization grid covers.
+  double fitted(const FieldQuadric& f, const double* x, double fallback) const {
+    const double a = f.q[12], b = f.q[3] * x[0] + f.q[7] * x[1] + f.q[10] * x[2] + f.q[13];
+    return a > 0 ? std::clamp(-b / a, fieldMin_, fieldMax_) : fallback;
   }
 
   static constexpr uint8_t kFaces[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
@@ -391,7 +418,7 @@ class Simplifier {
       const double* x[3];
       for (int k = 0; k < 4; ++k) {
         if (v[k] == i) si = k;
-        else { st.other[n] = v[k]; x[n] = p(v[k]); st.f[n] = field_[v[k]]; ++n; }
+        else { st.other[n] = v[k]; x[n] = p(v[k]); st.f[n] = fit_[v[k]]; ++n; }
       }
       for (int k = 0; k < 3; ++k) std::copy_n(x[k], 3, st.x[k]);
       // Moving the vertex at slot si to the front takes si adjacent swaps.
@@ -451,7 +478,10 @@ class Simplifier {
     *verdict = CollapseVerdict::Legal;
     if (boundary_[i] && !isBoundaryEdge(i, j)) return *verdict = CollapseVerdict::BoundaryRule, kInf;
     const double* P = p(j);
-    double bestInside = -kInf, interp = field_[j];
+    FieldQuadric fq = fieldQuadric_[i];
+    fq.add(fieldQuadric_[j]);
+    const double sj = fitsRegion(fq) ? fitted(fq, P, fit_[j]) : fit_[j];
+    double bestInside = -kInf, interp = sj;
     for (StarTet& st : L.star) {
       if (st.other[0] == j || st.other[1] == j || st.other[2] == j) continue;  // removed
       const double det = st.g[0][0] * P[0] + st.g[0][1] * P[1] + st.g[0][2] * P[2] + st.h[0];
@@ -480,16 +510,18 @@ class Simplifier {
       }
       if (lo > bestInside) {
         bestInside = lo;
-        interp = lambda[0] * field_[j] + lambda[1] * st.f[0] + lambda[2] * st.f[1] + lambda[3] * st.f[2];
+        interp = lambda[0] * sj + lambda[1] * st.f[0] + lambda[2] * st.f[1] + lambda[3] * st.f[2];
       }
     }
     // Paper eq. (6) at p_i, plus the field quadric over everything i and j stand for.
     double local = std::abs(double(field_[i]) - interp) / range_;
-    FieldQuadric fq = fieldQuadric_[i];
-    fq.add(fieldQuadric_[j]);
-    const double x5[5] = {P[0], P[1], P[2], double(field_[j]), 1.0};
+    const double x5[5] = {P[0], P[1], P[2], sj, 1.0};
     double region = fq.weight > 0 ? std::sqrt(std::max(0.0, fq.eval(x5)) / fq.weight) / range_ : 0.0;
-    double ef = local + region;
+    // The collapse is ordered by its error weighted by how much of the domain it spreads over
+    // (the square root of the region's volume over a mean vertex's share), which is what adds to
+    // the RMS error over the whole mesh; the manifest reports the unweighted error.
+    const double spread = fq.weight > 0 ? std::sqrt(fq.weight / meanWeight_) : 1.0;
+    const double ef = (local + region) * spread;
     double eg = 0;
     if (boundary_[i]) {
       Quadric q = quadric_[i];
@@ -497,7 +529,7 @@ class Simplifier {
       const double x4[4] = {P[0], P[1], P[2], 1.0};
       if (q.weight > 0) eg = std::sqrt(std::max(0.0, q.eval(x4)) / q.weight) / diag_;
     }
-    *fieldErr = float(ef);
+    *fieldErr = float(local + region);
     return opt_.weightGeometry * eg + opt_.weightField * ef;
   }
 
@@ -894,6 +926,8 @@ class Simplifier {
     CollapseLog& log = out_.log;
     log.i.push_back(i);
     log.j.push_back(j);
+    log.iValue.push_back(fit_[i]);
+    log.jValue.push_back(fit_[j]);
     log.fieldError.push_back(float(fieldErr * range_));
     log.movedBegin.push_back(uint32_t(log.moved.size()));
     log.removedBegin.push_back(uint32_t(log.removed.size()));
@@ -940,6 +974,11 @@ class Simplifier {
     boundary_[j] |= boundary_[i];
     quadric_[j].add(quadric_[i]);
     fieldQuadric_[j].add(fieldQuadric_[i]);
+    // j now stands for the region of both: its value becomes the one that fits the original
+    // field there best (least squares over the region's original tets, at p_j), which the
+    // split restores (paper §3 keeps the sample; at 5% of Harmonic's tets this lowers the RMS
+    // field error by a fifth).
+    if (fitsRegion(fieldQuadric_[j])) fit_[j] = float(fitted(fieldQuadric_[j], p(j), fit_[j]));
 
     // Everything around j changed. j and its neighbours are re-evaluated lazily, when they reach
     // the top: those already queued keep their entry; a blocked one (no legal collapse last
@@ -973,7 +1012,10 @@ class Simplifier {
   uint32_t V_ = 0, T_ = 0, alive_ = 0, tetsAlive_ = 0, flatInput_ = 0;
   std::vector<double> pos_;
   const float* field_ = nullptr;
-  double range_ = 1, diag_ = 1;
+  double range_ = 1, diag_ = 1, meanWeight_ = 1;
+  std::vector<float> fit_;  // the steering field's value at each vertex now (fitted, see collapse)
+  bool fitOn_ = false;
+  double fieldMin_ = 0, fieldMax_ = 0;
   std::vector<std::vector<uint32_t>> star_;
   std::vector<uint32_t> opp_;
   std::vector<uint8_t> boundary_;

@@ -11,6 +11,9 @@
 //        from the linear fields of all original tets that i and j now stand for, kept as
 //        volume-weighted 4D field quadrics summed on collapse (Garland & Heckbert's attribute
 //        quadrics; our stand-in for eq. (5)'s integral over the original vertices of the region).
+//        s_j is the value j takes after the collapse (fitValues below). The queue orders by
+//        E_f × sqrt(region volume / mean vertex volume): the error's share of the RMS over the
+//        whole mesh, so a large region with a small error is not collapsed before a small one.
 //   E_s  shape error, paper §3.3: the measure κ(S) − 3 normalised as (κ − 3)/κ = 1 − 3/κ, in
 //        [0, 1), averaged over the tets around p_j after the collapse (0: all equilateral).
 //        The paper's unbounded κ − 3 let the shape term outweigh the field wherever a mesh is
@@ -50,6 +53,10 @@ struct SimplifyOptions {
   int field = 0;                // index of the field that steers the field error
   double minQuality = 0.02;     // 3/κ of every tet a collapse changes must stay at or above this
                                 // (or at the worst 3/κ of the star before it, when that is lower)
+  // After each collapse the kept vertex takes the value of the steering field that fits the
+  // original field over everything it stands for (field quadric minimum at p_j); the log keeps
+  // the values before, so splits restore them exactly. Off: every vertex keeps its sample.
+  bool fitValues = true;
   std::function<void(uint32_t done, uint32_t planned)> progress;  // called now and then
   bool verifyLinkCondition = false;  // tests: also run the slow reference link check, count mismatches
   // Threads for cost evaluation (1 or 2; the result is the same either way), used for meshes of
@@ -62,6 +69,7 @@ struct SimplifyOptions {
 struct CollapseLog {
   std::vector<uint32_t> i, j;            // removed vertex, kept vertex
   std::vector<float> fieldError;         // E_f of the collapse (field units), for the manifest
+  std::vector<float> iValue, jValue;     // the steering field at i and j just before the collapse
   std::vector<uint32_t> movedBegin;      // collapse c moved tets moved[movedBegin[c] .. movedBegin[c+1])
   std::vector<uint32_t> moved;           // tets whose i slot became j
   std::vector<uint32_t> removedBegin;    // likewise for removed tets
@@ -76,6 +84,8 @@ struct SimplifyResult {
   std::vector<uint32_t> tets;      // 4 per original tet, current vertices (valid where tetAlive)
   std::vector<uint8_t> tetAlive;   // 1 per original tet
   std::vector<uint8_t> vertexAlive;
+  std::vector<float> values;       // the steering field per vertex at the end (fitted values)
+  int valuesField = -1;            // the index of that field in the mesh
   uint32_t vertices = 0, tetCount = 0;  // counts of the base mesh
   uint32_t flatTetsRemoved = 0;    // input tets with zero volume that the collapses removed
   uint32_t flatTetsLeft = 0;

@@ -73,7 +73,7 @@ class Encoder {
       if (!s_.vertexAlive[v]) continue;
       out_.streamVertexOf[v] = b.vertexCount();
       b.positions.insert(b.positions.end(), &mesh_.positions[3 * size_t(v)], &mesh_.positions[3 * size_t(v)] + 3);
-      for (size_t f = 0; f < mesh_.fields.size(); ++f) b.fields[f].values.push_back(mesh_.fields[f].values[v]);
+      for (size_t f = 0; f < mesh_.fields.size(); ++f) b.fields[f].values.push_back(valueAt(f, v));
     }
     for (uint32_t t = 0; t < T; ++t) {
       if (!s_.tetAlive[t]) continue;
@@ -87,6 +87,14 @@ class Encoder {
     records_.clear();
     inChunk_ = 0;
     prevJ_ = 0;  // each chunk decodes on its own (FORMAT.md §4)
+  }
+
+  // A value as the decoder will see it: on the field's quantization grid unless lossless.
+  float snapped(size_t f, float x) const { return q_.lossless ? x : q_.field[f].dequantize(q_.field[f].quantize(x)); }
+  // Field f at original vertex v at the base level: the simplifier's fitted value for the
+  // field it steered by, the sample for the others.
+  float valueAt(size_t f, uint32_t v) const {
+    return int(f) == s_.valuesField ? snapped(f, s_.values[v]) : mesh_.fields[f].values[v];
   }
 
   uint32_t candidateIndex(uint32_t v) const {
@@ -159,13 +167,22 @@ class Encoder {
     const float* pi = &mesh_.positions[3 * size_t(i)];
     const float* pj = &pm_.mesh.positions[3 * size_t(js)];
     for (int k = 0; k < 3; ++k) putValue(pi[k], pj[k], q_.position[k]);
-    fields_.resize(mesh_.fields.size());
-    for (size_t f = 0; f < mesh_.fields.size(); ++f) {
-      fields_[f] = mesh_.fields[f].values[i];
+    // p_i's values as they were when it was removed, then (with fitted values) the values p_j
+    // had before the collapse, which the split gives back.
+    const size_t F = mesh_.fields.size();
+    const bool fit = s_.valuesField >= 0;
+    fields_.resize(F);
+    jFields_.resize(F);
+    for (size_t f = 0; f < F; ++f) {
+      const bool steered = int(f) == s_.valuesField;
+      fields_[f] = steered ? snapped(f, log.iValue[c]) : mesh_.fields[f].values[i];
+      jFields_[f] = steered ? snapped(f, log.jValue[c]) : pm_.mesh.fields[f].values[js];
       putValue(fields_[f], pm_.mesh.fields[f].values[js], q_.field[f]);
     }
+    if (fit)
+      for (size_t f = 0; f < F; ++f) putValue(jFields_[f], pm_.mesh.fields[f].values[js], q_.field[f]);
     changed_.clear();
-    applySplit(pm_, SplitOp{js, moved_, newTets_, pi, fields_.data()}, changed_);
+    applySplit(pm_, SplitOp{js, moved_, newTets_, pi, fields_.data(), fit ? jFields_.data() : nullptr}, changed_);
   }
 
   // Closes the current chunk and compresses it on another thread while encoding goes on. The
@@ -220,7 +237,7 @@ class Encoder {
     const uint32_t index = uint32_t(jobs_.size());
     beginChunk(job.raw, ChunkKind::Splits, index);
     putU32(job.raw, inChunk_);
-    putU32(job.raw, q_.lossless ? kSplitFlagLossless : 0);
+    putU32(job.raw, (q_.lossless ? kSplitFlagLossless : 0) | (s_.valuesField >= 0 ? kSplitFlagKeptValues : 0));
     job.raw.insert(job.raw.end(), records_.begin(), records_.end());
     job.info.kind = ChunkKind::Splits;
     job.info.vertices = pm_.vertexCount();
@@ -276,7 +293,7 @@ class Encoder {
   EncodedStream& out_;
   Quantizer q_;
   ProgressiveMesh pm_;
-  std::vector<float> prefixMax_, fields_;
+  std::vector<float> prefixMax_, fields_, jFields_;
   std::vector<uint8_t> records_;
   std::vector<Pair> pairs_, chain_;
   std::deque<Job> jobs_;  // chunks being compressed, in order (stable addresses)

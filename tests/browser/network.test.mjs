@@ -43,6 +43,9 @@ function chunkFile(i) {
   return manifest.chunks[i].file;
 }
 
+// Parts of the test stream, as the viewer's messages count them.
+const parts = () => manifest.chunks.length;
+
 // GET requests the own server saw for chunk i since `since` (ms, Date.now()).
 function requestsFor(i, since, server = own) {
   return server.requestLog.filter((r) => r.method === 'GET' && r.url.endsWith(chunkFile(i)) && r.time >= since);
@@ -208,7 +211,7 @@ test('a chunk that fails twice with 503 is retried with backoff and the stream c
   await page.screenshot({ path: path.join(outDir, 'network-retry.png') });
   // The status line is read after the screenshot: the backoff may have run out by then.
   assert.match(await page.textContent('#status-text'),
-    /^The server answered HTTP 503 \(Service Unavailable\): retrying part 4 of 10 (in (\d+ s|a moment)|now \(attempt 2\))\.$/);
+    new RegExp(`^The server answered HTTP 503 \\(Service Unavailable\\): retrying part 4 of ${parts()} (in (\\d+ s|a moment)|now \\(attempt 2\\))\\.$`));
   const s = await waitForState(page, ['complete', 'error']);
   assertCompleteAndRight(s, '503 twice');
   assert.deepEqual(requestsFor(3, since).map((r) => r.status), [503, 503, 200], 'two failures, then the chunk');
@@ -229,7 +232,7 @@ test('a truncated chunk (short but "successful" response) is refused and fetched
   assert.equal(s.chunksRefused, 1, 'the short copy was refused, never applied');
   assert.equal(s.retries, 1);
   const seen = await notices(page);
-  assert.ok(seen.some((n) => /^Part 5 of 10 arrived damaged \([\d,]+ bytes instead of [\d,]+\): retrying part 5 of 10 /.test(n)),
+  assert.ok(seen.some((n) => new RegExp(`^Part 5 of ${parts()} arrived damaged \\([\\d,]+ bytes instead of [\\d,]+\\): retrying part 5 of ${parts()} `).test(n)),
     `a plain message: ${JSON.stringify(seen)}`);
   assert.deepEqual(problems, []);
   await page.close();
@@ -243,7 +246,7 @@ test('a corrupted chunk (bit flips) fails the hash check, is never applied and i
   assert.equal(requestsFor(5, since).length, 2);
   assert.equal(s.chunksRefused, 1);
   const seen = await notices(page);
-  assert.ok(seen.some((n) => n.startsWith("Part 6 of 10 arrived damaged (its content does not match the manifest's hash)")),
+  assert.ok(seen.some((n) => n.startsWith(`Part 6 of ${parts()} arrived damaged (its content does not match the manifest's hash)`)),
     `a plain message: ${JSON.stringify(seen)}`);
   assert.deepEqual(problems, []);
   await page.close();
@@ -257,7 +260,7 @@ test('a dropped connection mid-chunk is retried and the stream completes', async
   assert.equal(requestsFor(2, since).length, 3);
   assert.equal(s.retries, 2);
   const seen = await notices(page);
-  assert.ok(seen.some((n) => /^Connection lost: retrying part 3 of 10 /.test(n)), `a plain message: ${JSON.stringify(seen)}`);
+  assert.ok(seen.some((n) => new RegExp(`^Connection lost: retrying part 3 of ${parts()} `).test(n)), `a plain message: ${JSON.stringify(seen)}`);
   assert.deepEqual(problems, []);
   await page.close();
 });
@@ -299,7 +302,7 @@ test('a chunk stalled past the stall timer (?stallSeconds=1) is abandoned and fe
   assert.equal(requestsFor(3, since).length, 2);
   assert.equal(s.retries, 1);
   const seen = await notices(page);
-  assert.ok(seen.some((n) => /^No data for 1 s: retrying part 4 of 10 /.test(n)), `a plain message: ${JSON.stringify(seen)}`);
+  assert.ok(seen.some((n) => new RegExp(`^No data for 1 s: retrying part 4 of ${parts()} `).test(n)), `a plain message: ${JSON.stringify(seen)}`);
   assert.deepEqual(problems, []);
   await page.close();
 });
@@ -309,7 +312,7 @@ test('a 404 chunk stops the stream with a message naming the part; the loaded le
   own.setFaults([{ match: `/data/${chunkFile(6)}`, kind: 'status', status: 404 }]);
   const { page, s, problems } = await streamTo(`${ownUrl}/index.html?data=/data/manifest.json`);
   assert.equal(s.state, 'error');
-  assert.equal(s.error, `Could not download part 7 of 10 of the dataset (${chunkFile(6)}): HTTP 404 (not found). ` +
+  assert.equal(s.error, `Could not download part 7 of ${parts()} of the dataset (${chunkFile(6)}): HTTP 404 (not found). ` +
     'Showing the last complete level.');
   assert.equal(await page.textContent('#status-text'), s.error);
   assert.equal(requestsFor(6, since).length, 1, 'a 404 is not retried');
@@ -342,8 +345,8 @@ test('offline and back: retries wait for the network and streaming resumes when 
   const { page: viewer, problems } = await openViewerWithRoute(`${ownUrl}/index.html?data=/data/manifest.json`, () => linkDown);
   await viewer.waitForFunction(() => window.tetstream.stats().chunksReceived >= 2, null, { timeout: 20000 });
   await viewer.context().setOffline(true);
-  await viewer.waitForFunction(() => /^You are offline: retrying part 3 of 10 (in|now)/.test(window.tetstream.stats().notice),
-    null, { timeout: 20000 });
+  await viewer.waitForFunction((n) => new RegExp(`^You are offline: retrying part 3 of ${n} (in|now)`).test(window.tetstream.stats().notice),
+    parts(), { timeout: 20000 });
   await new Promise((resolve) => setTimeout(resolve, 2500)); // the backoff grows meanwhile
   const during = await viewer.evaluate(() => window.tetstream.stats());
   assert.equal(during.state, 'streaming');
@@ -392,7 +395,7 @@ test('?maxMemoryMB= below the full dataset stops at the last level that fits, wi
   assert.ok(s.chunksAllowed >= 1 && s.chunksAllowed < s.chunksTotal, `stopped part way: ${s.chunksAllowed}`);
   assert.equal(s.chunksReceived, s.chunksAllowed);
   assert.match(s.error, new RegExp(`^This dataset needs about [\\d.]+ MB of memory at full detail, more than the [\\d.]+ MB ` +
-    `this page may use\\. Streaming stopped after part ${s.chunksAllowed} of 10 \\([\\d.]+% of the vertices\\); ` +
+    `this page may use\\. Streaming stopped after part ${s.chunksAllowed} of ${parts()} \\([\\d.]+% of the vertices\\); ` +
     'that level stays fully usable\\.$'));
   assert.ok(s.memory.limitBytes <= limitMB * 1048576 + 1);
   assert.ok(s.memory.allowedBytes <= s.memory.limitBytes);

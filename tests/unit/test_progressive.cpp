@@ -324,6 +324,77 @@ TEST(Progressive, BoundaryIsPreserved) {
   }
 }
 
+// RMS over the input's vertices of (coarse field interpolated there − input value), by brute
+// force: the coarse tet that holds each point best (largest smallest barycentric coordinate).
+double fieldRms(const TetMesh& in, const TetMesh& coarse, int field) {
+  double sum = 0;
+  for (uint32_t v = 0; v < in.vertexCount(); ++v) {
+    const float* p = &in.positions[3 * v];
+    double best = -1e30, value = 0;
+    for (uint32_t t = 0; t < coarse.tetCount(); ++t) {
+      const uint32_t* c = &coarse.tets[4 * t];
+      const float* q[4] = {&coarse.positions[3 * c[0]], &coarse.positions[3 * c[1]], &coarse.positions[3 * c[2]],
+                           &coarse.positions[3 * c[3]]};
+      const double det = tetVolume(q[0], q[1], q[2], q[3]);
+      double l[4], lo = 1e30;
+      for (int k = 0; k < 4; ++k) {
+        const float* r[4] = {q[0], q[1], q[2], q[3]};
+        r[k] = p;
+        l[k] = tetVolume(r[0], r[1], r[2], r[3]) / det;
+        lo = std::min(lo, l[k]);
+      }
+      if (lo <= best) continue;
+      best = lo;
+      value = 0;
+      for (int k = 0; k < 4; ++k) value += l[k] * coarse.fields[size_t(field)].values[c[k]];
+    }
+    const double d = value - in.fields[size_t(field)].values[v];
+    sum += d * d;
+  }
+  return std::sqrt(sum / in.vertexCount());
+}
+
+// Coarse levels carry values fitted to the region each vertex stands for (SimplifyOptions::
+// fitValues): a lower field error than keeping the samples; --samples keeps the input's values
+// at every level, and fields that did not steer keep them either way.
+TEST(Progressive, FittedValuesLowerTheFieldErrorOfCoarseLevels) {
+  const TetMesh m = harmonic(20);
+  PackOptions o;
+  o.baseFraction = 0.05;
+  o.minBaseVertices = 0;
+  const std::string fitDir = pack("fitted", m, o);
+  o.fitValues = false;
+  const std::string sampleDir = pack("samples", m, o);
+  Dataset fit, samples;
+  ASSERT_TRUE(loadPackedDir(fitDir, fit, 1));
+  ASSERT_TRUE(loadPackedDir(sampleDir, samples, 1));
+  const TetMesh& a = fit.pm.mesh;
+  const TetMesh& b = samples.pm.mesh;
+  const double fitRms = fieldRms(m, a, 0), sampleRms = fieldRms(m, b, 0);
+  RecordProperty("fitted_rms", std::to_string(fitRms));
+  RecordProperty("sampled_rms", std::to_string(sampleRms));
+  EXPECT_LT(fitRms, 0.9 * sampleRms);
+  // Which base values are input samples: every one with --samples, and every one of the field
+  // that did not steer; the fitted field has values of its own.
+  const Quantizer& q = fit.quant;  // the same grid for both packs
+  auto key = [&](const float* p) {
+    return std::array<uint32_t, 3>{q.position[0].quantize(p[0]), q.position[1].quantize(p[1]), q.position[2].quantize(p[2])};
+  };
+  std::map<std::array<uint32_t, 3>, uint32_t> at;
+  for (uint32_t v = 0; v < m.vertexCount(); ++v) at[key(&m.positions[3 * v])] = v;
+  auto sampledCount = [&](const TetMesh& level, int f) {
+    uint32_t n = 0;
+    for (uint32_t v = 0; v < level.vertexCount(); ++v) {
+      const uint32_t w = at.at(key(&level.positions[3 * v]));
+      n += std::abs(level.fields[size_t(f)].values[v] - m.fields[size_t(f)].values[w]) <= 0.5f * q.field[size_t(f)].step * 1.0001f;
+    }
+    return n;
+  };
+  EXPECT_EQ(sampledCount(b, 0), b.vertexCount());
+  EXPECT_EQ(sampledCount(a, 1), a.vertexCount());
+  EXPECT_LT(sampledCount(a, 0), a.vertexCount() / 2);
+}
+
 TEST(Progressive, CorruptSplitChunkKeepsTheLastCompleteLevel) {
   PackOptions o;
   o.chunkKb = 2;
