@@ -270,9 +270,7 @@ class Simplifier {
     }
     queued_.assign(V_, 0);
     changed_.assign(V_, 0);
-    meanWeight_ = 0;
-    for (const FieldQuadric& f : fieldQuadric_) meanWeight_ += f.weight;
-    meanWeight_ = meanWeight_ > 0 ? meanWeight_ / alive_ : 1.0;
+    represented_.assign(V_, 1);
     lastCost_.assign(V_, float(kInf));
     // Every vertex's first cost, on two threads (each with its own scratch lane; the mesh is
     // only read), then queued in vertex order so the result does not depend on the threads.
@@ -297,12 +295,12 @@ class Simplifier {
       }
   }
 
-  // Whether j's value is fitted after a collapse whose region has field quadric f: only once the
-  // region covers kMinFitSpread mean vertex shares. Below that the fit gains little (Harmonic 64³
-  // at 30% of the tets: RMS 0.00031 instead of 0.00029) while every split that changes j's value
-  // costs the viewer an update of all tets around j; this way about a third of the splits do.
-  bool fitsRegion(const FieldQuadric& f) const { return fitOn_ && f.weight >= kMinFitSpread * meanWeight_; }
-  static constexpr double kMinFitSpread = 4;
+  // Whether j's value is fitted after a collapse that leaves it standing for `count` input
+  // vertices: only from kMinFitCount on. Below that the fit gains little (Harmonic 64³ at 30% of
+  // the tets: RMS 0.00031 instead of 0.00029) while every split that changes j's value costs the
+  // viewer an update of all tets around j; this way about a third of the splits do.
+  bool fitsRegion(uint32_t count) const { return fitOn_ && count >= kMinFitCount; }
+  static constexpr uint32_t kMinFitCount = 4;
 
   // The value s at x that minimises the field quadric (x, s): its derivative in s is zero.
   // (q is the upper triangle of the 5×5 form: q[12] is (s, s), q[3], q[7], q[10] are (x, s),
@@ -480,7 +478,8 @@ class Simplifier {
     const double* P = p(j);
     FieldQuadric fq = fieldQuadric_[i];
     fq.add(fieldQuadric_[j]);
-    const double sj = fitsRegion(fq) ? fitted(fq, P, fit_[j]) : fit_[j];
+    const uint32_t count = represented_[i] + represented_[j];
+    const double sj = fitsRegion(count) ? fitted(fq, P, fit_[j]) : fit_[j];
     double bestInside = -kInf, interp = sj;
     for (StarTet& st : L.star) {
       if (st.other[0] == j || st.other[1] == j || st.other[2] == j) continue;  // removed
@@ -517,11 +516,7 @@ class Simplifier {
     double local = std::abs(double(field_[i]) - interp) / range_;
     const double x5[5] = {P[0], P[1], P[2], sj, 1.0};
     double region = fq.weight > 0 ? std::sqrt(std::max(0.0, fq.eval(x5)) / fq.weight) / range_ : 0.0;
-    // The collapse is ordered by its error weighted by how much of the domain it spreads over
-    // (the square root of the region's volume over a mean vertex's share), which is what adds to
-    // the RMS error over the whole mesh; the manifest reports the unweighted error.
-    const double spread = fq.weight > 0 ? std::sqrt(fq.weight / meanWeight_) : 1.0;
-    const double ef = (local + region) * spread;
+    const double ef = local + region;
     double eg = 0;
     if (boundary_[i]) {
       Quadric q = quadric_[i];
@@ -529,8 +524,14 @@ class Simplifier {
       const double x4[4] = {P[0], P[1], P[2], 1.0};
       if (q.weight > 0) eg = std::sqrt(std::max(0.0, q.eval(x4)) / q.weight) / diag_;
     }
-    *fieldErr = float(local + region);
-    return opt_.weightGeometry * eg + opt_.weightField * ef;
+    *fieldErr = float(ef);
+    // The error terms are weighted by the square root of the number of input vertices i and j
+    // stand for together: about the root of the summed squared error at those vertices (paper
+    // eq. 5 sums over them), which is what adds to the RMS over the whole mesh, so a collapse
+    // that spreads an error over a large region waits behind one that keeps it local. A count,
+    // not a volume: graded CFD grids put most vertices in thin boundary layers, where a volume
+    // weight made the error 1.8× larger on Blunt Fin. The manifest reports the unweighted E_f.
+    return std::sqrt(double(count)) * (opt_.weightGeometry * eg + opt_.weightField * ef);
   }
 
   double finishCost(Lane& L, uint32_t j, double lower, CollapseVerdict* verdict) {
@@ -978,7 +979,8 @@ class Simplifier {
     // field there best (least squares over the region's original tets, at p_j), which the
     // split restores (paper §3 keeps the sample; at 5% of Harmonic's tets this lowers the RMS
     // field error by a fifth).
-    if (fitsRegion(fieldQuadric_[j])) fit_[j] = float(fitted(fieldQuadric_[j], p(j), fit_[j]));
+    represented_[j] += represented_[i];
+    if (fitsRegion(represented_[j])) fit_[j] = float(fitted(fieldQuadric_[j], p(j), fit_[j]));
 
     // Everything around j changed. j and its neighbours are re-evaluated lazily, when they reach
     // the top: those already queued keep their entry; a blocked one (no legal collapse last
@@ -1012,8 +1014,9 @@ class Simplifier {
   uint32_t V_ = 0, T_ = 0, alive_ = 0, tetsAlive_ = 0, flatInput_ = 0;
   std::vector<double> pos_;
   const float* field_ = nullptr;
-  double range_ = 1, diag_ = 1, meanWeight_ = 1;
+  double range_ = 1, diag_ = 1;
   std::vector<float> fit_;  // the steering field's value at each vertex now (fitted, see collapse)
+  std::vector<uint32_t> represented_;  // per vertex: input vertices it stands for (itself and those collapsed into it)
   bool fitOn_ = false;
   double fieldMin_ = 0, fieldMax_ = 0;
   std::vector<std::vector<uint32_t>> star_;
