@@ -85,7 +85,7 @@ Runner addPack(CLI::App& app) {
                  ->check(CLI::Range(0.0, 1.0))->capture_default_str();
   auto* bv = sub->add_option("--base-vertices", o->baseVertices, "base mesh size in vertices");
   auto* bt = sub->add_option("--base-tets", o->baseTets, "base mesh size in tets (with --base-fraction 0: the only target)");
-  auto* me = sub->add_option("--max-error", o->maxError, "stop simplifying when the cheapest collapse costs more (relative error units)")
+  auto* me = sub->add_option("--max-error", o->maxError, "stop simplifying when the next collapse would leave a field error above E (relative to the field's range)")
                  ->check(CLI::PositiveNumber);
   bv->excludes(bf);
   me->excludes(bf);

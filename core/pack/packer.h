@@ -23,7 +23,7 @@ struct PackOptions {
   uint32_t baseVertices = 0;              // ...or as a vertex count (wins when non-zero)
   uint32_t minBaseVertices = 256;         // floor for the fraction rule on small meshes
   uint32_t baseTets = 0;                  // stop earlier once the base has this many tets
-  double maxError = std::numeric_limits<double>::infinity();  // stop simplifying at this cost
+  double maxError = std::numeric_limits<double>::infinity();  // stop at this field error (SimplifyOptions)
   bool lossless = false;                  // keep float32 values in split records
   bool fitValues = true;                  // coarse levels get fitted values (SimplifyOptions::fitValues)
   uint32_t chunkKb = 256;                 // largest split chunk, compressed

@@ -139,16 +139,16 @@ class Simplifier {
     const uint32_t roundSize = parallel ? kRoundSize : 1;
     WorkPool pool(parallel ? 1 : 0);
     auto evaluateTask = [this](uint32_t k) { evaluateVertex(lanes_[k], round_[k].vertex); };
-    auto goOn = [&] { return alive_ > target && tetsAlive_ > opt_.targetTets; };
+    auto goOn = [&] { return alive_ > target && tetsAlive_ > opt_.targetTets && !errorBoundReached_; };
     while (goOn()) {
       round_.clear();
       Entry e;
-      while (round_.size() < roundSize && peekValid(e) && !(e.cost > opt_.maxError)) {
+      while (round_.size() < roundSize && peekValid(e)) {
         heap_.pop();
         round_.push_back(e);
       }
       if (round_.empty()) {
-        out_.stopReason = heap_.empty() ? "no legal collapse left" : "error bound reached";
+        out_.stopReason = "no legal collapse left";
         break;
       }
       pool.run(uint32_t(round_.size()), evaluateTask);
@@ -169,6 +169,7 @@ class Simplifier {
         if (opt_.progress && (out_.log.size() & 4095) == 0) opt_.progress(out_.log.size(), planned);
       }
     }
+    if (errorBoundReached_) out_.stopReason = "error bound reached";
     if (opt_.progress) opt_.progress(out_.log.size(), planned);
     out_.vertices = alive_;
     for (const Lane& L : lanes_) out_.costEvaluations += L.evaluations;
@@ -671,7 +672,12 @@ class Simplifier {
         ++out_.requeued;
         return;
       }
-      if (cand.cost > opt_.maxError) return;
+      if (cand.fieldErr > opt_.maxError) {  // the next collapse in line would exceed the bound
+        heap_.push({float(cand.cost), i});
+        queued_[i] = 1;
+        errorBoundReached_ = true;
+        return;
+      }
       if (!linkCondition(i, cand.j)) {
         ++out_.rejectedByLink;
         L.candidates.erase(L.candidates.begin() + c);
@@ -1018,6 +1024,7 @@ class Simplifier {
   std::vector<float> fit_;  // the steering field's value at each vertex now (fitted, see collapse)
   std::vector<uint32_t> represented_;  // per vertex: input vertices it stands for (itself and those collapsed into it)
   bool fitOn_ = false;
+  bool errorBoundReached_ = false;
   double fieldMin_ = 0, fieldMax_ = 0;
   std::vector<std::vector<uint32_t>> star_;
   std::vector<uint32_t> opp_;

@@ -51,7 +51,9 @@ struct SimplifyOptions {
   double weightGeometry = 100.0, weightField = 1.0, weightShape = 0.02;
   uint32_t targetVertices = 0;  // stop at this many vertices (0: as far as legal collapses go)
   uint32_t targetTets = 0;      // ...or at this many tets, whichever comes first
-  double maxError = std::numeric_limits<double>::infinity();  // stop when the cheapest cost exceeds it
+  // Stop when the collapse next in line would leave a field error E_f (relative to the field's
+  // range) above this.
+  double maxError = std::numeric_limits<double>::infinity();
   int field = 0;                // index of the field that steers the field error
   double minQuality = 0.02;     // 3/κ of every tet a collapse changes must stay at or above this
                                 // (or at the worst 3/κ of the star before it, when that is lower)

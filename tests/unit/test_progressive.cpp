@@ -395,6 +395,23 @@ TEST(Progressive, FittedValuesLowerTheFieldErrorOfCoarseLevels) {
   EXPECT_LT(sampledCount(a, 0), a.vertexCount() / 2);
 }
 
+// --max-error E: every collapse made leaves a field error of at most E (relative to the range),
+// and the packer says it stopped there.
+TEST(Progressive, MaxErrorBoundsEveryCollapse) {
+  const TetMesh m = harmonic(12);
+  PackOptions o;
+  o.baseFraction = 0;
+  o.minBaseVertices = 0;
+  o.maxError = 0.02;
+  PackSummary s;
+  const std::string dir = pack("max-error", m, o, &s);
+  EXPECT_EQ(s.stopReason, "error bound reached");
+  EXPECT_GT(s.splits, m.vertexCount() / 4) << "simplified a good part of the way";
+  const Range r = s.manifest.fields[0].range;
+  EXPECT_GT(s.manifest.chunks[0].fieldError, 0.0);
+  EXPECT_LE(s.manifest.chunks[0].fieldError, 0.02 * (r.max - r.min) * 1.0001);
+}
+
 TEST(Progressive, CorruptSplitChunkKeepsTheLastCompleteLevel) {
   PackOptions o;
   o.chunkKb = 2;
