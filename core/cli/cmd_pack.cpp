@@ -79,7 +79,7 @@ Runner addPack(CLI::App& app) {
   sub->add_option("-o,--output", o->out, "output folder (created; an earlier pack there is replaced)")->required();
   sub->add_option("--field", o->field, "field that steers simplification and is shown first (default: the first)");
   sub->add_option("--name", o->name, "dataset name shown in the viewer (default: the file name)");
-  sub->add_option("--weights", o->weights, "cost weights G,F,S: boundary geometry, field, tet shape (default 100,1,0.02)")
+  sub->add_option("--weights", o->weights, "cost weights G,F,S: boundary geometry, field, tet shape (default 100,1,0.005)")
       ->delimiter(',')->expected(3);
   auto* bf = sub->add_option("--base-fraction", o->baseFraction, "base mesh size as a fraction of the vertices")
                  ->check(CLI::Range(0.0, 1.0))->capture_default_str();

@@ -18,7 +18,7 @@ struct PackOptions {
   std::string field;     // field that steers simplification and is shown first; "" = first field
   std::string name;      // dataset name; "" = mesh.name
   int zstdLevel = 19;
-  double weights[3] = {100.0, 1.0, 0.02};  // geometry, field, shape (simplify.h)
+  double weights[3] = {100.0, 1.0, 0.005};  // geometry, field, shape (simplify.h)
   double baseFraction = 0.01;             // base mesh size as a fraction of the vertices...
   uint32_t baseVertices = 0;              // ...or as a vertex count (wins when non-zero)
   uint32_t minBaseVertices = 256;         // floor for the fraction rule on small meshes

@@ -18,10 +18,11 @@
 //        [0, 1), averaged over the tets around p_j after the collapse (0: all equilateral).
 //        The paper's unbounded κ − 3 let the shape term outweigh the field wherever a mesh is
 //        anisotropic: on the Blunt Fin CFD grid it made the density error 6.6× larger.
-// Defaults (100, 1, 0.02) keep the boundary first, then the field; tet shape is a
+// Defaults (100, 1, 0.005) keep the boundary first, then the field; tet shape is a
 // tie-breaker; all terms are scale free, so they work for any mesh size and field range.
-// (Chosen on Harmonic 64³, Blunt Fin and post.vtk: shape 0.02 rather than 0.002 gives better
-// tets, 0.535 against 0.49 mean 3/κ on Harmonic at 5%, and a 4% lower field error.)
+// (Shape weight chosen on Harmonic 64³ and Blunt Fin: 0.002 to 0.02 trade the field error at the
+// coarsest levels against that at finer ones; 0.02 gives better tets, mean 3/κ 0.535 against 0.50
+// at 5% of Harmonic's tets, and a 2% lower error there, but a 10% higher one at 30%.)
 //
 // Legality, checked for every collapse (paper §3.2 and Staadt & Gross / Dey et al.):
 //   - a boundary vertex may only move along a boundary edge;
@@ -48,7 +49,7 @@
 namespace tetstream {
 
 struct SimplifyOptions {
-  double weightGeometry = 100.0, weightField = 1.0, weightShape = 0.02;
+  double weightGeometry = 100.0, weightField = 1.0, weightShape = 0.005;
   uint32_t targetVertices = 0;  // stop at this many vertices (0: as far as legal collapses go)
   uint32_t targetTets = 0;      // ...or at this many tets, whichever comes first
   // Stop when the collapse next in line would leave a field error E_f (relative to the field's
