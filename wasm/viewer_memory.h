@@ -5,7 +5,7 @@
 // (viewer_state.h: openManifest, addChunk).
 //
 // The estimate uses only the manifest's per-chunk counts (vertices, tets, splits, rawBytes) and
-// the viewer's per-element costs: mesh and incidence lists (progressive.h), the kept split
+// the viewer's per-element costs: mesh, incidence lists and undo log (progressive.h), the kept split
 // payloads (dataset.h), the isosurface with its interval tree (isosurface_incremental.h, ~49
 // bytes per tet measured on Harmonic 64), and the hull (viewer_state.h: ~110 bytes per boundary
 // triangle, boundary triangles guessed from the tet count as for a cube). It is an estimate:
