@@ -98,8 +98,8 @@ class IncrementalIsosurface {
   void rebuild(const TetMesh& mesh, std::span<const float> field, float isovalue,
                std::span<const float> colour = {});
 
-  // Recomputes the triangles of the listed tets (T_new and T_moved of a split or its undo; see the
-  // contract above), updates the interval tree for them, releases unused surface vertices and
+  // Recomputes the triangles of the listed tets (T_new and T_moved of a split or its undo, and
+  // every tet around p_j when the split changes p_j's value; see the contract above), updates the interval tree for them, releases unused surface vertices and
   // renormalises the touched vertices' normals. No allocation once the arrays are warm.
   // Precondition (asserted): rebuild() was called since the last reset().
   // `colour` as for rebuild() (the same field every time, or recolour() after switching).

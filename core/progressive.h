@@ -7,6 +7,7 @@
 // chasing a linked list through the whole mesh: a split reads the star of j twice and a linked
 // list made that half of the streaming time. No per-vertex allocation.
 // Tets are only ever appended (T_new) or have one slot changed (T_moved); undo reverses both.
+// A split may also give p_j a value back (fitted values, FORMAT.md §4); undo restores it.
 #pragma once
 #include <cstdint>
 #include <span>

@@ -297,9 +297,9 @@ class Simplifier {
   }
 
   // Whether j's value is fitted after a collapse that leaves it standing for `count` input
-  // vertices: only from kMinFitCount on. Below that the fit gains little (Harmonic 64³ at 30% of
-  // the tets: RMS 0.00031 instead of 0.00029) while every split that changes j's value costs the
-  // viewer an update of all tets around j; this way about a third of the splits do.
+  // vertices: only from kMinFitCount on. Below that the fit gains little while every split that
+  // changes j's value costs the viewer an update of all tets around j; this way most splits of
+  // the finest levels (the bulk of the stream) leave p_j's value alone.
   bool fitsRegion(uint32_t count) const { return fitOn_ && count >= kMinFitCount; }
   static constexpr uint32_t kMinFitCount = 4;
 
@@ -982,9 +982,9 @@ class Simplifier {
     quadric_[j].add(quadric_[i]);
     fieldQuadric_[j].add(fieldQuadric_[i]);
     // j now stands for the region of both: its value becomes the one that fits the original
-    // field there best (least squares over the region's original tets, at p_j), which the
-    // split restores (paper §3 keeps the sample; at 5% of Harmonic's tets this lowers the RMS
-    // field error by a fifth).
+    // field there best (least squares over the region's original tets, at p_j); the split gives
+    // the value before back. (The paper keeps the sample; at 5% of Harmonic's tets fitting
+    // lowers the RMS field error by a fifth.)
     represented_[j] += represented_[i];
     if (fitsRegion(represented_[j])) fit_[j] = float(fitted(fieldQuadric_[j], p(j), fit_[j]));
 
