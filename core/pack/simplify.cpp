@@ -477,11 +477,9 @@ class Simplifier {
     *verdict = CollapseVerdict::Legal;
     if (boundary_[i] && !isBoundaryEdge(i, j)) return *verdict = CollapseVerdict::BoundaryRule, kInf;
     const double* P = p(j);
-    FieldQuadric fq = fieldQuadric_[i];
-    fq.add(fieldQuadric_[j]);
-    const uint32_t count = represented_[i] + represented_[j];
-    const double sj = fitsRegion(count) ? fitted(fq, P, fit_[j]) : fit_[j];
-    double bestInside = -kInf, interp = sj;
+    // The coarse field at p_i: the weight of p_j and the rest of the interpolation, kept apart
+    // until p_j's new value is known (only for a legal collapse: most candidates are not).
+    double bestInside = -kInf, weightJ = 1, others = 0;
     for (StarTet& st : L.star) {
       if (st.other[0] == j || st.other[1] == j || st.other[2] == j) continue;  // removed
       const double det = st.g[0][0] * P[0] + st.g[0][1] * P[1] + st.g[0][2] * P[2] + st.h[0];
@@ -510,9 +508,15 @@ class Simplifier {
       }
       if (lo > bestInside) {
         bestInside = lo;
-        interp = lambda[0] * sj + lambda[1] * st.f[0] + lambda[2] * st.f[1] + lambda[3] * st.f[2];
+        weightJ = lambda[0];
+        others = lambda[1] * st.f[0] + lambda[2] * st.f[1] + lambda[3] * st.f[2];
       }
     }
+    FieldQuadric fq = fieldQuadric_[i];
+    fq.add(fieldQuadric_[j]);
+    const uint32_t count = represented_[i] + represented_[j];
+    const double sj = fitsRegion(count) ? fitted(fq, P, fit_[j]) : fit_[j];
+    const double interp = weightJ * sj + others;
     // Paper eq. (6) at p_i, plus the field quadric over everything i and j stand for.
     double local = std::abs(double(field_[i]) - interp) / range_;
     const double x5[5] = {P[0], P[1], P[2], sj, 1.0};
