@@ -1,6 +1,8 @@
 #include "mesh.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace tetstream {
 
@@ -50,6 +52,19 @@ double tetVolume(const float* a, const float* b, const float* c, const float* d)
   double det = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
                u[2] * (v[0] * w[1] - v[1] * w[0]);
   return det / 6.0;
+}
+
+double barycentric(const float* const q[4], const float* x, double l[4]) {
+  const double det = tetVolume(q[0], q[1], q[2], q[3]);
+  if (det == 0) return -std::numeric_limits<double>::infinity();
+  double lo = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 4; ++k) {
+    const float* r[4] = {q[0], q[1], q[2], q[3]};
+    r[k] = x;
+    l[k] = tetVolume(r[0], r[1], r[2], r[3]) / det;
+    lo = std::min(lo, l[k]);
+  }
+  return lo;
 }
 
 }  // namespace tetstream

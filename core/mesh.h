@@ -50,5 +50,8 @@ inline double tetVolume(const TetMesh& m, uint32_t t) {
   const float* p = m.positions.data();
   return tetVolume(p + 3 * size_t(v[0]), p + 3 * size_t(v[1]), p + 3 * size_t(v[2]), p + 3 * size_t(v[3]));
 }
+// Barycentric coordinates of point x in tet q (by volumes); returns the smallest of them
+// (negative: outside), or -infinity for a flat tet.
+double barycentric(const float* const q[4], const float* x, double l[4]);
 
 }  // namespace tetstream

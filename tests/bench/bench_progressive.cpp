@@ -89,15 +89,8 @@ struct Locator {
     const uint32_t* v = &m.tets[4 * size_t(t)];
     const float* q[4] = {&m.positions[3 * size_t(v[0])], &m.positions[3 * size_t(v[1])], &m.positions[3 * size_t(v[2])],
                          &m.positions[3 * size_t(v[3])]};
-    double det = tetVolume(q[0], q[1], q[2], q[3]);
-    if (det == 0) return;
-    double l[4], lo = 1e30;
-    for (int k = 0; k < 4; ++k) {
-      const float* r[4] = {q[0], q[1], q[2], q[3]};
-      r[k] = p;
-      l[k] = tetVolume(r[0], r[1], r[2], r[3]) / det;
-      lo = std::min(lo, l[k]);
-    }
+    double l[4];
+    const double lo = barycentric(q, p, l);
     if (lo <= best) return;
     best = lo;
     double sum = 0, val = 0;

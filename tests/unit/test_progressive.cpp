@@ -335,14 +335,8 @@ double fieldRms(const TetMesh& in, const TetMesh& coarse, int field) {
       const uint32_t* c = &coarse.tets[4 * t];
       const float* q[4] = {&coarse.positions[3 * c[0]], &coarse.positions[3 * c[1]], &coarse.positions[3 * c[2]],
                            &coarse.positions[3 * c[3]]};
-      const double det = tetVolume(q[0], q[1], q[2], q[3]);
-      double l[4], lo = 1e30;
-      for (int k = 0; k < 4; ++k) {
-        const float* r[4] = {q[0], q[1], q[2], q[3]};
-        r[k] = p;
-        l[k] = tetVolume(r[0], r[1], r[2], r[3]) / det;
-        lo = std::min(lo, l[k]);
-      }
+      double l[4];
+      const double lo = barycentric(q, p, l);
       if (lo <= best) continue;
       best = lo;
       value = 0;
