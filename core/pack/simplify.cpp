@@ -121,10 +121,12 @@ class Simplifier {
     Lane& L = main_;
     neighbours(L, i, L.nbr);
     if (std::find(L.nbr.begin(), L.nbr.end(), j) == L.nbr.end()) return CollapseVerdict::NotAnEdge;
-    float ef;
     CollapseVerdict v = CollapseVerdict::Legal;
     prepareStar(L, i);
-    evaluate(L, i, j, &ef, &v);
+    if (legal(L, i, j, &v)) {
+      Candidate c = fieldTerms(L, i, j);
+      finishCost(L, c, &v);
+    }
     if (v == CollapseVerdict::Legal && !linkCondition(i, j)) v = CollapseVerdict::LinkCondition;
     return v;
   }
@@ -347,7 +349,7 @@ class Simplifier {
     uint32_t other[3];        // the vertices besides i, in slot order
     double g[4][3], h[4];     // [0]: det of the new tet; [1..3]: numerators with p_i at other[k-1]
     double detOld;            // det with p_i (numerator for the slot of i)
-    double fixedEdges, longestFixed, sumSq, sum[3], fixedFace;
+    double fixedEdges, sumSq, sum[3], fixedFace;
     double C[3][3], D[3][3];  // faces (P, x, y): cross = C - P × D
     double x[3][3];           // positions of the other vertices
     double sign;              // orientation sign of the slot of i
@@ -358,8 +360,9 @@ class Simplifier {
 
   struct Candidate {
     double cost;     // exact, or a lower bound until `exact`
+    double base;     // the cost without the shape term
     uint32_t j;
-    float fieldErr;
+    float fieldErr;  // E_f
     bool exact;
   };
 
@@ -426,9 +429,26 @@ class Simplifier {
       st.sign = sign;
       st.baryReady = false;
       st.detOld = st.g[0][0] * pi[0] + st.g[0][1] * pi[1] + st.g[0][2] * pi[2] + st.h[0];
-      st.longestFixed = std::max({dist2(x[0], x[1]), dist2(x[0], x[2]), dist2(x[1], x[2])});
       L.star.push_back(st);
     }
+  }
+
+  // Numerators of the barycentric coordinates of p_i with p_j's position P in the slot of i:
+  // with p_i in each other slot (computed on first use, for the legal candidates only).
+  static void prepareBary(StarTet& st, const double* pi) {
+    st.baryReady = true;
+    for (int k = 0; k < 3; ++k) {
+      const double* y[3] = {st.x[0], st.x[1], st.x[2]};
+      y[k] = pi;
+      affineDet(y[0], y[1], y[2], st.sign, st.g[k + 1], &st.h[k + 1]);
+    }
+  }
+
+  // Whether the new tet (P and the others of st) is flat, judged by its own longest edge.
+  static bool isFlat(const StarTet& st, const double* P, double det) {
+    double longest = std::max({dist2(st.x[0], st.x[1]), dist2(st.x[0], st.x[2]), dist2(st.x[1], st.x[2])});
+    for (int k = 0; k < 3; ++k) longest = std::max(longest, dist2(P, st.x[k]));
+    return det <= kFlat * longest * std::sqrt(longest);
   }
 
   static double dist2(const double* a, const double* b) {
@@ -467,60 +487,62 @@ class Simplifier {
     }
   }
 
-  // Cost of hec(i → j) given prepareStar(i), in two parts so that the expensive shape term is
-  // only computed for candidates that can still win: lowerBound() checks that no tet inverts or
-  // flattens and adds the geometric and field terms (E_s ≥ 0, so this bounds the cost from
-  // below); finishCost() adds the shape term and the minimum-quality check. Infinity marks an
-  // illegal collapse (the verdict says why).
-  double lowerBound(Lane& L, uint32_t i, uint32_t j, float* fieldErr, CollapseVerdict* verdict) {
+  // Cost of hec(i → j) given prepareStar(i), in two steps so that the expensive shape term is
+  // only computed for candidates that can still win (cheapestCandidate): legal() checks the
+  // boundary rule and that no tet inverts or flattens, then fieldTerms() adds the geometric and
+  // field terms and a lower bound of the shape term; finishCost() the exact shape term and the
+  // minimum-quality check.
+  bool legal(Lane& L, uint32_t i, uint32_t j, CollapseVerdict* verdict) {
     ++L.evaluations;
     *verdict = CollapseVerdict::Legal;
-    if (boundary_[i] && !isBoundaryEdge(i, j)) return *verdict = CollapseVerdict::BoundaryRule, kInf;
+    if (boundary_[i] && !isBoundaryEdge(i, j)) return *verdict = CollapseVerdict::BoundaryRule, false;
     const double* P = p(j);
-    // The coarse field at p_i: the weight of p_j and the rest of the interpolation, kept apart
-    // until p_j's new value is known (only for a legal collapse: most candidates are not).
-    double bestInside = -kInf, weightJ = 1, others = 0;
-    for (StarTet& st : L.star) {
+    for (const StarTet& st : L.star) {
       if (st.other[0] == j || st.other[1] == j || st.other[2] == j) continue;  // removed
       const double det = st.g[0][0] * P[0] + st.g[0][1] * P[1] + st.g[0][2] * P[2] + st.h[0];
-      if (det <= 0) return *verdict = CollapseVerdict::Inverted, kInf;
-      if (det <= L.flatBound) {  // only then can the tet be flat: check with its own edges
-        double longest = st.longestFixed;
-        for (int k = 0; k < 3; ++k) longest = std::max(longest, dist2(P, st.x[k]));
-        if (det <= kFlat * longest * std::sqrt(longest)) return *verdict = CollapseVerdict::Flat, kInf;
-      }
-      // Barycentric coordinates of p_i in the new tet, to interpolate the coarse field there;
-      // the first tet that contains p_i wins.
-      if (bestInside >= 0) continue;
-      if (!st.baryReady) {  // numerators with p_i in each other slot, computed on first use
-        st.baryReady = true;
-        const double* pi = p(i);
-        for (int k = 0; k < 3; ++k) {
-          const double* y[3] = {st.x[0], st.x[1], st.x[2]};
-          y[k] = pi;
-          affineDet(y[0], y[1], y[2], st.sign, st.g[k + 1], &st.h[k + 1]);
-        }
-      }
-      double lambda[4] = {st.detOld / det, 0, 0, 0}, lo = lambda[0];
-      for (int k = 1; k < 4; ++k) {
-        lambda[k] = (st.g[k][0] * P[0] + st.g[k][1] * P[1] + st.g[k][2] * P[2] + st.h[k]) / det;
-        lo = std::min(lo, lambda[k]);
-      }
-      if (lo > bestInside) {
-        bestInside = lo;
-        weightJ = lambda[0];
-        others = lambda[1] * st.f[0] + lambda[2] * st.f[1] + lambda[3] * st.f[2];
-      }
+      if (det <= 0) return *verdict = CollapseVerdict::Inverted, false;
+      if (det <= L.flatBound && isFlat(st, P, det)) return *verdict = CollapseVerdict::Flat, false;
     }
+    return true;
+  }
+
+  Candidate fieldTerms(Lane& L, uint32_t i, uint32_t j) {
+    const double* P = p(j);
+    Candidate c;
+    c.j = j;
     FieldQuadric fq = fieldQuadric_[i];
     fq.add(fieldQuadric_[j]);
     const uint32_t count = represented_[i] + represented_[j];
     const double sj = fitsRegion(count) ? fitted(fq, P, fit_[j]) : fit_[j];
-    const double interp = weightJ * sj + others;
-    // Paper eq. (6) at p_i, plus the field quadric over everything i and j stand for.
-    double local = std::abs(double(field_[i]) - interp) / range_;
+    // Where p_i lands among the new tets, to interpolate the coarse field there (the paper's
+    // local error, eq. 6). The first tet that contains p_i wins; if none does (p_i on the
+    // boundary, or round-off), the one it is least outside of. Only signs are needed until the
+    // tet is found: each barycentric numerator is affine in p_j and det > 0.
+    double bestInside = -kInf, interp = sj, removedQuality = 0;
+    int removed = 0;
+    for (StarTet& st : L.star) {
+      if (st.other[0] == j || st.other[1] == j || st.other[2] == j) {
+        removedQuality += 3.0 / st.kappa;
+        ++removed;
+        continue;
+      }
+      if (bestInside >= 0) continue;  // found; the loop goes on for the removed tets
+      if (!st.baryReady) prepareBary(st, p(i));
+      double num[4] = {st.detOld, 0, 0, 0}, lo = num[0];
+      for (int k = 1; k < 4; ++k) {
+        num[k] = st.g[k][0] * P[0] + st.g[k][1] * P[1] + st.g[k][2] * P[2] + st.h[k];
+        lo = std::min(lo, num[k]);
+      }
+      const double det = st.g[0][0] * P[0] + st.g[0][1] * P[1] + st.g[0][2] * P[2] + st.h[0];
+      if (lo < 0 && lo / det <= bestInside) continue;
+      bestInside = lo / det;
+      interp = (num[0] / det) * sj + ((num[1] / det) * st.f[0] + (num[2] / det) * st.f[1] + (num[3] / det) * st.f[2]);
+    }
+    // Paper eq. (6) at p_i, plus the field quadric over everything i and j stand for (our
+    // stand-in for eq. 5's sum over the region).
+    const double local = std::abs(double(field_[i]) - interp) / range_;
     const double x5[5] = {P[0], P[1], P[2], sj, 1.0};
-    double region = fq.weight > 0 ? std::sqrt(std::max(0.0, fq.eval(x5)) / fq.weight) / range_ : 0.0;
+    const double region = fq.weight > 0 ? std::sqrt(std::max(0.0, fq.eval(x5)) / fq.weight) / range_ : 0.0;
     const double ef = local + region;
     double eg = 0;
     if (boundary_[i]) {
@@ -529,18 +551,27 @@ class Simplifier {
       const double x4[4] = {P[0], P[1], P[2], 1.0};
       if (q.weight > 0) eg = std::sqrt(std::max(0.0, q.eval(x4)) / q.weight) / diag_;
     }
-    *fieldErr = float(ef);
+    c.fieldErr = float(ef);
     // The error terms are weighted by the square root of the number of input vertices i and j
     // stand for together: about the root of the summed squared error at those vertices (paper
     // eq. 5 sums over them), which is what adds to the RMS over the whole mesh, so a collapse
     // that spreads an error over a large region waits behind one that keeps it local. A count,
     // not a volume: graded CFD grids put most vertices in thin boundary layers, where a volume
     // weight made the error 1.8× larger on Blunt Fin. The manifest reports the unweighted E_f.
-    return std::sqrt(double(count)) * (opt_.weightGeometry * eg + opt_.weightField * ef);
+    c.base = std::sqrt(double(count)) * (opt_.weightGeometry * eg + opt_.weightField * ef);
+    // E_s after the collapse with every new tet at the best quality (3/κ = 1), as the tets of
+    // p_j's star that stay are known: most candidates lose without finishCost(). Scaled down a
+    // little so that round-off (its sums run in another order) never lifts it above E_s.
+    const double moved = double(L.star.size()) - removed, after = double(star_[j].size()) - removed + moved;
+    const double shapeBound = after > 0 ? std::max(0.0, 1.0 - (qualitySum_[j] - removedQuality + moved) / after) : 0.0;
+    c.cost = c.base + opt_.weightShape * shapeBound * (1 - 1e-9);
+    c.exact = false;
+    return c;
   }
 
-  double finishCost(Lane& L, uint32_t j, double lower, CollapseVerdict* verdict) {
+  bool finishCost(Lane& L, Candidate& c, CollapseVerdict* verdict) {
     prepareShape(L);
+    const uint32_t j = c.j;
     const double* P = p(j);
     const double PP = P[0] * P[0] + P[1] * P[1] + P[2] * P[2];
     double qualitySum = qualitySum_[j];
@@ -561,29 +592,24 @@ class Simplifier {
         faces += c0 * c0 + c1 * c1 + c2 * c2;
       }
       const double kappa = std::sqrt(edges * 0.25 * faces) / det;
-      if (3.0 / kappa < L.qualityFloor) return *verdict = CollapseVerdict::LowQuality, kInf;
+      if (3.0 / kappa < L.qualityFloor) return *verdict = CollapseVerdict::LowQuality, false;
       qualitySum += 3.0 / std::min<double>(kappa, kKappaCap);
       ++count;
     }
     // Mean of (κ − 3)/κ = 1 − 3/κ: the paper's κ − 3, mapped onto [0, 1) so that one sliver
     // cannot outweigh the field error (see simplify.h).
     double es = count > 0 ? std::max(0.0, 1.0 - qualitySum / double(count)) : 0.0;
-    return lower + opt_.weightShape * es;
+    c.cost = c.base + opt_.weightShape * es;
+    c.exact = true;
+    return true;
   }
 
-  double evaluate(Lane& L, uint32_t i, uint32_t j, float* fieldErr, CollapseVerdict* verdict) {
-    double lower = lowerBound(L, i, j, fieldErr, verdict);
-    return lower < kInf ? finishCost(L, j, lower, verdict) : kInf;
-  }
-
-  // The out-edges of i with their lower bounds (prepareStar(i) and neighbours(i) first).
+  // The legal out-edges of i with their lower bounds (prepareStar(i) and neighbours(i) first).
   void gatherCandidates(Lane& L, uint32_t i) {
     L.candidates.clear();
     for (uint32_t w : L.nbr) {
-      float ef;
       CollapseVerdict v;
-      double lb = lowerBound(L, i, w, &ef, &v);
-      if (lb < kInf) L.candidates.push_back({lb, w, ef, false});
+      if (legal(L, i, w, &v)) L.candidates.push_back(fieldTerms(L, i, w));
     }
   }
 
@@ -602,9 +628,7 @@ class Simplifier {
       Candidate& b = L.candidates[size_t(best)];
       if (b.exact) return best;
       CollapseVerdict v;
-      b.cost = finishCost(L, b.j, b.cost, &v);
-      b.exact = true;
-      if (!(b.cost < kInf)) L.candidates.erase(L.candidates.begin() + best);
+      if (!finishCost(L, b, &v)) L.candidates.erase(L.candidates.begin() + best);
     }
   }
 
