@@ -17,9 +17,16 @@ Result beginSplits(SplitReader& r, std::span<const uint8_t> payload, const Chunk
   if (!r.in.u32(count) || !r.in.u32(flags)) return fail(Status::Truncated, "split chunk: payload shorter than its header");
   if (count != info.splits)
     return corrupt(std::to_string(count) + " splits where the manifest says " + std::to_string(info.splits));
-  if (flags & ~(kSplitFlagLossless | kSplitFlagKeptValues)) return fail(Status::Unsupported, "split chunk: unknown flags");
+  if (flags & ~(kSplitFlagLossless | kSplitFlagKeptValues | kSplitFlagKeptIsoValue))
+    return fail(Status::Unsupported, "split chunk: unknown flags");
+  if ((flags & kSplitFlagKeptValues) && (flags & kSplitFlagKeptIsoValue)) return corrupt("both kinds of kept values flagged");
   r.lossless = flags & kSplitFlagLossless;
-  r.keptValues = flags & kSplitFlagKeptValues;
+  r.keptValues = flags & (kSplitFlagKeptValues | kSplitFlagKeptIsoValue);
+  r.keptField = -1;
+  if (flags & kSplitFlagKeptIsoValue) {
+    r.keptField = m.findField(m.isoField);
+    if (r.keptField < 0) return corrupt("kept values of a field the manifest does not have");
+  }
   if (r.lossless != m.lossless) return corrupt("lossless flag differs from the manifest");
   r.remaining = count;
   r.prevJ = 0;
@@ -88,14 +95,22 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
   float position[3];
   const size_t F = pm.mesh.fields.size();
   r.fields.resize(F);
+  // Kept values: of every field, or of keptField only (the others stay as they are).
   r.jFields.resize(r.keptValues ? F : 0);
+  size_t keptBegin = 0, keptEnd = r.jFields.size();
+  if (r.keptValues && r.keptField >= 0) {
+    if (size_t(r.keptField) >= F) return corrupt("kept values of a field the mesh does not have");
+    for (size_t f = 0; f < F; ++f) r.jFields[f] = pm.mesh.fields[f].values[j];
+    keptBegin = size_t(r.keptField);
+    keptEnd = keptBegin + 1;
+  }
   if (r.lossless) {
     for (float& x : position)
       if (!r.in.f32(x)) return fail(Status::Truncated, "split chunk: record ends early");
     for (float& x : r.fields)
       if (!r.in.f32(x)) return fail(Status::Truncated, "split chunk: record ends early");
-    for (float& x : r.jFields)
-      if (!r.in.f32(x)) return fail(Status::Truncated, "split chunk: record ends early");
+    for (size_t f = keptBegin; f < keptEnd; ++f)
+      if (!r.in.f32(r.jFields[f])) return fail(Status::Truncated, "split chunk: record ends early");
     for (float x : position)
       if (!std::isfinite(x)) return fail(Status::NonFinite, "split chunk: a vertex position is not finite");
   } else {
@@ -112,7 +127,7 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
       if (!predicted(q.position[k], pj[k], position[k])) return corrupt("a position leaves the grid or the record ends early");
     for (size_t f = 0; f < F; ++f)
       if (!predicted(q.field[f], pm.mesh.fields[f].values[j], r.fields[f])) return corrupt("a field value leaves its range or the record ends early");
-    for (size_t f = 0; f < r.jFields.size(); ++f)
+    for (size_t f = keptBegin; f < keptEnd; ++f)
       if (!predicted(q.field[f], pm.mesh.fields[f].values[j], r.jFields[f])) return corrupt("a field value leaves its range or the record ends early");
   }
   if (r.remaining == 1 && !r.in.atEnd()) return corrupt("bytes after the last split");

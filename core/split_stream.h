@@ -15,7 +15,11 @@
 namespace tetstream {
 
 inline constexpr uint32_t kSplitFlagLossless = 1;
-inline constexpr uint32_t kSplitFlagKeptValues = 2;  // records also carry j's values after the split
+// Records also carry p_j's value after the split: of every field (bit 1, as the first packers
+// with fitted values wrote them), or of the manifest's isoField only, the one field whose values the packer fits
+// (bit 2). Never both.
+inline constexpr uint32_t kSplitFlagKeptValues = 2;
+inline constexpr uint32_t kSplitFlagKeptIsoValue = 4;
 
 // How a split record lists its recreated tets (i, j, a, b) (FORMAT.md §4).
 enum class RingMode : uint32_t {
@@ -30,7 +34,8 @@ struct SplitReader {
   uint32_t remaining = 0;  // records left in the chunk
   uint32_t prevJ = 0;
   bool lossless = false;
-  bool keptValues = false;
+  bool keptValues = false;   // records carry kept values
+  int keptField = -1;        // ... of this field only (-1: of every field)
   // scratch, reused across records
   std::vector<uint32_t> star, candidates, moved, newTets, ring;
   std::vector<float> fields, jFields;

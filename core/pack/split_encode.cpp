@@ -179,8 +179,7 @@ class Encoder {
       jFields_[f] = steered ? snapped(f, log.jValue[c]) : pm_.mesh.fields[f].values[js];
       putValue(fields_[f], pm_.mesh.fields[f].values[js], q_.field[f]);
     }
-    if (fit)
-      for (size_t f = 0; f < F; ++f) putValue(jFields_[f], pm_.mesh.fields[f].values[js], q_.field[f]);
+    if (fit) putValue(jFields_[size_t(s_.valuesField)], pm_.mesh.fields[size_t(s_.valuesField)].values[js], q_.field[size_t(s_.valuesField)]);
     changed_.clear();
     applySplit(pm_, SplitOp{js, moved_, newTets_, pi, fields_.data(), fit ? jFields_.data() : nullptr}, changed_);
   }
@@ -237,7 +236,7 @@ class Encoder {
     const uint32_t index = uint32_t(jobs_.size());
     beginChunk(job.raw, ChunkKind::Splits, index);
     putU32(job.raw, inChunk_);
-    putU32(job.raw, (q_.lossless ? kSplitFlagLossless : 0) | (s_.valuesField >= 0 ? kSplitFlagKeptValues : 0));
+    putU32(job.raw, (q_.lossless ? kSplitFlagLossless : 0) | (s_.valuesField >= 0 ? kSplitFlagKeptIsoValue : 0));
     job.raw.insert(job.raw.end(), records_.begin(), records_.end());
     job.info.kind = ChunkKind::Splits;
     job.info.vertices = pm_.vertexCount();
@@ -308,6 +307,9 @@ class Encoder {
 Result encodeStream(const TetMesh& mesh, const SimplifyResult& s, const Manifest& m, const StreamOptions& opt,
                     EncodedStream& out) {
   out = EncodedStream{};
+  // Kept values are written for the manifest's isoField only (split flag bit 2).
+  if (s.valuesField >= 0 && m.findField(m.isoField) != s.valuesField)
+    return fail(Status::Unsupported, "fitted values of a field other than the manifest's isoField");
   Encoder e(mesh, s, m, opt, out);
   return e.run();
 }

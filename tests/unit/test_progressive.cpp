@@ -19,7 +19,9 @@
 #include <zstd.h>
 
 #include "adjacency.h"
+#include "chunk.h"
 #include "dataset.h"
+#include "split_stream.h"
 #include "pack/chunk_encode.h"
 #include "pack/generators.h"
 #include "pack/packer.h"
@@ -420,6 +422,41 @@ TEST(Progressive, CorruptSplitChunkKeepsTheLastCompleteLevel) {
   EXPECT_EQ(applyChunk(ds, 2, bytes).status, Status::HashMismatch);
   EXPECT_EQ(ds.pm.vertexCount(), v);
   EXPECT_EQ(ds.pm.tetCount(), t);
+}
+
+// Split flag bit 2: records carry p_j's kept value of the isoField only. Bit 1 (the first packers
+// with fitted values) carried one per field; with one field the two read the same. Both at once is refused.
+TEST(Progressive, KeptValueFlagsAreReadAsDocumented) {
+  PackOptions o;
+  o.chunkKb = 2;
+  TetMesh m = harmonic(10);
+  m.fields.resize(1);
+  std::string dir = pack("kept-flags", m, o);
+  Dataset ref;
+  ASSERT_TRUE(loadPackedDir(dir, ref, 2));
+  // Chunk 1 with its flags word replaced, re-compressed, and the manifest entry to match.
+  auto withFlags = [&](Dataset& ds, uint32_t flags) {
+    const ChunkInfo info = ds.manifest.chunks[1];
+    std::vector<uint8_t> file = test::loadBytes(dir + "/" + info.file), raw(info.rawBytes);
+    EXPECT_EQ(ZSTD_decompress(raw.data(), raw.size(), file.data(), file.size()), raw.size());
+    uint32_t old;
+    std::memcpy(&old, &raw[kChunkHeaderBytes + 4], 4);
+    EXPECT_EQ(old, kSplitFlagKeptIsoValue);
+    std::memcpy(&raw[kChunkHeaderBytes + 4], &flags, 4);
+    ChunkInfo& entry = ds.manifest.chunks[1];
+    EXPECT_TRUE(finishChunk(raw, 3, file, entry));
+    return applyChunk(ds, 1, file);
+  };
+  Dataset both;
+  ASSERT_TRUE(loadPackedDir(dir, both, 1));
+  EXPECT_EQ(withFlags(both, kSplitFlagKeptValues | kSplitFlagKeptIsoValue).status, Status::Corrupt);
+  EXPECT_EQ(both.pm.vertexCount(), ref.manifest.chunks[0].vertices);
+  Dataset old;
+  ASSERT_TRUE(loadPackedDir(dir, old, 1));
+  Result r = withFlags(old, kSplitFlagKeptValues);
+  ASSERT_TRUE(r) << r.message;
+  EXPECT_EQ(old.pm.mesh.tets, ref.pm.mesh.tets);
+  EXPECT_EQ(old.pm.mesh.fields[0].values, ref.pm.mesh.fields[0].values);
 }
 
 // ------------------------------------------------------------------ legality on tiny meshes
