@@ -116,6 +116,8 @@ void initProgressive(ProgressiveMesh& pm, TetMesh base) {
   pm.splitJ.clear();
   pm.splitTetsBefore.clear();
   pm.splitJValues.clear();
+  pm.keptFirst = pm.keptCount = 0;
+  pm.keptFixed = false;
   pm.baseVertices = pm.mesh.vertexCount();
   pm.baseTets = pm.mesh.tetCount();
 }
@@ -151,11 +153,12 @@ void applySplit(ProgressiveMesh& pm, const SplitOp& op, std::vector<uint32_t>& c
   m.positions.insert(m.positions.end(), op.position, op.position + 3);
   for (size_t f = 0; f < m.fields.size(); ++f) m.fields[f].values.push_back(op.fields[f]);
   bool jValuesChange = false;
-  for (size_t f = 0; f < m.fields.size(); ++f) {
-    float& value = m.fields[f].values[op.j];
+  assert(pm.keptFirst + pm.keptCount <= m.fields.size());
+  for (uint32_t k = 0; k < pm.keptCount; ++k) {
+    float& value = m.fields[pm.keptFirst + k].values[op.j];
     pm.splitJValues.push_back(value);
-    if (op.jFields && !sameBits(value, op.jFields[f])) {
-      value = op.jFields[f];
+    if (op.jFields && !sameBits(value, op.jFields[k])) {
+      value = op.jFields[k];
       jValuesChange = true;
     }
   }
@@ -189,15 +192,15 @@ void undoSplit(ProgressiveMesh& pm, std::vector<uint32_t>& changed) {
   const uint32_t i = m.vertexCount() - 1;
   pm.splitJ.pop_back();
   pm.splitTetsBefore.pop_back();
-  const size_t F = m.fields.size();
+  const size_t K = pm.keptCount;
   bool jValuesChange = false;
-  for (size_t f = 0; f < F; ++f) {
-    float& value = m.fields[f].values[j];
-    const float before = pm.splitJValues[pm.splitJValues.size() - F + f];
+  for (size_t k = 0; k < K; ++k) {
+    float& value = m.fields[pm.keptFirst + k].values[j];
+    const float before = pm.splitJValues[pm.splitJValues.size() - K + k];
     jValuesChange |= !sameBits(value, before);
     value = before;
   }
-  pm.splitJValues.resize(pm.splitJValues.size() - F);
+  pm.splitJValues.resize(pm.splitJValues.size() - K);
 
   // Drop the new tets' corners from their vertices (once per vertex), then the tets.
   const uint32_t firstDead = 4 * tetsBefore;

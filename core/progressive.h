@@ -61,7 +61,8 @@ class StarPool {
 // One split, decoded: the new vertex i gets id vertexCount(); `moved` lists tets (ids, all in
 // star(j)) whose j slot becomes i; `newTets` holds 4 vertex ids per recreated tet (using the
 // new id for i); `position` 3 floats; `fields` one value per field; `jFields`, when given, the
-// values j takes back (one per field: the packer fits j's value to the region it stood for).
+// values j takes back for the mesh's kept fields (ProgressiveMesh::keptFirst, keptCount: the
+// packer fits j's value to the region it stood for).
 struct SplitOp {
   uint32_t j = 0;
   std::span<const uint32_t> moved;
@@ -76,7 +77,13 @@ struct ProgressiveMesh {
   StarPool stars;  // the corners around each vertex
   // Undo log, one entry per applied split: the kept vertex and the tet count before the split.
   std::vector<uint32_t> splitJ, splitTetsBefore;
-  std::vector<float> splitJValues;  // per applied split, j's field values before it (one per field)
+  std::vector<float> splitJValues;  // per applied split, j's kept-field values before it
+  // The fields whose value at j a split may give back: [keptFirst, keptFirst + keptCount). The
+  // same for every split of a dataset (FORMAT.md §4), so the undo log holds keptCount values a
+  // split, not one per field: the isoField's (1), none (packed with --samples) or, in streams
+  // of the first packers with fitted values, every field. keptFixed: set by the first split.
+  uint32_t keptFirst = 0, keptCount = 0;
+  bool keptFixed = false;
   uint32_t baseVertices = 0, baseTets = 0;
   // Scratch for de-duplicating vertices without sorting: a stamp per vertex.
   mutable std::vector<uint32_t> seen;

@@ -95,15 +95,15 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
   float position[3];
   const size_t F = pm.mesh.fields.size();
   r.fields.resize(F);
-  // Kept values: of every field, or of keptField only (the others stay as they are).
-  r.jFields.resize(r.keptValues ? F : 0);
-  size_t keptBegin = 0, keptEnd = r.jFields.size();
-  if (r.keptValues && r.keptField >= 0) {
-    if (size_t(r.keptField) >= F) return corrupt("kept values of a field the mesh does not have");
-    for (size_t f = 0; f < F; ++f) r.jFields[f] = pm.mesh.fields[f].values[j];
-    keptBegin = size_t(r.keptField);
-    keptEnd = keptBegin + 1;
-  }
+  // Kept values: of every field, or of keptField only. Every split chunk of a dataset carries
+  // the same kind (the undo log holds that many values a split).
+  const size_t keptBegin = r.keptField >= 0 ? size_t(r.keptField) : 0;
+  const size_t keptEnd = !r.keptValues ? 0 : r.keptField >= 0 ? keptBegin + 1 : F;
+  if (keptEnd > F) return corrupt("kept values of a field the mesh does not have");
+  const uint32_t keptCount = uint32_t(keptEnd - keptBegin), keptFirst = keptCount ? uint32_t(keptBegin) : 0;
+  if (pm.keptFixed && (pm.keptFirst != keptFirst || pm.keptCount != keptCount))
+    return corrupt("kept values of other fields than the dataset's earlier splits");
+  r.jFields.resize(F);
   if (r.lossless) {
     for (float& x : position)
       if (!r.in.f32(x)) return fail(Status::Truncated, "split chunk: record ends early");
@@ -132,7 +132,10 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
   }
   if (r.remaining == 1 && !r.in.atEnd()) return corrupt("bytes after the last split");
 
-  SplitOp op{j, r.moved, r.newTets, position, r.fields.data(), r.keptValues ? r.jFields.data() : nullptr};
+  pm.keptFirst = keptFirst;
+  pm.keptCount = keptCount;
+  pm.keptFixed = true;
+  SplitOp op{j, r.moved, r.newTets, position, r.fields.data(), keptCount ? r.jFields.data() + keptFirst : nullptr};
   applySplit(pm, op, changed);
   r.prevJ = j;
   --r.remaining;

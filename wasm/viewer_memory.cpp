@@ -12,7 +12,7 @@ constexpr double kPerVertex = 12 + 9 + 4;   // position; star block (start, size
 constexpr double kPerFieldValue = 4;
 constexpr double kPerTet = 16 + 23;         // vertex ids; 4 corners in the star pool at 1.4 slots each
 constexpr double kPerSplit = 4 + 4 + 4;     // undo log (splitJ, splitTetsBefore); record offset
-constexpr double kPerSplitField = 4;        // undo log: j's value before the split, per field
+constexpr double kPerSplitKept = 4;         // undo log: j's isoField value before the split (FORMAT.md §4, flag bit 2)
 constexpr double kSurfacePerTet = 56;       // isosurface + interval tree, measured 49 plus margin
 constexpr double kHullPerTriangle = 110;
 constexpr double kFixed = 1 << 20;          // zstd context, scratch, the JSON of the manifest
@@ -34,7 +34,7 @@ uint64_t estimateLevelBytes(const Manifest& m, uint32_t chunks) {
   const double v = last.vertices, t = last.tets;
   const double hullTriangles = 4 * std::cbrt(t * t);  // a cube of 6n³ tets has 12n² ≈ 3.6 t^(2/3)
   const double bytes = kFixed + v * (kPerVertex + kPerFieldValue * double(m.fields.size())) + t * kPerTet +
-                       splits * (kPerSplit + kPerSplitField * double(m.fields.size())) + payloads + largestRaw + t * kSurfacePerTet +
+                       splits * (kPerSplit + kPerSplitKept) + payloads + largestRaw + t * kSurfacePerTet +
                        hullTriangles * kHullPerTriangle;
   return uint64_t(bytes);
 }

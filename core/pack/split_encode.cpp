@@ -81,6 +81,11 @@ class Encoder {
       for (int k = 0; k < 4; ++k) b.tets.push_back(out_.streamVertexOf[s_.tets[4 * size_t(t) + k]]);
     }
     initProgressive(pm_, b);
+    if (s_.valuesField >= 0) {  // splits give j back its value of the fitted field only
+      pm_.keptFirst = uint32_t(s_.valuesField);
+      pm_.keptCount = 1;
+      pm_.keptFixed = true;
+    }
   }
 
   void startChunk() {
@@ -181,7 +186,7 @@ class Encoder {
     }
     if (fit) putValue(jFields_[size_t(s_.valuesField)], pm_.mesh.fields[size_t(s_.valuesField)].values[js], q_.field[size_t(s_.valuesField)]);
     changed_.clear();
-    applySplit(pm_, SplitOp{js, moved_, newTets_, pi, fields_.data(), fit ? jFields_.data() : nullptr}, changed_);
+    applySplit(pm_, SplitOp{js, moved_, newTets_, pi, fields_.data(), fit ? &jFields_[size_t(s_.valuesField)] : nullptr}, changed_);
   }
 
   // Closes the current chunk and compresses it on another thread while encoding goes on. The

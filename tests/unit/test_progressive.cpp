@@ -459,6 +459,42 @@ TEST(Progressive, KeptValueFlagsAreReadAsDocumented) {
   EXPECT_EQ(old.pm.mesh.fields[0].values, ref.pm.mesh.fields[0].values);
 }
 
+// The undo log holds one value a split, the isoField's, however many fields there are (none
+// with --samples); a chunk whose records carry another kind of kept values than the splits
+// before it is refused and leaves the level as it was.
+TEST(Progressive, UndoLogKeepsOnlyTheFittedFieldsValue) {
+  PackOptions o;
+  o.chunkKb = 2;
+  const TetMesh m = harmonic(10);
+  ASSERT_EQ(m.fields.size(), 2u);
+  std::string dir = pack("undo-log", m, o);
+  Dataset ds;
+  ASSERT_TRUE(loadPackedDir(dir, ds, 3));
+  ASSERT_GT(ds.pm.splitsApplied(), 0u);
+  EXPECT_EQ(ds.pm.splitJValues.size(), ds.pm.splitsApplied());
+  EXPECT_EQ(ds.pm.keptFirst, uint32_t(ds.manifest.findField(ds.manifest.isoField)));
+  // Chunk 3 written without kept values (as --samples would), after two chunks with them.
+  const ChunkInfo info = ds.manifest.chunks[3];
+  std::vector<uint8_t> file = test::loadBytes(dir + "/" + info.file), raw(info.rawBytes);
+  ASSERT_EQ(ZSTD_decompress(raw.data(), raw.size(), file.data(), file.size()), raw.size());
+  const uint32_t none = 0;
+  std::memcpy(&raw[kChunkHeaderBytes + 4], &none, 4);
+  ASSERT_TRUE(finishChunk(raw, 3, file, ds.manifest.chunks[3]));
+  const uint32_t v = ds.pm.vertexCount();
+  Result r = applyChunk(ds, 3, file);
+  EXPECT_EQ(r.status, Status::Corrupt) << r.message;
+  EXPECT_NE(r.message.find("kept values"), std::string::npos) << r.message;
+  EXPECT_EQ(ds.pm.vertexCount(), v);
+
+  PackOptions samples = o;
+  samples.fitValues = false;
+  std::string plain = pack("undo-log-samples", m, samples);
+  Dataset ps;
+  ASSERT_TRUE(loadPackedDir(plain, ps));
+  EXPECT_GT(ps.pm.splitsApplied(), 0u);
+  EXPECT_TRUE(ps.pm.splitJValues.empty());
+}
+
 // ------------------------------------------------------------------ legality on tiny meshes
 
 namespace {
