@@ -201,6 +201,7 @@ void undoSplit(ProgressiveMesh& pm, std::vector<uint32_t>& changed) {
     value = before;
   }
   pm.splitJValues.resize(pm.splitJValues.size() - K);
+  if (pm.splitJ.empty()) pm.keptFixed = false;  // back at the base: the next split sets the kind again
 
   // Drop the new tets' corners from their vertices (once per vertex), then the tets.
   const uint32_t firstDead = 4 * tetsBefore;

@@ -81,7 +81,8 @@ struct ProgressiveMesh {
   // The fields whose value at j a split may give back: [keptFirst, keptFirst + keptCount). The
   // same for every split of a dataset (FORMAT.md §4), so the undo log holds keptCount values a
   // split, not one per field: the isoField's (1), none (packed with --samples) or, in streams
-  // of the first packers with fitted values, every field. keptFixed: set by the first split.
+  // of the first packers with fitted values, every field. keptFixed: set by the first split,
+  // cleared when the last one is undone.
   uint32_t keptFirst = 0, keptCount = 0;
   bool keptFixed = false;
   uint32_t baseVertices = 0, baseTets = 0;
