@@ -21,12 +21,15 @@ Result beginSplits(SplitReader& r, std::span<const uint8_t> payload, const Chunk
     return fail(Status::Unsupported, "split chunk: unknown flags");
   if ((flags & kSplitFlagKeptValues) && (flags & kSplitFlagKeptIsoValue)) return corrupt("both kinds of kept values flagged");
   r.lossless = flags & kSplitFlagLossless;
-  r.keptValues = flags & (kSplitFlagKeptValues | kSplitFlagKeptIsoValue);
-  r.keptField = -1;
+  r.keptFirst = r.keptCount = 0;
+  if (flags & kSplitFlagKeptValues) r.keptCount = uint32_t(m.fields.size());
   if (flags & kSplitFlagKeptIsoValue) {
-    r.keptField = m.findField(m.isoField);
-    if (r.keptField < 0) return corrupt("kept values of a field the manifest does not have");
+    const int f = m.findField(m.isoField);
+    if (f < 0) return corrupt("kept values of a field the manifest does not have");
+    r.keptFirst = uint32_t(f);
+    r.keptCount = 1;
   }
+  r.jFields.resize(r.keptCount);
   if (r.lossless != m.lossless) return corrupt("lossless flag differs from the manifest");
   r.remaining = count;
   r.prevJ = 0;
@@ -95,22 +98,18 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
   float position[3];
   const size_t F = pm.mesh.fields.size();
   r.fields.resize(F);
-  // Kept values: of every field, or of keptField only. Every split chunk of a dataset carries
-  // the same kind (the undo log holds that many values a split).
-  const size_t keptBegin = r.keptField >= 0 ? size_t(r.keptField) : 0;
-  const size_t keptEnd = !r.keptValues ? 0 : r.keptField >= 0 ? keptBegin + 1 : F;
-  if (keptEnd > F) return corrupt("kept values of a field the mesh does not have");
-  const uint32_t keptCount = uint32_t(keptEnd - keptBegin), keptFirst = keptCount ? uint32_t(keptBegin) : 0;
-  if (pm.keptFixed && (pm.keptFirst != keptFirst || pm.keptCount != keptCount))
+  // Every split chunk of a dataset carries the same kind of kept values (the undo log holds
+  // that many values a split).
+  if (r.keptFirst + r.keptCount > F) return corrupt("kept values of a field the mesh does not have");
+  if (pm.keptFixed && (pm.keptFirst != r.keptFirst || pm.keptCount != r.keptCount))
     return corrupt("kept values of other fields than the dataset's earlier splits");
-  r.jFields.resize(F);
   if (r.lossless) {
     for (float& x : position)
       if (!r.in.f32(x)) return fail(Status::Truncated, "split chunk: record ends early");
     for (float& x : r.fields)
       if (!r.in.f32(x)) return fail(Status::Truncated, "split chunk: record ends early");
-    for (size_t f = keptBegin; f < keptEnd; ++f)
-      if (!r.in.f32(r.jFields[f])) return fail(Status::Truncated, "split chunk: record ends early");
+    for (float& x : r.jFields)
+      if (!r.in.f32(x)) return fail(Status::Truncated, "split chunk: record ends early");
     for (float x : position)
       if (!std::isfinite(x)) return fail(Status::NonFinite, "split chunk: a vertex position is not finite");
   } else {
@@ -127,15 +126,17 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
       if (!predicted(q.position[k], pj[k], position[k])) return corrupt("a position leaves the grid or the record ends early");
     for (size_t f = 0; f < F; ++f)
       if (!predicted(q.field[f], pm.mesh.fields[f].values[j], r.fields[f])) return corrupt("a field value leaves its range or the record ends early");
-    for (size_t f = keptBegin; f < keptEnd; ++f)
-      if (!predicted(q.field[f], pm.mesh.fields[f].values[j], r.jFields[f])) return corrupt("a field value leaves its range or the record ends early");
+    for (uint32_t k = 0; k < r.keptCount; ++k) {
+      const size_t f = r.keptFirst + k;
+      if (!predicted(q.field[f], pm.mesh.fields[f].values[j], r.jFields[k])) return corrupt("a field value leaves its range or the record ends early");
+    }
   }
   if (r.remaining == 1 && !r.in.atEnd()) return corrupt("bytes after the last split");
 
-  pm.keptFirst = keptFirst;
-  pm.keptCount = keptCount;
+  pm.keptFirst = r.keptFirst;
+  pm.keptCount = r.keptCount;
   pm.keptFixed = true;
-  SplitOp op{j, r.moved, r.newTets, position, r.fields.data(), keptCount ? r.jFields.data() + keptFirst : nullptr};
+  SplitOp op{j, r.moved, r.newTets, position, r.fields.data(), r.keptCount ? r.jFields.data() : nullptr};
   applySplit(pm, op, changed);
   r.prevJ = j;
   --r.remaining;

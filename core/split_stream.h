@@ -34,11 +34,11 @@ struct SplitReader {
   uint32_t remaining = 0;  // records left in the chunk
   uint32_t prevJ = 0;
   bool lossless = false;
-  bool keptValues = false;   // records carry kept values
-  int keptField = -1;        // ... of this field only (-1: of every field)
+  // Records carry j's kept values of fields [keptFirst, keptFirst + keptCount) (from the flags).
+  uint32_t keptFirst = 0, keptCount = 0;
   // scratch, reused across records
   std::vector<uint32_t> star, candidates, moved, newTets, ring;
-  std::vector<float> fields, jFields;
+  std::vector<float> fields, jFields;  // jFields: keptCount values
 };
 
 // Starts reading a split chunk's payload (after the chunk header). The payload must outlive

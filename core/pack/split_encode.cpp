@@ -175,18 +175,19 @@ class Encoder {
     // p_i's values as they were when it was removed, then (with fitted values) the values p_j
     // had before the collapse, which the split gives back.
     const size_t F = mesh_.fields.size();
-    const bool fit = s_.valuesField >= 0;
     fields_.resize(F);
-    jFields_.resize(F);
     for (size_t f = 0; f < F; ++f) {
-      const bool steered = int(f) == s_.valuesField;
-      fields_[f] = steered ? snapped(f, log.iValue[c]) : mesh_.fields[f].values[i];
-      jFields_[f] = steered ? snapped(f, log.jValue[c]) : pm_.mesh.fields[f].values[js];
+      fields_[f] = int(f) == s_.valuesField ? snapped(f, log.iValue[c]) : mesh_.fields[f].values[i];
       putValue(fields_[f], pm_.mesh.fields[f].values[js], q_.field[f]);
     }
-    if (fit) putValue(jFields_[size_t(s_.valuesField)], pm_.mesh.fields[size_t(s_.valuesField)].values[js], q_.field[size_t(s_.valuesField)]);
+    float jValue = 0;
+    if (s_.valuesField >= 0) {
+      const size_t f = size_t(s_.valuesField);
+      jValue = snapped(f, log.jValue[c]);
+      putValue(jValue, pm_.mesh.fields[f].values[js], q_.field[f]);
+    }
     changed_.clear();
-    applySplit(pm_, SplitOp{js, moved_, newTets_, pi, fields_.data(), fit ? &jFields_[size_t(s_.valuesField)] : nullptr}, changed_);
+    applySplit(pm_, SplitOp{js, moved_, newTets_, pi, fields_.data(), s_.valuesField >= 0 ? &jValue : nullptr}, changed_);
   }
 
   // Closes the current chunk and compresses it on another thread while encoding goes on. The
@@ -297,7 +298,7 @@ class Encoder {
   EncodedStream& out_;
   Quantizer q_;
   ProgressiveMesh pm_;
-  std::vector<float> prefixMax_, fields_, jFields_;
+  std::vector<float> prefixMax_, fields_;
   std::vector<uint8_t> records_;
   std::vector<Pair> pairs_, chain_;
   std::deque<Job> jobs_;  // chunks being compressed, in order (stable addresses)
