@@ -447,6 +447,12 @@ void queueWork() {
   });
 }
 
+// New work (a chunk, a level, resuming) starts at once rather than at the next frame, which on a
+// software GL may be 100-200 ms away while the GPU process renders the last one.
+void workOnChange() {
+  if (refining(g_app.state) || treePending(g_app.state)) queueWork();
+}
+
 }  // namespace
 
 // One refinement slice (called from the MessageChannel task queued above; not for the shell).
@@ -651,7 +657,9 @@ EMSCRIPTEN_KEEPALIVE int ts_add_chunk(int index, const uint8_t* bytes, int len) 
     failLoad(g_app.state, "The page passed an invalid chunk to the viewer.");
     return 0;
   }
-  return addChunk(g_app.state, uint32_t(index), std::span<const uint8_t>(bytes, size_t(len))).ok() ? 1 : 0;
+  const bool ok = addChunk(g_app.state, uint32_t(index), std::span<const uint8_t>(bytes, size_t(len))).ok();
+  workOnChange();
+  return ok ? 1 : 0;
 }
 
 // timeMs: performance.now() when the figures were taken (samples taken before the viewer had the
@@ -665,11 +673,13 @@ EMSCRIPTEN_KEEPALIVE void ts_set_paused(int paused) {
   requestRedraw();
   setPaused(g_app.state, paused != 0);
   notifyPause();
+  workOnChange();
 }
 
 EMSCRIPTEN_KEEPALIVE void ts_set_level(double fraction) {
   requestRedraw();
   setLevelFraction(g_app.state, fraction);
+  workOnChange();
 }
 
 EMSCRIPTEN_KEEPALIVE void ts_set_isovalue(float value) {

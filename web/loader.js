@@ -13,12 +13,19 @@
 // kept past the check, before it.
 import { fetchBytes, retryDelayMs, seconds, STALL_SECONDS } from './net.js';
 
-// Requests under way: at most MAX_IN_FLIGHT, and past two only while the bytes still to come of
-// those under way are fewer than MAX_OUTSTANDING_BYTES. Equal chunks sharing a link fairly
-// finish together, and a new batch then starts a round trip later with the link idle; counting
-// outstanding bytes starts the next request while the others are still arriving instead.
+// Chunks should arrive one after another, each at the link's full rate: chunks sharing a link
+// finish together, so the viewer waits for the whole batch and then gets all of its work at
+// once, which it is still applying long after the last byte. So a request starts when the bytes
+// still to come of those under way drop below the lead: what the link delivers while a request
+// waits for its first byte (measured: rate of finished responses, time to their first byte),
+// with a margin, so that the next response starts as the last one ends and the link never idles.
+// At most MAX_IN_FLIGHT requests (many small chunks on a long link).
 export const MAX_IN_FLIGHT = 6;
-export const MAX_OUTSTANDING_BYTES = 1 << 20;
+export const MIN_LEAD_BYTES = 4 << 10;
+export const MAX_LEAD_BYTES = 1 << 20;
+export const FIRST_LEAD_BYTES = 256 << 10;  // before anything is measured
+export const LEAD_MARGIN = 1.25;
+export const STARTUP_SECONDS = 1;
 // ... until the base is in: it alone decides when the first surface appears, so it shares the
 // link with one more request only (which keeps the link busy while the base's last bytes come).
 export const MAX_IN_FLIGHT_BEFORE_BASE = 2;
@@ -27,6 +34,17 @@ export const MAX_AHEAD_BYTES = 64 << 20;    // ... and at most this much held in
 export const MAX_DAMAGED = 4;               // a chunk damaged this often in a row is broken at the source
 
 const grouped = (n) => n.toLocaleString('en-US');
+
+// The network's timing of a finished request (Resource Timing; the project's server and the
+// documented nginx config send Timing-Allow-Origin for other origins): time to the first byte
+// and transfer time, which a busy main thread does not stretch as it does callback times.
+function networkTiming(url) {
+  if (typeof performance === 'undefined' || !performance.getEntriesByName || typeof location === 'undefined') return null;
+  const entries = performance.getEntriesByName(new URL(url, location.href).href, 'resource');
+  const e = entries[entries.length - 1];
+  if (!e || !(e.responseStart > e.startTime) || !(e.responseEnd > e.responseStart)) return null;
+  return { firstByteMs: e.responseStart - e.startTime, transferMs: e.responseEnd - e.responseStart };
+}
 
 export class ChunkLoader {
   // urls, names (as the manifest gives them, for messages), sizes: per chunk.
@@ -49,6 +67,8 @@ export class ChunkLoader {
     this.networkBytes = 0;         // off the wire, failed and aborted requests included
     this.retries = 0;              // requests made again after a failure
     this.refused = 0;              // responses the check refused (never handed over)
+    this.rate = 0;                 // bytes/s of the last finished response, first byte to last
+    this.firstByteMs = 0;          // time to the first byte of the last response that had one
     this.paused = false;
     this.stopped = false;
     this.failure = null;           // { index, message }: the first chunk that cannot be had
@@ -86,6 +106,27 @@ export class ChunkLoader {
     this.pump();
   }
 
+  // Link rate and time to first byte from a finished response: the network's own timing when
+  // the browser gives it, else callback times (the least time to a first byte seen, as a busy
+  // main thread only adds to it).
+  measure(i, entry, bytes) {
+    const t = networkTiming(this.urls[i]);
+    const firstByteMs = t ? t.firstByteMs : entry.firstByte - entry.start;
+    const transferMs = t ? t.transferMs : performance.now() - entry.firstByte;
+    if (entry.firstByte && firstByteMs > 0) this.firstByteMs = t || !this.firstByteMs ? firstByteMs : Math.min(this.firstByteMs, firstByteMs);
+    if (transferMs > 0 && bytes >= MIN_LEAD_BYTES) this.rate = bytes / (transferMs / 1000);
+  }
+
+  // Bytes still to come of the requests under way below which the next one starts (see above).
+  lead() {
+    if (!this.rate || !this.firstByteMs) return FIRST_LEAD_BYTES;
+    // Until the viewer is attached its program is starting, and the main thread may run no
+    // callbacks for a while (compiling, the base, the first surface: 0.3 s to over 1 s here):
+    // requests not opened before would wait with the link idle.
+    const seconds = this.attached ? this.firstByteMs / 1000 * LEAD_MARGIN : STARTUP_SECONDS;
+    return Math.min(MAX_LEAD_BYTES, Math.max(MIN_LEAD_BYTES, this.rate * seconds));
+  }
+
   pump() {
     if (this.paused || this.stopped || this.failure) return;
     const end = Math.min(this.allowed, this.warmed ? this.next + MAX_AHEAD : 1);
@@ -102,7 +143,7 @@ export class ChunkLoader {
     for (let i = this.next; i < end && this.inFlight.size < limit; i++) {
       if (this.arrived.has(i) || this.inFlight.has(i) || this.waiting.has(i)) continue;
       if (i > this.next && ahead + this.sizes[i] > MAX_AHEAD_BYTES) break;
-      if (this.inFlight.size >= 2 && outstanding >= MAX_OUTSTANDING_BYTES) break;
+      if (this.inFlight.size > 0 && outstanding >= this.lead()) break;
       ahead += this.sizes[i];
       outstanding += this.sizes[i];
       this.fetchChunk(i);
@@ -110,7 +151,7 @@ export class ChunkLoader {
   }
 
   fetchChunk(i) {
-    const entry = { controller: new AbortController(), received: 0 };
+    const entry = { controller: new AbortController(), received: 0, start: performance.now(), firstByte: 0 };
     this.inFlight.set(i, entry);
     const trouble = this.trouble.get(i);
     if (trouble) this.retries++;
@@ -121,13 +162,15 @@ export class ChunkLoader {
       // After a failure, past any cache: a proxy or the browser may hold the damaged copy.
       cache: trouble ? 'reload' : 'default',
       onProgress: (n) => {
+        if (!entry.firstByte) entry.firstByte = performance.now();
         entry.received += n;
         this.networkBytes += n;
-        if (this.inFlight.size >= 2 && this.inFlight.size < MAX_IN_FLIGHT) this.pump(); // outstanding bytes dropped
+        if (this.inFlight.size < MAX_IN_FLIGHT) this.pump(); // outstanding bytes dropped
       },
     }).then((bytes) => {
       if (this.inFlight.get(i) !== entry) return; // dropped meanwhile (pause, stop)
       this.inFlight.delete(i);
+      this.measure(i, entry, bytes.length);
       if (this.attached) {
         this.accept(i, bytes);
       } else {

@@ -50,7 +50,7 @@ class Encoder {
       encodeSplit(c);
       ++inChunk_;
       if (opt_.progress && (c & 4095) == 0) opt_.progress(C - c, C);
-      if (records_.size() >= target_ * ratio_ || c == 0)
+      if (records_.size() >= target_ * ratio_ || c == 0 || tapers(C - c, c))
         if (Result r = flushChunk(C - c); !r) {
           collect();
           return r;
@@ -88,7 +88,18 @@ class Encoder {
     }
   }
 
+  // Towards the end chunks halve again (a chunk ends once it holds about as many bytes as the
+  // splits still to come would take, at the mean size so far), down to the first chunk's size:
+  // a viewer that keeps pace with the link then has a small last chunk to apply when the last
+  // byte arrives, instead of a whole large one. A rest smaller than that stays in the chunk.
+  bool tapers(uint32_t done, uint32_t left) const {
+    const double least = opt_.firstChunkBytes * ratio_;
+    const double rest = double(left) * double(flushedRaw_ + records_.size()) / double(done);
+    return double(records_.size()) >= std::max(least, rest) && rest >= least;
+  }
+
   void startChunk() {
+    flushedRaw_ += records_.size();
     records_.clear();
     inChunk_ = 0;
     prevJ_ = 0;  // each chunk decodes on its own (FORMAT.md §4)
@@ -305,6 +316,7 @@ class Encoder {
   std::vector<uint32_t> star_, moved_, candidates_, newTets_, changed_;
   uint32_t prevJ_ = 0, inChunk_ = 0;
   uint64_t target_ = 0;
+  uint64_t flushedRaw_ = 0;  // record bytes of the chunks before the current one
   double ratio_ = 2.5;
 };
 

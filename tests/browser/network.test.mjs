@@ -198,6 +198,37 @@ test('progress from the first byte: the bar counts the viewer program before it 
   }
 });
 
+test('over a slow link the chunks come one after another at the full rate, not as a batch sharing it', async (t) => {
+  // Chunks sharing a link end together, and the viewer then gets all their splits at once: it is
+  // still applying them long after the last byte. 64 KB chunks over 150 KB/s, 30 ms before each
+  // response: a chunk alone takes ~0.4 s, and the next request should start only near its end.
+  const { dir } = makePack(tmp, 'h32', { n: 32, packArgs: ['--chunk-kb', '64'] });
+  const chunks = readManifest(dir).chunks.length;
+  const slow = createServer({ mounts: [{ prefix: '/data', dir }, { prefix: '/', dir: webDir }], throttleBytesPerSec: 150e3, latencyMs: 30 });
+  const slowUrl = await listen(slow);
+  try {
+    const { page, problems } = await openViewer(browser, `${slowUrl}/index.html?data=/data/manifest.json`);
+    const s = await waitForState(page, ['complete', 'error']);
+    assert.equal(s.state, 'complete', s.error);
+    assertSurfaceMatches(s, cliIso(s.isovalue, { dir, chunks }), 'slow link, one chunk after another');
+    // The chunks requested once the viewer runs (a few go out together while the program
+    // starts, as no callback runs then), in request order: how long each response overlaps the
+    // one before, against that one's transfer time.
+    const timing = await page.evaluate((after) => performance.getEntriesByType('resource')
+      .filter((e) => /\/chunks\/\d+-/.test(e.name) && e.startTime > after)
+      .sort((a, b) => a.startTime - b.startTime)
+      .map((e) => ({ file: e.name.replace(/.*\//, ''), firstByte: e.responseStart, end: e.responseEnd })), s.firstSurfaceMs);
+    assert.ok(timing.length >= 4, `chunks requested after the first surface: ${timing.length}`);
+    const overlaps = timing.slice(1).map((e, k) => Math.max(0, timing[k].end - e.firstByte) / (timing[k].end - timing[k].firstByte));
+    t.diagnostic(`overlap with the response before, as a share of its transfer time: ${overlaps.map((x) => x.toFixed(2)).join(' ')}`);
+    assert.ok(Math.max(...overlaps) < 0.5, `each response mostly alone on the link: ${overlaps.map((x) => x.toFixed(2)).join(' ')}`);
+    assert.deepEqual(problems, []);
+    await page.close();
+  } finally {
+    await new Promise((resolve) => slow.close(resolve));
+  }
+});
+
 // ------------------------------------------------------------------ injected faults
 
 test('a chunk that fails twice with 503 is retried with backoff and the stream completes', async (t) => {
