@@ -62,6 +62,9 @@ struct SimplifyOptions {
   // original field over everything it stands for (field quadric minimum at p_j); the log keeps
   // the values before, so splits restore them exactly. Off: every vertex keeps its sample.
   bool fitValues = true;
+  // With fitValues, at the end the values of the vertices that stand for others are fitted again,
+  // all together, to the input field at every input vertex (least squares; simplify.cpp).
+  bool refitValues = true;
   std::function<void(uint32_t done, uint32_t planned)> progress;  // called now and then
   bool verifyLinkCondition = false;  // tests: also run the slow reference link check, count mismatches
   // Threads for cost evaluation (1 or 2; the result is the same either way), used for meshes of
