@@ -392,6 +392,32 @@ TEST(Progressive, FittedValuesLowerTheFieldErrorOfCoarseLevels) {
   EXPECT_LT(sampledCount(a, 0), a.vertexCount() / 2);
 }
 
+// Chunk sizes (FORMAT.md): split chunks double up to --chunk-kb, then halve again towards the
+// end, so that the last chunk a viewer has to apply after the last byte is small; a rest smaller
+// than the first chunk's size stays in the chunk before it.
+TEST(Progressive, LastChunksHalveTowardsTheEnd) {
+  PackOptions o;
+  o.chunkKb = 64;
+  o.minBaseVertices = 0;
+  const std::string dir = pack("taper", harmonic(36), o);
+  Dataset d;
+  ASSERT_TRUE(loadPackedDir(dir, d, 0));
+  std::vector<uint64_t> bytes;
+  for (size_t c = 1; c < d.manifest.chunks.size(); ++c) bytes.push_back(d.manifest.chunks[c].bytes);
+  ASSERT_GE(bytes.size(), 6u);
+  std::string sizes;
+  for (uint64_t b : bytes) sizes += std::to_string(b) + " ";
+  RecordProperty("chunk_bytes", sizes);
+  const uint64_t largest = *std::max_element(bytes.begin(), bytes.end());
+  size_t top = 0;  // the last chunk of the largest size class
+  for (size_t c = 0; c < bytes.size(); ++c)
+    if (bytes[c] * 10 >= largest * 9) top = c;
+  ASSERT_LE(top + 3, bytes.size()) << "at least two smaller chunks after the large ones";
+  for (size_t c = top + 1; c + 1 < bytes.size(); ++c)
+    EXPECT_LT(bytes[c + 1], bytes[c]) << "chunk " << c + 2 << " after " << c + 1;
+  EXPECT_LT(bytes.back(), 40u << 10) << "the last chunk is small (the first split chunk aims at 16 KB)";
+}
+
 // The coarsest level as the simplifier leaves it: alive vertices and tets, the steering field's
 // values as fitted.
 TetMesh coarseMesh(const TetMesh& in, const SimplifyResult& r) {
