@@ -999,6 +999,9 @@ class Simplifier {
         continue;  // (a vertex of no tet stands nowhere)
       }
       const double f = field_[v];
+      bool usable = std::isfinite(f);  // a NaN or infinite sample (or neighbour value) fits nothing
+      for (int x = 0; x < 4; ++x) usable = usable && (w[x] == 0 || std::isfinite(fit_[t4[x]]));
+      if (!usable) continue;
       for (int x = 0; x < 4; ++x) {
         const uint32_t r = col[t4[x]];
         if (r == none || w[x] == 0) continue;
@@ -1013,11 +1016,13 @@ class Simplifier {
     // Conjugate gradients with a Jacobi preconditioner, from the values the collapses fitted.
     // The values must stay inside the field's range (the stream's grid covers just that): one
     // that ends up outside is held at the bound it crossed and the others are solved again.
-    std::vector<double> x(n), res(n), z(n), d(n), q(n), diag(n);
+    std::vector<double> x(n), res(n), z(n), d(n), q(n), inverse(n);
     std::vector<uint8_t> held(n, 0);
     for (uint32_t r = 0; r < n; ++r) {
-      x[r] = fit_[free[r]];
-      diag[r] = at(r, free[r]);
+      x[r] = std::isfinite(fit_[free[r]]) ? fit_[free[r]] : 0.0;
+      const double diagonal = at(r, free[r]);
+      inverse[r] = diagonal > 0 ? 1 / diagonal : 0.0;
+      if (!(diagonal > 0)) held[r] = 2;  // no usable sample around it: it keeps its value
     }
     auto multiply = [&](const std::vector<double>& in, std::vector<double>& out) {
       for (uint32_t r = 0; r < n; ++r) {
@@ -1031,7 +1036,7 @@ class Simplifier {
       double rz = 0, norm = 0;
       for (uint32_t r = 0; r < n; ++r) {
         res[r] = held[r] ? 0.0 : rhs[r] - q[r];
-        z[r] = res[r] / diag[r];
+        z[r] = res[r] * inverse[r];
         d[r] = z[r];
         rz += res[r] * z[r];
         norm += held[r] ? 0.0 : rhs[r] * rhs[r];
@@ -1046,7 +1051,7 @@ class Simplifier {
         for (uint32_t r = 0; r < n; ++r) {
           x[r] += alpha * d[r];
           res[r] -= alpha * q[r];
-          z[r] = res[r] / diag[r];
+          z[r] = res[r] * inverse[r];
           rzNext += res[r] * z[r];
         }
         const double beta = rzNext / rz;
@@ -1055,7 +1060,6 @@ class Simplifier {
       }
       bool crossed = false;
       for (uint32_t r = 0; r < n; ++r) {
-        if (!std::isfinite(x[r])) x[r] = fit_[free[r]];
         if (held[r] || (x[r] >= fieldMin_ && x[r] <= fieldMax_)) continue;
         x[r] = std::clamp(x[r], fieldMin_, fieldMax_);
         held[r] = 1;
@@ -1063,7 +1067,8 @@ class Simplifier {
       }
       if (!crossed) break;
     }
-    for (uint32_t r = 0; r < n; ++r) fit_[free[r]] = float(std::clamp(x[r], fieldMin_, fieldMax_));
+    for (uint32_t r = 0; r < n; ++r)
+      if (held[r] != 2 && std::isfinite(x[r])) fit_[free[r]] = float(std::clamp(x[r], fieldMin_, fieldMax_));
   }
   static constexpr int kRefitRounds = 4;
   static constexpr int kRefitIterations = 200;

@@ -392,6 +392,26 @@ TEST(Progressive, FittedValuesLowerTheFieldErrorOfCoarseLevels) {
   EXPECT_LT(sampledCount(a, 0), a.vertexCount() / 2);
 }
 
+// Samples that are not numbers (simulations write NaN for "no value") take no part in the final
+// fit: the other values still get fitted, and none becomes NaN that was not before.
+TEST(Progressive, RefitIgnoresSamplesThatAreNotNumbers) {
+  TetMesh m = harmonic(12);
+  for (uint32_t v = 100; v < m.vertexCount(); v += 97) m.fields[0].values[v] = std::nanf("");
+  SimplifyOptions o;
+  o.targetVertices = m.vertexCount() / 20;
+  SimplifyResult refit, once;
+  ASSERT_TRUE(simplifyMesh(m, o, refit));
+  o.refitValues = false;
+  ASSERT_TRUE(simplifyMesh(m, o, once));
+  uint32_t changed = 0;
+  for (uint32_t v = 0; v < m.vertexCount(); ++v) {
+    if (!refit.vertexAlive[v]) continue;
+    if (std::isfinite(once.values[v])) EXPECT_TRUE(std::isfinite(refit.values[v])) << "vertex " << v;
+    changed += refit.values[v] != once.values[v];
+  }
+  EXPECT_GT(changed, 10u);
+}
+
 // Chunk sizes (FORMAT.md): split chunks double up to --chunk-kb, then halve again towards the
 // end, so that the last chunk a viewer has to apply after the last byte is small; a rest smaller
 // than the first chunk's size stays in the chunk before it.
