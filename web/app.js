@@ -539,7 +539,10 @@ async function instantiateProgram(imports) {
     const counted = countingResponse(response, {
       type: 'application/wasm',
       stallMs,
-      onProgress: (n) => { shell.programBytes += n; },
+      onProgress: (n) => {
+        shell.programBytes += n;
+        programNearlyDownloaded();
+      },
       onEnd: programDownloaded,
       onError: (e) => { streamError = e; },
     });
@@ -786,6 +789,14 @@ function startLoader({ names, sizes }, manifestUrl) {
   shell.datasetTotal = sizes.reduce((a, b) => a + b, 0);
   if (shell.programLoaded) loader.warm();
   loader.pump();
+}
+
+// What is left of the program would come in while a new request waits for its first byte: the
+// chunks after the base are asked for now, so that the link does not idle for a round trip
+// when the program's last byte is in. (Decoded bytes left, at least the bytes on the wire.)
+function programNearlyDownloaded() {
+  if (shell.programLoaded || !loader || !shell.programTotal) return;
+  if (shell.programTotal - shell.programBytes < loader.lead()) loader.warm();
 }
 
 // The program's last byte is in (the counting stream's end, on every attempt): the link is free
