@@ -792,11 +792,11 @@ function startLoader({ names, sizes }, manifestUrl) {
 }
 
 // What is left of the program would come in while a new request waits for its first byte: the
-// chunks after the base are asked for now, so that the link does not idle for a round trip
+// first chunk after the base is asked for now, so that the link does not idle for a round trip
 // when the program's last byte is in. (Decoded bytes left, at least the bytes on the wire.)
 function programNearlyDownloaded() {
   if (shell.programLoaded || !loader || !shell.programTotal) return;
-  if (shell.programTotal - shell.programBytes < loader.lead()) loader.warm();
+  if (shell.programTotal - shell.programBytes < loader.lead()) loader.nearlyWarm();
 }
 
 // The program's last byte is in (the counting stream's end, on every attempt): the link is free

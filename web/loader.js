@@ -56,6 +56,7 @@ export class ChunkLoader {
     Object.assign(this, { urls, names, sizes, allowed, stallMs, check, deliver, failed: fail, done });
     this.attached = !!check;
     this.warmed = this.attached;   // before: the program is still downloading, only the base
+    this.programNearlyIn = false;  // its last bytes are coming: the first split chunk too
     this.unchecked = new Set();    // arrived before attach()
     this.total = urls.length;
     this.next = 0;                 // next chunk to hand over
@@ -106,6 +107,15 @@ export class ChunkLoader {
     this.pump();
   }
 
+  // The program's last bytes are coming: one more request (the first split chunk, the smallest)
+  // now keeps the link busy over the round trip after them, and takes little from the program
+  // the first surface waits for.
+  nearlyWarm() {
+    if (this.warmed || this.programNearlyIn) return;
+    this.programNearlyIn = true;
+    this.pump();
+  }
+
   // Link rate and time to first byte from a finished response: the network's own timing when
   // the browser gives it, else callback times (the least time to a first byte seen, as a busy
   // main thread only adds to it).
@@ -129,7 +139,7 @@ export class ChunkLoader {
 
   pump() {
     if (this.paused || this.stopped || this.failure) return;
-    const end = Math.min(this.allowed, this.warmed ? this.next + MAX_AHEAD : 1);
+    const end = Math.min(this.allowed, this.warmed ? this.next + MAX_AHEAD : this.programNearlyIn ? 2 : 1);
     let ahead = 0, outstanding = 0;
     for (const b of this.arrived.values()) ahead += b.length;
     for (const [j, e] of this.inFlight) {
