@@ -392,17 +392,22 @@ TEST(Progressive, FittedValuesLowerTheFieldErrorOfCoarseLevels) {
   EXPECT_LT(sampledCount(a, 0), a.vertexCount() / 2);
 }
 
+// The same mesh simplified to 5% of its vertices with the final fit of the values and without.
+void simplifyWithAndWithoutRefit(const TetMesh& m, SimplifyResult& refit, SimplifyResult& once) {
+  SimplifyOptions o;
+  o.targetVertices = m.vertexCount() / 20;
+  ASSERT_TRUE(simplifyMesh(m, o, refit));
+  o.refitValues = false;
+  ASSERT_TRUE(simplifyMesh(m, o, once));
+}
+
 // Samples that are not numbers (simulations write NaN for "no value") take no part in the final
 // fit: the other values still get fitted, and none becomes NaN that was not before.
 TEST(Progressive, RefitIgnoresSamplesThatAreNotNumbers) {
   TetMesh m = harmonic(12);
   for (uint32_t v = 100; v < m.vertexCount(); v += 97) m.fields[0].values[v] = std::nanf("");
-  SimplifyOptions o;
-  o.targetVertices = m.vertexCount() / 20;
   SimplifyResult refit, once;
-  ASSERT_TRUE(simplifyMesh(m, o, refit));
-  o.refitValues = false;
-  ASSERT_TRUE(simplifyMesh(m, o, once));
+  ASSERT_NO_FATAL_FAILURE(simplifyWithAndWithoutRefit(m, refit, once));
   uint32_t changed = 0;
   for (uint32_t v = 0; v < m.vertexCount(); ++v) {
     if (!refit.vertexAlive[v]) continue;
@@ -462,12 +467,8 @@ TetMesh coarseMesh(const TetMesh& in, const SimplifyResult& r) {
 // stand only for themselves keep their samples (no split would restore another value).
 TEST(Progressive, RefitValuesMinimiseTheErrorAtTheInputVertices) {
   const TetMesh m = harmonic(14);
-  SimplifyOptions o;
-  o.targetVertices = m.vertexCount() / 20;
   SimplifyResult refit, once;
-  ASSERT_TRUE(simplifyMesh(m, o, refit));
-  o.refitValues = false;
-  ASSERT_TRUE(simplifyMesh(m, o, once));
+  ASSERT_NO_FATAL_FAILURE(simplifyWithAndWithoutRefit(m, refit, once));
   ASSERT_EQ(refit.log.j, once.log.j);  // the same collapses: only values differ
   TetMesh a = coarseMesh(m, refit);
   const double refitRms = fieldRms(m, a, 0), onceRms = fieldRms(m, coarseMesh(m, once), 0);
