@@ -971,7 +971,8 @@ class Simplifier {
         free.push_back(v);
       }
     if (free.empty()) return;
-    // The normal equations' matrix, one row per unknown over its alive neighbours and itself.
+    // The normal equations' matrix, one row per unknown over the unknowns among its neighbours
+    // and itself (column = unknown index; col[] grows with the vertex id, so sorted either way).
     const uint32_t n = uint32_t(free.size());
     std::vector<uint32_t> rowStart(n + 1, 0), cols;
     for (uint32_t r = 0; r < n; ++r) {
@@ -979,13 +980,13 @@ class Simplifier {
       main_.nbr.push_back(free[r]);
       std::sort(main_.nbr.begin(), main_.nbr.end());
       for (uint32_t w : main_.nbr)
-        if (col[w] != none) cols.push_back(w);
+        if (col[w] != none) cols.push_back(col[w]);
       rowStart[r + 1] = uint32_t(cols.size());
     }
     std::vector<double> a(cols.size(), 0.0), rhs(n, 0.0);
-    auto at = [&](uint32_t r, uint32_t v) -> double& {
-      auto it = std::lower_bound(cols.begin() + rowStart[r], cols.begin() + rowStart[r + 1], v);
-      assert(it != cols.begin() + rowStart[r + 1] && *it == v);
+    auto at = [&](uint32_t r, uint32_t c) -> double& {
+      auto it = std::lower_bound(cols.begin() + rowStart[r], cols.begin() + rowStart[r + 1], c);
+      assert(it != cols.begin() + rowStart[r + 1] && *it == c);
       return a[size_t(it - cols.begin())];
     };
     for (uint32_t v = 0; v < V_; ++v) {
@@ -995,7 +996,7 @@ class Simplifier {
         t4[0] = v;
         w[0] = 1;
         for (int k = 1; k < 4; ++k) t4[k] = v, w[k] = 0;
-      } else if (star_[rep[v]].empty() || !locate(p(v), star_[rep[v]].front(), t4, w)) {
+      } else if (star_[rep[v]].empty() || !locate(v, star_[rep[v]].front(), t4, w)) {
         continue;  // (a vertex of no tet stands nowhere)
       }
       const double f = field_[v];
@@ -1009,7 +1010,7 @@ class Simplifier {
         for (int y = 0; y < 4; ++y) {
           if (w[y] == 0) continue;
           if (col[t4[y]] == none) rhs[r] -= w[x] * w[y] * fit_[t4[y]];  // a fixed value
-          else at(r, t4[y]) += w[x] * w[y];
+          else at(r, col[t4[y]]) += w[x] * w[y];
         }
       }
     }
@@ -1020,14 +1021,14 @@ class Simplifier {
     std::vector<uint8_t> held(n, 0);
     for (uint32_t r = 0; r < n; ++r) {
       x[r] = std::isfinite(fit_[free[r]]) ? fit_[free[r]] : 0.0;
-      const double diagonal = at(r, free[r]);
+      const double diagonal = at(r, r);
       inverse[r] = diagonal > 0 ? 1 / diagonal : 0.0;
       if (!(diagonal > 0)) held[r] = 2;  // no usable sample around it: it keeps its value
     }
     auto multiply = [&](const std::vector<double>& in, std::vector<double>& out) {
       for (uint32_t r = 0; r < n; ++r) {
         double sum = 0;
-        for (uint32_t k = rowStart[r]; k < rowStart[r + 1]; ++k) sum += a[k] * in[col[cols[k]]];
+        for (uint32_t k = rowStart[r]; k < rowStart[r + 1]; ++k) sum += a[k] * in[cols[k]];
         out[r] = held[r] ? 0.0 : sum;
       }
     };
@@ -1073,25 +1074,21 @@ class Simplifier {
   static constexpr int kRefitRounds = 4;
   static constexpr int kRefitIterations = 200;
 
-  // The tet of the current mesh holding point x, by walking from tet `t` across the face with the
+  // The tet of the current mesh holding input vertex x, by walking from tet `t` across the face with the
   // most negative barycentric coordinate; outside the mesh (the boundary moved inwards), the
   // tet x is least outside of, with its coordinates clamped to the tet. Weights by vertex.
-  bool locate(const double* x, uint32_t t, uint32_t* vertices, double* w) const {
+  bool locate(uint32_t x, uint32_t t, uint32_t* vertices, double* w) const {
+    const float* P = mesh_.positions.data();
     double best = -kInf;
     bool found = false;
     for (int step = 0; step < 64; ++step) {
       const uint32_t* v = &out_.tets[4 * size_t(t)];
-      const double* q[4] = {p(v[0]), p(v[1]), p(v[2]), p(v[3])};
-      const double whole = orient(q[0], q[1], q[2], q[3]);
-      if (!(std::abs(whole) > 0)) break;  // flat (left from the input): no coordinates
+      const float* q[4] = {P + 3 * size_t(v[0]), P + 3 * size_t(v[1]), P + 3 * size_t(v[2]), P + 3 * size_t(v[3])};
       double l[4];
+      if (barycentric(q, P + 3 * size_t(x), l) == -kInf) break;  // flat (left from the input): no coordinates
       int worst = 0;
-      for (int k = 0; k < 4; ++k) {
-        const double* r[4] = {q[0], q[1], q[2], q[3]};
-        r[k] = x;
-        l[k] = orient(r[0], r[1], r[2], r[3]) / whole;
+      for (int k = 1; k < 4; ++k)
         if (l[k] < l[worst]) worst = k;
-      }
       if (l[worst] > best) {
         best = l[worst];
         found = true;
@@ -1108,12 +1105,6 @@ class Simplifier {
       t = next >> 2;
     }
     return found;
-  }
-
-  static double orient(const double* a, const double* b, const double* c, const double* d) {
-    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]},
-                 w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-    return u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) + u[2] * (v[0] * w[1] - v[1] * w[0]);
   }
 
   // ------------------------------------------------------------------ the collapse

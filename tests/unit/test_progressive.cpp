@@ -326,24 +326,32 @@ TEST(Progressive, BoundaryIsPreserved) {
   }
 }
 
-// RMS over the input's vertices of (coarse field interpolated there − input value), by brute
-// force: the coarse tet that holds each point best (largest smallest barycentric coordinate).
+// By brute force, the coarse tet that holds p best (largest smallest barycentric coordinate,
+// returned) and p's barycentric coordinates in it.
+double bestTet(const TetMesh& coarse, const float* p, uint32_t& tet, double w[4]) {
+  double best = -1e30;
+  for (uint32_t t = 0; t < coarse.tetCount(); ++t) {
+    const uint32_t* c = &coarse.tets[4 * t];
+    const float* q[4] = {&coarse.positions[3 * c[0]], &coarse.positions[3 * c[1]], &coarse.positions[3 * c[2]],
+                         &coarse.positions[3 * c[3]]};
+    double l[4];
+    const double lo = barycentric(q, p, l);
+    if (lo <= best) continue;
+    best = lo;
+    tet = t;
+    std::copy_n(l, 4, w);
+  }
+  return best;
+}
+
+// RMS over the input's vertices of (coarse field interpolated there − input value).
 double fieldRms(const TetMesh& in, const TetMesh& coarse, int field) {
   double sum = 0;
   for (uint32_t v = 0; v < in.vertexCount(); ++v) {
-    const float* p = &in.positions[3 * v];
-    double best = -1e30, value = 0;
-    for (uint32_t t = 0; t < coarse.tetCount(); ++t) {
-      const uint32_t* c = &coarse.tets[4 * t];
-      const float* q[4] = {&coarse.positions[3 * c[0]], &coarse.positions[3 * c[1]], &coarse.positions[3 * c[2]],
-                           &coarse.positions[3 * c[3]]};
-      double l[4];
-      const double lo = barycentric(q, p, l);
-      if (lo <= best) continue;
-      best = lo;
-      value = 0;
-      for (int k = 0; k < 4; ++k) value += l[k] * coarse.fields[size_t(field)].values[c[k]];
-    }
+    uint32_t tet = 0;
+    double w[4] = {}, value = 0;
+    bestTet(coarse, &in.positions[3 * v], tet, w);
+    for (int k = 0; k < 4; ++k) value += w[k] * coarse.fields[size_t(field)].values[coarse.tets[4 * tet + k]];
     const double d = value - in.fields[size_t(field)].values[v];
     sum += d * d;
   }
@@ -411,7 +419,9 @@ TEST(Progressive, RefitIgnoresSamplesThatAreNotNumbers) {
   uint32_t changed = 0;
   for (uint32_t v = 0; v < m.vertexCount(); ++v) {
     if (!refit.vertexAlive[v]) continue;
-    if (std::isfinite(once.values[v])) EXPECT_TRUE(std::isfinite(refit.values[v])) << "vertex " << v;
+    if (std::isfinite(once.values[v])) {
+      EXPECT_TRUE(std::isfinite(refit.values[v])) << "vertex " << v;
+    }
     changed += refit.values[v] != once.values[v];
   }
   EXPECT_GT(changed, 10u);
@@ -485,18 +495,9 @@ TEST(Progressive, RefitValuesMinimiseTheErrorAtTheInputVertices) {
   std::vector<double> gradient(a.vertexCount(), 0.0), curvature(a.vertexCount(), 0.0);
   const std::vector<float>& value = a.fields[0].values;
   for (uint32_t v = 0; v < m.vertexCount(); ++v) {
-    const float* p = &m.positions[3 * v];
-    double best = -1e30, l[4], w[4] = {};
     uint32_t tet = 0;
-    for (uint32_t t = 0; t < a.tetCount(); ++t) {
-      const uint32_t* c = &a.tets[4 * t];
-      const float* q[4] = {&a.positions[3 * c[0]], &a.positions[3 * c[1]], &a.positions[3 * c[2]], &a.positions[3 * c[3]]};
-      const double lo = barycentric(q, p, l);
-      if (lo <= best) continue;
-      best = lo;
-      tet = t;
-      std::copy_n(l, 4, w);
-    }
+    double w[4] = {};
+    const double best = bestTet(a, &m.positions[3 * v], tet, w);
     ASSERT_GT(best, -1e-6) << "input vertex " << v << " inside the coarse mesh";
     const uint32_t* c = &a.tets[4 * tet];
     double residual = -double(m.fields[0].values[v]);
