@@ -124,7 +124,8 @@ class Simplifier {
     CollapseVerdict v = CollapseVerdict::Legal;
     prepareStar(L, i);
     if (legal(L, i, j, &v)) {
-      Candidate c = fieldTerms(L, i, j);
+      Candidate c = boundTerms(L, i, j);
+      localTerm(L, i, c);
       finishCost(L, c, &v);
     }
     if (v == CollapseVerdict::Legal && !linkCondition(i, j)) v = CollapseVerdict::LinkCondition;
@@ -359,12 +360,16 @@ class Simplifier {
     float kappa;              // κ of the tet now
   };
 
+  // A candidate's cost is refined in stages while it could still be the cheapest
+  // (cheapestCandidate): each stage's cost is a lower bound of the next one's.
   struct Candidate {
-    double cost;     // exact, or a lower bound until `exact`
+    enum Stage : uint8_t { Bound, Local, Exact };
+    double cost;     // exact, or a lower bound until stage Exact
     double base;     // the cost without the shape term
+    double sj, region, eg, weight, shapeBound;  // parts of the cost (boundTerms)
     uint32_t j;
-    float fieldErr;  // E_f
-    bool exact;
+    float fieldErr;  // E_f (from stage Local on)
+    Stage stage;
   };
 
   // Scratch for evaluating one vertex's out-edges; one per thread.
@@ -390,48 +395,46 @@ class Simplifier {
   }
 
   void prepareStar(Lane& L, uint32_t i) {
-    L.star.clear();
+    const std::vector<uint32_t>& star = star_[i];
+    L.star.resize(star.size());
     L.shapeReady = false;
+    const double* pi = p(i);
     // Every edge of a tet after the collapse lies in the star's bounding box, so the flatness
     // threshold of the longest possible edge bounds every tet's own threshold from above.
-    double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
-    for (uint32_t t : star_[i])
+    double lo[3] = {pi[0], pi[1], pi[2]}, hi[3] = {pi[0], pi[1], pi[2]};
+    float worstKappa = 0;
+    for (size_t n = 0; n < star.size(); ++n) {
+      const uint32_t t = star[n];
+      const uint32_t* v = &out_.tets[4 * size_t(t)];
+      StarTet& st = L.star[n];
+      st.t = t;
+      st.kappa = kappa_[t];
+      worstKappa = std::max(worstKappa, st.kappa);
+      int si = 0, m = 0;
       for (int k = 0; k < 4; ++k) {
-        const double* q = p(out_.tets[4 * size_t(t) + k]);
+        if (v[k] == i) { si = k; continue; }
+        const double* q = p(v[k]);
+        st.other[m] = v[k];
+        st.f[m] = fit_[v[k]];
         for (int a = 0; a < 3; ++a) {
+          st.x[m][a] = q[a];
           lo[a] = std::min(lo[a], q[a]);
           hi[a] = std::max(hi[a], q[a]);
         }
+        ++m;
       }
+      // Moving the vertex at slot si to the front takes si adjacent swaps.
+      st.sign = (si & 1) ? -1.0 : 1.0;
+      affineDet(st.x[0], st.x[1], st.x[2], st.sign, st.g[0], &st.h[0]);
+      st.baryReady = false;
+      st.detOld = st.g[0][0] * pi[0] + st.g[0][1] * pi[1] + st.g[0][2] * pi[2] + st.h[0];
+    }
     const double diam2 = (hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]);
     L.flatBound = kFlat * diam2 * std::sqrt(diam2);
-    const double* pi = p(i);
     // A changed tet must reach the minimum quality, or else be no worse than the worst tet of
     // the star now: real meshes (boundary layers of CFD grids) start with tets far below any
     // fixed minimum, and a collapse that does not make their region worse is allowed.
-    float worstKappa = 0;
-    for (uint32_t t : star_[i]) worstKappa = std::max(worstKappa, kappa_[t]);
     L.qualityFloor = std::min(opt_.minQuality, 3.0 / double(worstKappa));
-    for (uint32_t t : star_[i]) {
-      const uint32_t* v = &out_.tets[4 * size_t(t)];
-      StarTet st;
-      st.t = t;
-      st.kappa = kappa_[t];
-      int si = 0, n = 0;
-      const double* x[3];
-      for (int k = 0; k < 4; ++k) {
-        if (v[k] == i) si = k;
-        else { st.other[n] = v[k]; x[n] = p(v[k]); st.f[n] = fit_[v[k]]; ++n; }
-      }
-      for (int k = 0; k < 3; ++k) std::copy_n(x[k], 3, st.x[k]);
-      // Moving the vertex at slot si to the front takes si adjacent swaps.
-      const double sign = (si & 1) ? -1.0 : 1.0;
-      affineDet(x[0], x[1], x[2], sign, st.g[0], &st.h[0]);
-      st.sign = sign;
-      st.baryReady = false;
-      st.detOld = st.g[0][0] * pi[0] + st.g[0][1] * pi[1] + st.g[0][2] * pi[2] + st.h[0];
-      L.star.push_back(st);
-    }
   }
 
   // Numerators of the barycentric coordinates of p_i with p_j's position P in the slot of i:
@@ -488,11 +491,11 @@ class Simplifier {
     }
   }
 
-  // Cost of hec(i → j) given prepareStar(i), in two steps so that the expensive shape term is
-  // only computed for candidates that can still win (cheapestCandidate): legal() checks the
-  // boundary rule and that no tet inverts or flattens, then fieldTerms() adds the geometric and
-  // field terms and a lower bound of the shape term; finishCost() the exact shape term and the
-  // minimum-quality check.
+  // Cost of hec(i → j) given prepareStar(i), in steps so that the expensive terms are only
+  // computed for candidates that can still win (cheapestCandidate): legal() checks the boundary
+  // rule and that no tet inverts or flattens, boundTerms() a lower bound from the geometric and
+  // region terms, localTerm() adds the local field error, finishCost() the exact shape term and
+  // the minimum-quality check.
   bool legal(Lane& L, uint32_t i, uint32_t j, CollapseVerdict* verdict) {
     ++L.evaluations;
     *verdict = CollapseVerdict::Legal;
@@ -507,27 +510,70 @@ class Simplifier {
     return true;
   }
 
-  Candidate fieldTerms(Lane& L, uint32_t i, uint32_t j) {
+  // Everything of the cost but the local field error and the exact shape term: the geometric
+  // error, the region term of the field error and a lower bound of the shape term.
+  Candidate boundTerms(Lane& L, uint32_t i, uint32_t j) {
     const double* P = p(j);
     Candidate c;
     c.j = j;
     FieldQuadric fq = fieldQuadric_[i];
     fq.add(fieldQuadric_[j]);
     const uint32_t count = represented_[i] + represented_[j];
-    const double sj = fitsRegion(count) ? fitted(fq, P, fit_[j]) : fit_[j];
-    // Where p_i lands among the new tets, to interpolate the coarse field there (the paper's
-    // local error, eq. 6). The first tet that contains p_i wins; if none does (p_i on the
-    // boundary, or round-off), the one it is least outside of. Only signs are needed until the
-    // tet is found: each barycentric numerator is affine in p_j and det > 0.
-    double bestInside = -kInf, interp = sj, removedQuality = 0;
+    c.sj = fitsRegion(count) ? fitted(fq, P, fit_[j]) : fit_[j];
+    // The field quadric over everything i and j stand for (our stand-in for eq. 5's sum over
+    // the region).
+    const double x5[5] = {P[0], P[1], P[2], c.sj, 1.0};
+    c.region = fq.weight > 0 ? std::sqrt(std::max(0.0, fq.eval(x5)) / fq.weight) / range_ : 0.0;
+    c.eg = 0;
+    if (boundary_[i]) {
+      Quadric q = quadric_[i];
+      q.add(quadric_[j]);
+      const double x4[4] = {P[0], P[1], P[2], 1.0};
+      if (q.weight > 0) c.eg = std::sqrt(std::max(0.0, q.eval(x4)) / q.weight) / diag_;
+    }
+    // The error terms are weighted by the square root of the number of input vertices i and j
+    // stand for together: about the root of the summed squared error at those vertices (paper
+    // eq. 5 sums over them), which is what adds to the RMS over the whole mesh, so a collapse
+    // that spreads an error over a large region waits behind one that keeps it local. A count,
+    // not a volume: graded CFD grids put most vertices in thin boundary layers, where a volume
+    // weight made the error 1.8× larger on Blunt Fin. The manifest reports the unweighted E_f.
+    c.weight = std::sqrt(double(count));
+    // E_s after the collapse with every new tet at the best quality (3/κ = 1), as the tets of
+    // p_j's star that stay are known: most candidates lose without finishCost(). Scaled down a
+    // little so that round-off (its sums run in another order) never lifts it above E_s.
+    double removedQuality = 0;
     int removed = 0;
-    for (StarTet& st : L.star) {
+    for (const StarTet& st : L.star)
       if (st.other[0] == j || st.other[1] == j || st.other[2] == j) {
         removedQuality += 3.0 / st.kappa;
         ++removed;
-        continue;
       }
-      if (bestInside >= 0) continue;  // found; the loop goes on for the removed tets
+    const double moved = double(L.star.size()) - removed, after = double(star_[j].size()) - removed + moved;
+    c.shapeBound = after > 0 ? std::max(0.0, 1.0 - (qualitySum_[j] - removedQuality + moved) / after) : 0.0;
+    setCost(c, 0.0);  // a lower bound: the local error is at least 0 (rounding is monotone)
+    c.stage = Candidate::Bound;
+    return c;
+  }
+
+  // The cost with the local field error `local` and the bound of the shape term.
+  void setCost(Candidate& c, double local) const {
+    const double ef = local + c.region;
+    c.fieldErr = float(ef);
+    c.base = c.weight * (opt_.weightGeometry * c.eg + opt_.weightField * ef);
+    c.cost = c.base + opt_.weightShape * c.shapeBound * (1 - 1e-9);
+  }
+
+  // Adds the paper's local field error (eq. 6) to a candidate of boundTerms():
+  // |S(p_i) − S'(p_i)| / range, where S' interpolates the coarse field at p_i among the new tets.
+  // The first tet that contains p_i wins; if none does (p_i on the boundary, or round-off), the
+  // one it is least outside of. Only signs are needed until the tet is found: each barycentric
+  // numerator is affine in p_j and det > 0.
+  void localTerm(Lane& L, uint32_t i, Candidate& c) {
+    const uint32_t j = c.j;
+    const double* P = p(j);
+    double bestInside = -kInf, interp = c.sj;
+    for (StarTet& st : L.star) {
+      if (st.other[0] == j || st.other[1] == j || st.other[2] == j) continue;  // removed
       if (!st.baryReady) prepareBary(st, p(i));
       double num[4] = {st.detOld, 0, 0, 0}, lo = num[0];
       for (int k = 1; k < 4; ++k) {
@@ -537,37 +583,11 @@ class Simplifier {
       const double det = st.g[0][0] * P[0] + st.g[0][1] * P[1] + st.g[0][2] * P[2] + st.h[0];
       if (lo < 0 && lo / det <= bestInside) continue;
       bestInside = lo / det;
-      interp = (num[0] / det) * sj + ((num[1] / det) * st.f[0] + (num[2] / det) * st.f[1] + (num[3] / det) * st.f[2]);
+      interp = (num[0] / det) * c.sj + ((num[1] / det) * st.f[0] + (num[2] / det) * st.f[1] + (num[3] / det) * st.f[2]);
+      if (bestInside >= 0) break;
     }
-    // Paper eq. (6) at p_i, plus the field quadric over everything i and j stand for (our
-    // stand-in for eq. 5's sum over the region).
-    const double local = std::abs(double(field_[i]) - interp) / range_;
-    const double x5[5] = {P[0], P[1], P[2], sj, 1.0};
-    const double region = fq.weight > 0 ? std::sqrt(std::max(0.0, fq.eval(x5)) / fq.weight) / range_ : 0.0;
-    const double ef = local + region;
-    double eg = 0;
-    if (boundary_[i]) {
-      Quadric q = quadric_[i];
-      q.add(quadric_[j]);
-      const double x4[4] = {P[0], P[1], P[2], 1.0};
-      if (q.weight > 0) eg = std::sqrt(std::max(0.0, q.eval(x4)) / q.weight) / diag_;
-    }
-    c.fieldErr = float(ef);
-    // The error terms are weighted by the square root of the number of input vertices i and j
-    // stand for together: about the root of the summed squared error at those vertices (paper
-    // eq. 5 sums over them), which is what adds to the RMS over the whole mesh, so a collapse
-    // that spreads an error over a large region waits behind one that keeps it local. A count,
-    // not a volume: graded CFD grids put most vertices in thin boundary layers, where a volume
-    // weight made the error 1.8× larger on Blunt Fin. The manifest reports the unweighted E_f.
-    c.base = std::sqrt(double(count)) * (opt_.weightGeometry * eg + opt_.weightField * ef);
-    // E_s after the collapse with every new tet at the best quality (3/κ = 1), as the tets of
-    // p_j's star that stay are known: most candidates lose without finishCost(). Scaled down a
-    // little so that round-off (its sums run in another order) never lifts it above E_s.
-    const double moved = double(L.star.size()) - removed, after = double(star_[j].size()) - removed + moved;
-    const double shapeBound = after > 0 ? std::max(0.0, 1.0 - (qualitySum_[j] - removedQuality + moved) / after) : 0.0;
-    c.cost = c.base + opt_.weightShape * shapeBound * (1 - 1e-9);
-    c.exact = false;
-    return c;
+    setCost(c, std::abs(double(field_[i]) - interp) / range_);
+    c.stage = Candidate::Local;
   }
 
   bool finishCost(Lane& L, Candidate& c, CollapseVerdict* verdict) {
@@ -592,16 +612,17 @@ class Simplifier {
         double c0 = st.C[q][0] - pd[0], c1 = st.C[q][1] - pd[1], c2 = st.C[q][2] - pd[2];
         faces += c0 * c0 + c1 * c1 + c2 * c2;
       }
-      const double kappa = std::sqrt(edges * 0.25 * faces) / det;
-      if (3.0 / kappa < L.qualityFloor) return *verdict = CollapseVerdict::LowQuality, false;
-      qualitySum += 3.0 / std::min<double>(kappa, kKappaCap);
+      // 3/κ = 3·det / sqrt(edges · faces / 4): one root and one division.
+      const double quality = 6.0 * det / std::sqrt(edges * faces);
+      if (quality < L.qualityFloor) return *verdict = CollapseVerdict::LowQuality, false;
+      qualitySum += std::max(quality, 3.0 / kKappaCap);
       ++count;
     }
     // Mean of (κ − 3)/κ = 1 − 3/κ: the paper's κ − 3, mapped onto [0, 1) so that one sliver
     // cannot outweigh the field error (see simplify.h).
     double es = count > 0 ? std::max(0.0, 1.0 - qualitySum / double(count)) : 0.0;
     c.cost = c.base + opt_.weightShape * es;
-    c.exact = true;
+    c.stage = Candidate::Exact;
     return true;
   }
 
@@ -610,13 +631,13 @@ class Simplifier {
     L.candidates.clear();
     for (uint32_t w : L.nbr) {
       CollapseVerdict v;
-      if (legal(L, i, w, &v)) L.candidates.push_back(fieldTerms(L, i, w));
+      if (legal(L, i, w, &v)) L.candidates.push_back(boundTerms(L, i, w));
     }
   }
 
   // Best-first over the candidates: the cheapest one with an exact cost, finishing bounds only
   // while one could still win. Returns its index, or -1 when none is legal.
-  int cheapestCandidate(Lane& L) {
+  int cheapestCandidate(Lane& L, uint32_t i) {
     for (;;) {
       int best = -1;
       for (int c = 0; c < int(L.candidates.size()); ++c) {
@@ -627,9 +648,10 @@ class Simplifier {
       }
       if (best < 0) return -1;
       Candidate& b = L.candidates[size_t(best)];
-      if (b.exact) return best;
+      if (b.stage == Candidate::Exact) return best;
       CollapseVerdict v;
-      if (!finishCost(L, b, &v)) L.candidates.erase(L.candidates.begin() + best);
+      if (b.stage == Candidate::Bound) localTerm(L, i, b);
+      else if (!finishCost(L, b, &v)) L.candidates.erase(L.candidates.begin() + best);
     }
   }
 
@@ -654,7 +676,7 @@ class Simplifier {
     neighbours(L, v, L.nbr);
     prepareStar(L, v);
     gatherCandidates(L, v);
-    int best = cheapestCandidate(L);
+    int best = cheapestCandidate(L, v);
     return best < 0 ? float(kInf) : float(L.candidates[size_t(best)].cost);
   }
 
@@ -664,7 +686,7 @@ class Simplifier {
     neighbours(L, v, L.nbr);
     prepareStar(L, v);
     gatherCandidates(L, v);
-    cheapestCandidate(L);  // finishes the winner here, on the lane's thread
+    cheapestCandidate(L, v);  // finishes the winner here, on the lane's thread
   }
 
   // The top entry of the queue that is still current (stale ones are dropped on the way).
@@ -691,7 +713,7 @@ class Simplifier {
   // `next`, the key of the next entry: then i goes back into the queue under its new cost.
   void tryCollapse(uint32_t i, Lane& L, float next) {
     bool first = true;
-    for (int c; (c = cheapestCandidate(L)) >= 0;) {
+    for (int c; (c = cheapestCandidate(L, i)) >= 0;) {
       const Candidate cand = L.candidates[size_t(c)];
       if (first) lastCost_[i] = float(cand.cost);
       first = false;
