@@ -153,7 +153,7 @@ Runner addPack(CLI::App& app) {
                  {"bitsPerTet", bitsPerTet}, {"bytesPerSplit", bytesPerSplit},
                  {"baseFieldError", m.chunks[0].fieldError}, {"stopReason", s.stopReason},
                  {"flatTetsRemoved", s.flatTetsRemoved}, {"flatTetsLeft", s.flatTetsLeft},
-                 {"queuePops", s.queuePops}, {"requeued", s.requeued}, {"costEvaluations", s.costEvaluations},
+                 {"queuePops", s.queuePops}, {"halvesCollapses", s.halvesCollapses}, {"requeued", s.requeued}, {"costEvaluations", s.costEvaluations},
                  {"readMs", readMs}, {"simplifyMs", s.simplifyMs}, {"encodeMs", s.encodeMs}, {"writeMs", s.writeMs},
                  {"ms", total.ms()}, {"peakMemoryMB", peakMemoryMB()}, {"notes", notes}});
       return 0;

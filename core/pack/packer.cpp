@@ -153,6 +153,7 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   so.weightField = opt.weights[1];
   so.weightShape = opt.weights[2];
   so.threads = opt.threads;
+  so.partitionMinVertices = opt.partitionMinVertices;
   so.fitValues = opt.fitValues;
   so.field = iso;
   so.maxError = opt.maxError;
@@ -173,6 +174,7 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   summary.flatTetsRemoved = simplified.flatTetsRemoved;
   summary.flatTetsLeft = simplified.flatTetsLeft;
   summary.queuePops = simplified.queuePops;
+  summary.halvesCollapses = simplified.halvesCollapses;
   summary.requeued = simplified.requeued;
   summary.costEvaluations = simplified.costEvaluations;
 

@@ -71,6 +71,9 @@ struct SimplifyOptions {
   // at least parallelMinVertices vertices (below that, starting rounds costs more than it saves).
   int threads = 2;
   uint32_t parallelMinVertices = 20000;
+  // Meshes of at least this many vertices are simplified in two halves at once for most of the
+  // way (simplify.cpp, runParts); the result depends on this, not on `threads`.
+  uint32_t partitionMinVertices = 50000;
 };
 
 // One collapse as it happened, in original vertex and tet ids.
@@ -99,6 +102,7 @@ struct SimplifyResult {
   uint32_t flatTetsLeft = 0;
   uint64_t costEvaluations = 0, rejectedByLink = 0;
   uint64_t queuePops = 0, requeued = 0;  // pops of current entries, and those pushed back costlier
+  uint32_t halvesCollapses = 0;          // collapses made in the two halves at once (partitionMinVertices)
   uint64_t linkMismatches = 0;           // with verifyLinkCondition: fast and reference disagreed
   std::string stopReason;          // "target reached", "no legal collapse left", "error bound"
 };
