@@ -66,7 +66,7 @@ Runner addPack(CLI::App& app) {
     std::vector<double> weights;
     double baseFraction = 0.01, maxError = -1, maxMemoryGb = 0;
     uint32_t baseVertices = 0, baseTets = 0, chunkKb = 256;
-    int level = 19, threads = 2;
+    int level = 18, threads = 2;
     bool lossless = false, json = false, samples = false;
     ReadOptions read;
   };

@@ -187,10 +187,8 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   stream.progress = [&](uint32_t done, uint32_t planned) { progress("encode", done, planned); };
   EncodedStream enc;
   if (Result r = encodeStream(mesh, simplified, m, stream, enc); !r) return r;
-  std::vector<uint8_t> baseFile;
-  ChunkInfo base;
-  base.fieldError = enc.baseFieldError;
-  if (Result r = encodeBaseChunk(enc.base, 0, opt.zstdLevel, baseFile, base); !r) return r;
+  const std::vector<uint8_t>& baseFile = enc.baseFile;
+  ChunkInfo base = enc.baseInfo;
   summary.encodeMs = msSince(t0);
   // Vertices no tet uses are not part of any level: the stream drops them.
   m.vertices = enc.chunks.empty() ? enc.base.vertexCount() : enc.chunks.back().vertices;

@@ -143,7 +143,7 @@ class Simplifier {
     W.log = &out_.log;
     if (V_ >= opt_.partitionMinVertices) runParts(planned);
     for (uint32_t v = 0; v < V_; ++v)  // (after the parts: what they left queued)
-      if (out_.vertexAlive[v] && queued_[v]) W.heap.push({std::isfinite(lastCost_[v]) ? lastCost_[v] : 0.0f, v});
+      if (out_.vertexAlive[v] && queued_[v]) W.heap.push({queueKey(v), v});
     const bool parallel = opt_.threads > 1 && V_ >= opt_.parallelMinVertices;
     const uint32_t roundSize = parallel ? kRoundSize : 1;
     WorkPool pool(parallel ? 1 : 0);
@@ -768,6 +768,9 @@ class Simplifier {
     cheapestCandidate(L, v);  // finishes the winner here, on the lane's thread
   }
 
+  // The key v is queued under: its last known cost, or 0 when it had no legal collapse then.
+  float queueKey(uint32_t v) const { return std::isfinite(lastCost_[v]) ? lastCost_[v] : 0.0f; }
+
   // The top entry of the queue that is still current (stale ones are dropped on the way).
   bool peekValid(Heap& heap, Entry& e) {
     while (!heap.empty()) {
@@ -871,7 +874,7 @@ class Simplifier {
       if (inner_[v]) inner[side[v]] += 1;
     if (inner[0] + inner[1] == 0) return;
     for (uint32_t v : order)
-      if (inner_[v] && queued_[v]) parts_[side[v]].heap.push({lastCost_[v], v});
+      if (inner_[v] && queued_[v]) parts_[side[v]].heap.push({queueKey(v), v});
     // Both halves collapse every entry up to a key τ, then τ doubles: so they advance through
     // the same costs (with fixed quotas one half could end simplified further than the other).
     // Each step's collapses are capped, in proportion to the inner vertices, by what is left of
@@ -1403,7 +1406,7 @@ class Simplifier {
       if (queued_[v]) continue;  // its entry stays: it is evaluated afresh when popped
       queued_[v] = 1;
       if (W.part >= 0 && !inner_[v]) continue;  // left to the whole mesh's queue
-      W.heap.push({std::isfinite(lastCost_[v]) ? lastCost_[v] : 0.0f, v});
+      W.heap.push({queueKey(v), v});
     }
   }
 

@@ -43,7 +43,18 @@ class Encoder {
     for (uint32_t c = 0; c < C; ++c)
       prefixMax_[c] = std::min(range, std::max(c ? prefixMax_[c - 1] : 0.0f, log.fieldError[c]));
     out_.baseFieldError = C ? prefixMax_[C - 1] : 0;
+    // The base chunk compresses on another thread while the splits are encoded.
+    std::future<Result> base = std::async(std::launch::async, [this] {
+      out_.baseInfo.fieldError = out_.baseFieldError;
+      return encodeBaseChunk(out_.base, 0, opt_.zstdLevel, out_.baseFile, out_.baseInfo);
+    });
+    Result r = encodeSplits(C);
+    Result b = base.get();
+    return r ? b : r;
+  }
 
+ private:
+  Result encodeSplits(uint32_t C) {
     target_ = opt_.firstChunkBytes;
     startChunk();
     for (uint32_t c = C; c-- > 0;) {
@@ -59,7 +70,6 @@ class Encoder {
     return collect();
   }
 
- private:
   void buildBase() {
     const uint32_t V = mesh_.vertexCount(), T = mesh_.tetCount();
     out_.streamVertexOf.assign(V, kNone);

@@ -17,12 +17,14 @@ namespace tetstream {
 struct StreamOptions {
   uint32_t firstChunkBytes = 16u << 10;  // compressed size aimed at by the first split chunk
   uint32_t chunkBytes = 256u << 10;      // later chunks double up to this size
-  int zstdLevel = 19;
+  int zstdLevel = 18;
   std::function<void(uint32_t done, uint32_t planned)> progress;  // splits encoded so far
 };
 
 struct EncodedStream {
   TetMesh base;                              // vertices and tets in stream order
+  std::vector<uint8_t> baseFile;             // the base chunk (index 0), compressed
+  ChunkInfo baseInfo;                        // its manifest entry (file name left empty)
   std::vector<std::vector<uint8_t>> files;   // split chunk files, chunk 1 onwards
   std::vector<ChunkInfo> chunks;             // their manifest entries (file names left empty)
   std::vector<uint32_t> streamVertexOf;      // original vertex id -> id in the stream
@@ -31,7 +33,8 @@ struct EncodedStream {
 };
 
 // `mesh` is the simplifier's input (values on the quantization grid of `m` unless lossless);
-// `m` supplies bounds, fields, quantization and the chunk indices start at 1.
+// `m` supplies bounds, fields and quantization. The base mesh is compressed as chunk 0 while the
+// splits are encoded, and the split chunks follow from index 1.
 Result encodeStream(const TetMesh& mesh, const SimplifyResult& s, const Manifest& m, const StreamOptions& opt,
                     EncodedStream& out);
 
