@@ -154,7 +154,7 @@ Runner addPack(CLI::App& app) {
                  {"baseFieldError", m.chunks[0].fieldError}, {"stopReason", s.stopReason},
                  {"flatTetsRemoved", s.flatTetsRemoved}, {"flatTetsLeft", s.flatTetsLeft},
                  {"queuePops", s.queuePops}, {"halvesCollapses", s.halvesCollapses}, {"requeued", s.requeued}, {"costEvaluations", s.costEvaluations},
-                 {"readMs", readMs}, {"simplifyMs", s.simplifyMs}, {"encodeMs", s.encodeMs}, {"writeMs", s.writeMs},
+                 {"readMs", readMs}, {"prepareMs", s.prepareMs}, {"simplifyMs", s.simplifyMs}, {"encodeMs", s.encodeMs}, {"writeMs", s.writeMs},
                  {"ms", total.ms()}, {"peakMemoryMB", peakMemoryMB()}, {"notes", notes}});
       return 0;
     }
@@ -173,8 +173,8 @@ Runner addPack(CLI::App& app) {
     std::printf("  stopped   %s", s.stopReason.c_str());
     if (s.flatTetsRemoved || s.flatTetsLeft)
       std::printf("; flat input tets: %u removed, %u left", s.flatTetsRemoved, s.flatTetsLeft);
-    std::printf("\n  time      read %.0f ms, simplify %.0f ms, encode %.0f ms, write %.0f ms; peak memory %.0f MB\n",
-                readMs, s.simplifyMs, s.encodeMs, s.writeMs, peakMemoryMB());
+    std::printf("\n  time      read %.0f ms, prepare %.0f ms, simplify %.0f ms, encode %.0f ms, write %.0f ms; peak memory %.0f MB\n",
+                readMs, s.prepareMs, s.simplifyMs, s.encodeMs, s.writeMs, peakMemoryMB());
     return 0;
   };
 }

@@ -85,6 +85,7 @@ Result checkMemoryFor(const TetMesh& mesh, const PackOptions& opt) {
 
 Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt, PackSummary& summary) {
   summary = PackSummary{};
+  const auto start = std::chrono::steady_clock::now();
   auto progress = [&](const char* phase, uint64_t done, uint64_t planned) {
     if (opt.progress) opt.progress(phase, done, planned);
   };
@@ -147,6 +148,7 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
 
   // Simplify. Non-manifold or duplicated tets break the collapse's assumptions: keep them whole.
   SimplifyResult simplified;
+  summary.prepareMs = msSince(start);
   auto t0 = std::chrono::steady_clock::now();
   SimplifyOptions so;
   so.weightGeometry = opt.weights[0];

@@ -43,7 +43,7 @@ struct PackSummary {
   uint64_t queuePops = 0, requeued = 0, costEvaluations = 0;  // simplifier work, for benchmarks
   uint32_t halvesCollapses = 0;      // of the collapses, those made in two halves at once
   std::string stopReason;            // why simplification stopped
-  double simplifyMs = 0, encodeMs = 0, writeMs = 0;
+  double prepareMs = 0, simplifyMs = 0, encodeMs = 0, writeMs = 0;  // prepare: checks, orientation, grid
   std::vector<std::string> notes;    // what the packer changed or found, in plain words
 };
 
