@@ -713,6 +713,17 @@ class Simplifier {
   // The legal out-edges of i with their lower bounds (prepareStar(i) and neighbours(i) first).
   void gatherCandidates(Lane& L, uint32_t i) {
     L.candidates.clear();
+    // What boundTerms() reads of each neighbour is scattered over large arrays: ask for it now,
+    // so that it arrives while legal() runs (the loads of the field quadrics were half of
+    // boundTerms' time).
+    for (uint32_t w : L.nbr) {
+      const char* q = reinterpret_cast<const char*>(&fieldQuadric_[w]);
+      __builtin_prefetch(q);
+      __builtin_prefetch(q + 64);
+      __builtin_prefetch(&star_[w]);
+      __builtin_prefetch(&qualitySum_[w]);
+      __builtin_prefetch(&represented_[w]);
+    }
     for (uint32_t w : L.nbr) {
       CollapseVerdict v;
       if (legal(L, i, w, &v)) L.candidates.push_back(boundTerms(L, i, w));
@@ -745,14 +756,18 @@ class Simplifier {
     out.clear();
     ++L.stamp;
     L.seen[v] = L.stamp;
-    for (uint32_t t : star_[v])
+    for (uint32_t t : star_[v]) {
+      __builtin_prefetch(&kappa_[t]);
       for (int k = 0; k < 4; ++k) {
         uint32_t w = out_.tets[4 * size_t(t) + k];
         if (L.seen[w] != L.stamp) {
           L.seen[w] = L.stamp;
           out.push_back(w);
+          __builtin_prefetch(p(w));  // prepareStar and legal() read it next
+          __builtin_prefetch(&fit_[w]);
         }
       }
+    }
   }
 
   // The cost of v's cheapest legal out-edge (infinity when it has none).
