@@ -60,14 +60,29 @@ ValidationReport validateMesh(const TetMesh& m) {
   r.invertedTets = std::min(r.positiveTets, r.negativeTets);
 
   if (indicesOk && T > 0) {
-    // Duplicates: sort the sorted vertex quadruples.
+    // Duplicates: the sorted vertex quadruples, bucketed by their smallest vertex (a counting
+    // sort; duplicates share a bucket), sorted within each small bucket.
     std::vector<std::array<uint32_t, 4>> quads(T);
+    std::vector<uint32_t> start(size_t(V) + 1, 0);
     for (uint32_t t = 0; t < T; ++t) {
-      std::copy_n(&m.tets[4 * size_t(t)], 4, quads[t].begin());
-      std::sort(quads[t].begin(), quads[t].end());
+      std::array<uint32_t, 4> q;
+      std::copy_n(&m.tets[4 * size_t(t)], 4, q.begin());
+      std::sort(q.begin(), q.end());
+      ++start[q[0] + 1];
     }
-    std::sort(quads.begin(), quads.end());
-    for (size_t i = 1; i < quads.size(); ++i) r.duplicateTets += quads[i] == quads[i - 1];
+    for (uint32_t v = 0; v < V; ++v) start[v + 1] += start[v];
+    std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+    for (uint32_t t = 0; t < T; ++t) {
+      std::array<uint32_t, 4> q;
+      std::copy_n(&m.tets[4 * size_t(t)], 4, q.begin());
+      std::sort(q.begin(), q.end());
+      quads[fill[q[0]]++] = q;
+    }
+    for (uint32_t v = 0; v < V; ++v) {
+      auto b = quads.begin() + start[v], e = quads.begin() + start[v + 1];
+      std::sort(b, e);
+      for (auto it = b; it != e && it + 1 != e; ++it) r.duplicateTets += *it == *(it + 1);
+    }
 
     FaceAdjacency adj;
     buildFaceAdjacency(m.tets, V, adj);

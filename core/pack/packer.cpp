@@ -155,7 +155,7 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   so.weightField = opt.weights[1];
   so.weightShape = opt.weights[2];
   so.threads = opt.threads;
-  so.partitionMinVertices = getenv("TS_NOPART") ? ~0u : opt.partitionMinVertices;
+  so.partitionMinVertices = opt.partitionMinVertices;
   so.fitValues = opt.fitValues;
   so.field = iso;
   so.maxError = opt.maxError;
