@@ -141,6 +141,7 @@ class Simplifier {
     tetsAlive_ = T_;
     Worker& W = main_;
     W.log = &out_.log;
+    slack_ = V_ >= opt_.partitionMinVertices ? kLargeMeshSlack : 1.0f;
     if (V_ >= opt_.partitionMinVertices) runParts(planned);
     for (uint32_t v = 0; v < V_; ++v)  // (after the parts: what they left queued)
       if (out_.vertexAlive[v] && queued_[v]) W.heap.push({queueKey(v), v});
@@ -812,7 +813,13 @@ class Simplifier {
   }
 
   // Collapses i along its cheapest legal out-edge (evaluated in L) unless that costs more than
-  // `next`, the key of the next entry: then i goes back into the queue under its new cost.
+  // slack_ × `next`, the key of the next entry: then i goes back into the queue under its new
+  // cost. Most pops find that the cost went up since a neighbour collapsed. On meshes large
+  // enough to be cut in halves, those within 10% are taken anyway: a quarter fewer pops (each
+  // evaluates every out-edge of i), a field error 0.3–1.2% higher on Harmonic 64³ and up to 0.6%
+  // on the carotid data, 1.8% fewer bytes. Small meshes pack in moments: they keep the exact
+  // order (the 8,750 tets of post.vtk got up to 12% worse with the slack).
+  static constexpr float kLargeMeshSlack = 1.1f;
   void tryCollapse(Worker& W, uint32_t i, Lane& L, float next) {
     ++W.pops;
     bool first = true;
@@ -820,7 +827,7 @@ class Simplifier {
       const Candidate cand = L.candidates[size_t(c)];
       if (first) lastCost_[i] = float(cand.cost);
       first = false;
-      if (float(cand.cost) > next) {
+      if (float(cand.cost) > next * slack_) {
         W.heap.push({float(cand.cost), i});  // something else is cheaper now
         queued_[i] = 1;
         ++W.requeued;
@@ -1458,6 +1465,7 @@ class Simplifier {
   uint32_t roundStamp_ = 0;
   Worker main_;     // the one queue of the whole mesh (its log is out_.log)
   Worker parts_[2];  // the two halves of the parallel phase
+  float slack_ = 1.0f;  // see tryCollapse
   std::vector<uint8_t> inner_;  // per vertex: every neighbour is on its side of the cut (runParts)
 };
 
