@@ -356,18 +356,17 @@ class Simplifier {
   }
 
   // Per-tet data of star(i) shared by every candidate target j. With p_j at slot si, the
-  // determinant and the barycentric numerators of p_i are affine in p_j (g·p_j + h), and the
-  // edge and face terms of κ need only a few products per candidate (tet_quality.h).
+  // determinant is affine in p_j (g·p_j + h), and the edge and face terms of κ need only a few
+  // products per candidate (tet_quality.h).
   struct StarTet {
     uint32_t t;
     uint32_t other[3];        // the vertices besides i, in slot order
-    double g[4][3], h[4];     // [0]: det of the new tet; [1..3]: numerators with p_i at other[k-1]
+    double g[3], h;           // det of the new tet with P in the slot of i: g·P + h
     double detOld;            // det with p_i (numerator for the slot of i)
     double fixedEdges, sumSq, sum[3], fixedFace;
     double C[3][3], D[3][3];  // faces (P, x, y): cross = C - P × D
     double x[3][3];           // positions of the other vertices
     double sign;              // orientation sign of the slot of i
-    bool baryReady;           // g[1..3], h[1..3] computed
     float f[3];               // field at the other vertices
     float kappa;              // κ of the tet now
     double quality;           // 3/κ now
@@ -509,9 +508,8 @@ class Simplifier {
       }
       // Moving the vertex at slot si to the front takes si adjacent swaps.
       st.sign = (si & 1) ? -1.0 : 1.0;
-      affineDet(st.x[0], st.x[1], st.x[2], st.sign, st.g[0], &st.h[0]);
-      st.baryReady = false;
-      st.detOld = st.g[0][0] * pi[0] + st.g[0][1] * pi[1] + st.g[0][2] * pi[2] + st.h[0];
+      affineDet(st.x[0], st.x[1], st.x[2], st.sign, st.g, &st.h);
+      st.detOld = st.g[0] * pi[0] + st.g[1] * pi[1] + st.g[2] * pi[2] + st.h;
     }
     const double diam2 = (hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]);
     L.flatBound = kFlat * diam2 * std::sqrt(diam2);
@@ -519,17 +517,6 @@ class Simplifier {
     // the star now: real meshes (boundary layers of CFD grids) start with tets far below any
     // fixed minimum, and a collapse that does not make their region worse is allowed.
     L.qualityFloor = std::min(opt_.minQuality, 3.0 / double(worstKappa));
-  }
-
-  // Numerators of the barycentric coordinates of p_i with p_j's position P in the slot of i:
-  // with p_i in each other slot (computed on first use, for the legal candidates only).
-  static void prepareBary(StarTet& st, const double* pi) {
-    st.baryReady = true;
-    for (int k = 0; k < 3; ++k) {
-      const double* y[3] = {st.x[0], st.x[1], st.x[2]};
-      y[k] = pi;
-      affineDet(y[0], y[1], y[2], st.sign, st.g[k + 1], &st.h[k + 1]);
-    }
   }
 
   // Whether the new tet (P and the others of st) is flat, judged by its own longest edge.
@@ -593,7 +580,7 @@ class Simplifier {
         ++L.removed;
         continue;
       }
-      const double det = st.g[0][0] * P[0] + st.g[0][1] * P[1] + st.g[0][2] * P[2] + st.h[0];
+      const double det = st.g[0] * P[0] + st.g[1] * P[1] + st.g[2] * P[2] + st.h;
       if (det <= 0) return *verdict = CollapseVerdict::Inverted, false;
       if (det <= L.flatBound && isFlat(st, P, det)) return *verdict = CollapseVerdict::Flat, false;
     }
@@ -656,16 +643,27 @@ class Simplifier {
   void localTerm(Lane& L, uint32_t i, Candidate& c) {
     const uint32_t j = c.j;
     const double* P = p(j);
+    const double* pi = p(i);
+    const double d[3] = {pi[0] - P[0], pi[1] - P[1], pi[2] - P[2]};
     double bestInside = -kInf, interp = c.sj;
-    for (StarTet& st : L.star) {
+    for (const StarTet& st : L.star) {
       if (st.other[0] == j || st.other[1] == j || st.other[2] == j) continue;  // removed
-      if (!st.baryReady) prepareBary(st, p(i));
-      double num[4] = {st.detOld, 0, 0, 0}, lo = num[0];
-      for (int k = 1; k < 4; ++k) {
-        num[k] = st.g[k][0] * P[0] + st.g[k][1] * P[1] + st.g[k][2] * P[2] + st.h[k];
-        lo = std::min(lo, num[k]);
+      // The new tet is P and the others x0, x1, x2 with det = sign·(x0 − P)·((x1 − P) × (x2 − P)).
+      // p_i's barycentric numerators: that det with p_i in place of the vertex (detOld for P).
+      double a[3], b[3], e[3], be[3], de[3], bd[3];
+      for (int k = 0; k < 3; ++k) {
+        a[k] = st.x[0][k] - P[k];
+        b[k] = st.x[1][k] - P[k];
+        e[k] = st.x[2][k] - P[k];
       }
-      const double det = st.g[0][0] * P[0] + st.g[0][1] * P[1] + st.g[0][2] * P[2] + st.h[0];
+      cross(b, e, be);
+      cross(d, e, de);
+      cross(b, d, bd);
+      double num[4] = {st.detOld, st.sign * (d[0] * be[0] + d[1] * be[1] + d[2] * be[2]),
+                       st.sign * (a[0] * de[0] + a[1] * de[1] + a[2] * de[2]),
+                       st.sign * (a[0] * bd[0] + a[1] * bd[1] + a[2] * bd[2])};
+      const double lo = std::min({num[0], num[1], num[2], num[3]});
+      const double det = st.g[0] * P[0] + st.g[1] * P[1] + st.g[2] * P[2] + st.h;
       if (lo < 0 && lo / det <= bestInside) continue;
       bestInside = lo / det;
       interp = (num[0] / det) * c.sj + ((num[1] / det) * st.f[0] + (num[2] / det) * st.f[1] + (num[3] / det) * st.f[2]);
@@ -688,7 +686,7 @@ class Simplifier {
         --count;
         continue;
       }
-      const double det = st.g[0][0] * P[0] + st.g[0][1] * P[1] + st.g[0][2] * P[2] + st.h[0];
+      const double det = st.g[0] * P[0] + st.g[1] * P[1] + st.g[2] * P[2] + st.h;
       const double edges = st.fixedEdges + 3 * PP - 2 * (P[0] * st.sum[0] + P[1] * st.sum[1] + P[2] * st.sum[2]) + st.sumSq;
       double faces = st.fixedFace;
       for (int q = 0; q < 3; ++q) {
