@@ -363,8 +363,7 @@ class Simplifier {
     uint32_t other[3];        // the vertices besides i, in slot order
     double g[3], h;           // det of the new tet with P in the slot of i: g·P + h
     double detOld;            // det with p_i (numerator for the slot of i)
-    double fixedEdges, sumSq, sum[3], fixedFace;
-    double C[3][3], D[3][3];  // faces (P, x, y): cross = C - P × D
+    double fixedEdges, fixedFace;  // κ's terms of the edges and the face without p_i (prepareShape)
     double x[3][3];           // positions of the other vertices
     double sign;              // orientation sign of the slot of i
     float f[3];               // field at the other vertices
@@ -530,6 +529,7 @@ class Simplifier {
     double d0 = a[0] - b[0], d1 = a[1] - b[1], d2 = a[2] - b[2];
     return d0 * d0 + d1 * d1 + d2 * d2;
   }
+  static double dot(const double* u, const double* v) { return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]; }
   static void cross(const double* u, const double* v, double* n) {
     n[0] = u[1] * v[2] - u[2] * v[1];
     n[1] = u[2] * v[0] - u[0] * v[2];
@@ -543,17 +543,6 @@ class Simplifier {
     for (StarTet& st : L.star) {
       const double* x[3] = {st.x[0], st.x[1], st.x[2]};
       st.fixedEdges = dist2(x[0], x[1]) + dist2(x[0], x[2]) + dist2(x[1], x[2]);
-      st.sumSq = 0;
-      for (int k = 0; k < 3; ++k) {
-        st.sum[k] = x[0][k] + x[1][k] + x[2][k];
-        st.sumSq += x[0][k] * x[0][k] + x[1][k] * x[1][k] + x[2][k] * x[2][k];
-      }
-      const int pairs[3][2] = {{0, 1}, {1, 2}, {0, 2}};
-      for (int q = 0; q < 3; ++q) {
-        const double *a = x[pairs[q][0]], *b = x[pairs[q][1]];
-        cross(a, b, st.C[q]);
-        for (int k = 0; k < 3; ++k) st.D[q][k] = b[k] - a[k];
-      }
       double u[3] = {x[1][0] - x[0][0], x[1][1] - x[0][1], x[1][2] - x[0][2]};
       double w[3] = {x[2][0] - x[0][0], x[2][1] - x[0][1], x[2][2] - x[0][2]};
       double n3[3];
@@ -677,7 +666,6 @@ class Simplifier {
     prepareShape(L);
     const uint32_t j = c.j;
     const double* P = p(j);
-    const double PP = P[0] * P[0] + P[1] * P[1] + P[2] * P[2];
     double qualitySum = qualitySum_[j];
     int64_t count = int64_t(star_[j].size());
     for (const StarTet& st : L.star) {
@@ -687,14 +675,18 @@ class Simplifier {
         continue;
       }
       const double det = st.g[0] * P[0] + st.g[1] * P[1] + st.g[2] * P[2] + st.h;
-      const double edges = st.fixedEdges + 3 * PP - 2 * (P[0] * st.sum[0] + P[1] * st.sum[1] + P[2] * st.sum[2]) + st.sumSq;
-      double faces = st.fixedFace;
-      for (int q = 0; q < 3; ++q) {
-        double pd[3];
-        cross(P, st.D[q], pd);
-        double c0 = st.C[q][0] - pd[0], c1 = st.C[q][1] - pd[1], c2 = st.C[q][2] - pd[2];
-        faces += c0 * c0 + c1 * c1 + c2 * c2;
+      // The edges and faces at P: a, b, e run from P to the others.
+      double a[3], b[3], e[3], ab[3], be[3], ae[3];
+      for (int k = 0; k < 3; ++k) {
+        a[k] = st.x[0][k] - P[k];
+        b[k] = st.x[1][k] - P[k];
+        e[k] = st.x[2][k] - P[k];
       }
+      cross(a, b, ab);
+      cross(b, e, be);
+      cross(a, e, ae);
+      const double edges = st.fixedEdges + dot(a, a) + dot(b, b) + dot(e, e);
+      const double faces = st.fixedFace + dot(ab, ab) + dot(be, be) + dot(ae, ae);
       // 3/κ = 3·det / sqrt(edges · faces / 4): one root and one division.
       const double quality = 6.0 * det / std::sqrt(edges * faces);
       if (quality < L.qualityFloor) return *verdict = CollapseVerdict::LowQuality, false;
