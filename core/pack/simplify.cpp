@@ -361,9 +361,9 @@ class Simplifier {
   struct StarTet {
     uint32_t t;
     uint32_t other[3];        // the vertices besides i, in slot order
-    double g[3], h;           // det of the new tet with P in the slot of i: g·P + h
+    double g[3];              // det of the new tet with P in the slot of i: g·(P − x[0]) (newDet)
     double detOld;            // det with p_i (numerator for the slot of i)
-    double fixedEdges, fixedFace;  // κ's terms of the edges and the face without p_i (prepareShape)
+    double fixedEdges, fixedFace;  // κ's terms of the edges and the face without p_i
     double x[3][3];           // positions of the other vertices
     double sign;              // orientation sign of the slot of i
     float f[3];               // field at the other vertices
@@ -386,7 +386,6 @@ class Simplifier {
   // Scratch for evaluating one vertex's out-edges; one per thread.
   struct Lane {
     std::vector<StarTet> star;
-    bool shapeReady = false;
     double flatBound = 0;  // see prepareStar
     double qualityFloor = 0;  // the least 3/κ a changed tet may have (see prepareStar)
     double removedQuality = 0;  // of the last legal() candidate: Σ 3/κ of the tets it removes
@@ -466,19 +465,9 @@ class Simplifier {
   };
 
 
-  static void affineDet(const double* a, const double* b, const double* c, double sign, double* g, double* h) {
-    // (a - P)·((b - P) × (c - P)) = a·(b×c) - P·(b×c + c×a + a×b)
-    double bc[3] = {b[1] * c[2] - b[2] * c[1], b[2] * c[0] - b[0] * c[2], b[0] * c[1] - b[1] * c[0]};
-    double ca[3] = {c[1] * a[2] - c[2] * a[1], c[2] * a[0] - c[0] * a[2], c[0] * a[1] - c[1] * a[0]};
-    double ab[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-    for (int k = 0; k < 3; ++k) g[k] = -sign * (bc[k] + ca[k] + ab[k]);
-    *h = sign * (a[0] * bc[0] + a[1] * bc[1] + a[2] * bc[2]);
-  }
-
   void prepareStar(Lane& L, uint32_t i) {
     const std::vector<uint32_t>& star = star_[i];
     L.star.resize(star.size());
-    L.shapeReady = false;
     const double* pi = p(i);
     // Every edge of a tet after the collapse lies in the star's bounding box, so the flatness
     // threshold of the longest possible edge bounds every tet's own threshold from above.
@@ -505,10 +494,21 @@ class Simplifier {
         }
         ++m;
       }
-      // Moving the vertex at slot si to the front takes si adjacent swaps.
+      // Moving the vertex at slot si to the front takes si adjacent swaps. With u, w the edges
+      // from x0, det(P) = sign·(x0 − P)·((x1 − P) × (x2 − P)) = g·(P − x0), g = −sign·(u × w):
+      // relative to x0, so no large terms cancel.
       st.sign = (si & 1) ? -1.0 : 1.0;
-      affineDet(st.x[0], st.x[1], st.x[2], st.sign, st.g, &st.h);
-      st.detOld = st.g[0] * pi[0] + st.g[1] * pi[1] + st.g[2] * pi[2] + st.h;
+      double u[3], w[3];
+      for (int k = 0; k < 3; ++k) {
+        u[k] = st.x[1][k] - st.x[0][k];
+        w[k] = st.x[2][k] - st.x[0][k];
+      }
+      cross(u, w, st.g);
+      for (double& x : st.g) x *= -st.sign;
+      st.detOld = newDet(st, pi);
+      // κ's terms without p_i: the face of the others (|u × w|²) and its edges.
+      st.fixedFace = dot(st.g, st.g);
+      st.fixedEdges = dot(u, u) + dot(w, w) + dist2(st.x[1], st.x[2]);
     }
     const double diam2 = (hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]);
     L.flatBound = kFlat * diam2 * std::sqrt(diam2);
@@ -530,25 +530,14 @@ class Simplifier {
     return d0 * d0 + d1 * d1 + d2 * d2;
   }
   static double dot(const double* u, const double* v) { return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]; }
+  // The determinant of st's tet with P in the slot of i (positive: properly oriented).
+  static double newDet(const StarTet& st, const double* P) {
+    return st.g[0] * (P[0] - st.x[0][0]) + st.g[1] * (P[1] - st.x[0][1]) + st.g[2] * (P[2] - st.x[0][2]);
+  }
   static void cross(const double* u, const double* v, double* n) {
     n[0] = u[1] * v[2] - u[2] * v[1];
     n[1] = u[2] * v[0] - u[0] * v[2];
     n[2] = u[0] * v[1] - u[1] * v[0];
-  }
-
-  // The parts of κ that do not depend on the target: only needed once a candidate is finished.
-  void prepareShape(Lane& L) {
-    if (L.shapeReady) return;
-    L.shapeReady = true;
-    for (StarTet& st : L.star) {
-      const double* x[3] = {st.x[0], st.x[1], st.x[2]};
-      st.fixedEdges = dist2(x[0], x[1]) + dist2(x[0], x[2]) + dist2(x[1], x[2]);
-      double u[3] = {x[1][0] - x[0][0], x[1][1] - x[0][1], x[1][2] - x[0][2]};
-      double w[3] = {x[2][0] - x[0][0], x[2][1] - x[0][1], x[2][2] - x[0][2]};
-      double n3[3];
-      cross(u, w, n3);
-      st.fixedFace = n3[0] * n3[0] + n3[1] * n3[1] + n3[2] * n3[2];
-    }
   }
 
   // Cost of hec(i → j) given prepareStar(i), in steps so that the expensive terms are only
@@ -569,7 +558,7 @@ class Simplifier {
         ++L.removed;
         continue;
       }
-      const double det = st.g[0] * P[0] + st.g[1] * P[1] + st.g[2] * P[2] + st.h;
+      const double det = newDet(st, P);
       if (det <= 0) return *verdict = CollapseVerdict::Inverted, false;
       if (det <= L.flatBound && isFlat(st, P, det)) return *verdict = CollapseVerdict::Flat, false;
     }
@@ -652,7 +641,7 @@ class Simplifier {
                        st.sign * (a[0] * de[0] + a[1] * de[1] + a[2] * de[2]),
                        st.sign * (a[0] * bd[0] + a[1] * bd[1] + a[2] * bd[2])};
       const double lo = std::min({num[0], num[1], num[2], num[3]});
-      const double det = st.g[0] * P[0] + st.g[1] * P[1] + st.g[2] * P[2] + st.h;
+      const double det = newDet(st, P);
       if (lo < 0 && lo / det <= bestInside) continue;
       bestInside = lo / det;
       interp = (num[0] / det) * c.sj + ((num[1] / det) * st.f[0] + (num[2] / det) * st.f[1] + (num[3] / det) * st.f[2]);
@@ -663,7 +652,6 @@ class Simplifier {
   }
 
   bool finishCost(Lane& L, Candidate& c, CollapseVerdict* verdict) {
-    prepareShape(L);
     const uint32_t j = c.j;
     const double* P = p(j);
     double qualitySum = qualitySum_[j];
@@ -674,7 +662,7 @@ class Simplifier {
         --count;
         continue;
       }
-      const double det = st.g[0] * P[0] + st.g[1] * P[1] + st.g[2] * P[2] + st.h;
+      const double det = newDet(st, P);
       // The edges and faces at P: a, b, e run from P to the others.
       double a[3], b[3], e[3], ab[3], be[3], ae[3];
       for (int k = 0; k < 3; ++k) {
