@@ -28,7 +28,7 @@ void note(std::vector<std::string>& out, uint64_t count, const std::string& what
 
 }  // namespace
 
-ValidationReport validateMesh(const TetMesh& m) {
+ValidationReport validateMesh(const TetMesh& m, FaceAdjacency* adjacency) {
   ValidationReport r;
   const uint32_t V = m.vertexCount(), T = m.tetCount();
   r.noTets = T == 0;
@@ -91,6 +91,7 @@ ValidationReport validateMesh(const TetMesh& m) {
     extractBoundary(m.tets, adj, boundary);
     r.boundaryFaces = boundary.size() / 3;
     r.nonManifoldBoundaryEdges = countNonManifoldBoundaryEdges(boundary);
+    if (adjacency) *adjacency = std::move(adj);
   }
 
   if (r.noTets) r.findings.push_back("the mesh has no tetrahedra");

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "adjacency.h"
 #include "mesh.h"
 
 namespace tetstream {
@@ -30,6 +31,7 @@ struct ValidationReport {
   bool fatal() const { return noTets || outOfRangeIndices || repeatedVertexTets || nonFinitePositions; }
 };
 
-ValidationReport validateMesh(const TetMesh& mesh);
+// With `adjacency`, the face adjacency it builds is handed over (empty when the indices are bad).
+ValidationReport validateMesh(const TetMesh& mesh, FaceAdjacency* adjacency = nullptr);
 
 }  // namespace tetstream

@@ -91,7 +91,8 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   };
   if (Result r = checkMemoryFor(mesh, opt); !r) return r;
   progress("validate", 0, 0);
-  ValidationReport report = validateMesh(mesh);
+  FaceAdjacency adjacency;  // built by the validation, used again by the simplifier
+  ValidationReport report = validateMesh(mesh, &adjacency);
   if (report.fatal()) {
     std::string why;
     for (const std::string& f : report.findings) why += (why.empty() ? "" : "; ") + f;
@@ -109,10 +110,16 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   for (const std::string& f : report.findings) summary.notes.push_back("input: " + f);
 
   // FORMAT.md §3 wants positively oriented tets: flip the others (an odd permutation).
+  // (Swapping slots 2 and 3 swaps the faces opposite them: the adjacency follows.)
   for (uint32_t t = 0; t < mesh.tetCount(); ++t)
     if (tetVolume(mesh, t) < 0) {
       std::swap(mesh.tets[4 * size_t(t) + 2], mesh.tets[4 * size_t(t) + 3]);
       ++summary.flippedTets;
+      if (adjacency.opposite.size() != mesh.tets.size()) continue;
+      std::vector<uint32_t>& opp = adjacency.opposite;
+      std::swap(opp[4 * size_t(t) + 2], opp[4 * size_t(t) + 3]);
+      for (uint32_t h = 4 * t + 2; h <= 4 * t + 3; ++h)
+        if (opp[h] != kNoNeighbor) opp[opp[h]] = h;
     }
   if (summary.flippedTets)
     summary.notes.push_back("re-oriented " + std::to_string(summary.flippedTets) + " negatively oriented tetrahedra");
@@ -170,7 +177,7 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
     so.targetVertices = mesh.vertexCount();
   }
   so.progress = [&](uint32_t done, uint32_t planned) { progress("simplify", done, planned); };
-  if (Result r = simplifyMesh(mesh, so, simplified); !r) return r;
+  if (Result r = simplifyMesh(mesh, so, simplified, &adjacency); !r) return r;
   summary.simplifyMs = msSince(t0);
   summary.stopReason = simplified.stopReason;
   summary.flatTetsRemoved = simplified.flatTetsRemoved;

@@ -115,7 +115,8 @@ uint64_t makeEdge(uint32_t a, uint32_t b) { return a < b ? uint64_t(a) << 32 | b
 
 class Simplifier {
  public:
-  Simplifier(const TetMesh& m, const SimplifyOptions& o, SimplifyResult& r) : mesh_(m), opt_(o), out_(r) {}
+  Simplifier(const TetMesh& m, const SimplifyOptions& o, SimplifyResult& r, FaceAdjacency* adjacency = nullptr)
+      : mesh_(m), opt_(o), out_(r), adjacency_(adjacency) {}
 
   CollapseVerdict check(uint32_t i, uint32_t j) {
     init();
@@ -234,9 +235,13 @@ class Simplifier {
     for (uint32_t v = 0; v < V_; ++v)
       if (!star_[v].empty()) { out_.vertexAlive[v] = 1; ++alive_; }
 
-    FaceAdjacency adj;
-    buildFaceAdjacency(out_.tets, V_, adj);
-    opp_ = std::move(adj.opposite);
+    if (adjacency_ && adjacency_->opposite.size() == out_.tets.size()) {
+      opp_ = std::move(adjacency_->opposite);
+    } else {
+      FaceAdjacency adj;
+      buildFaceAdjacency(out_.tets, V_, adj);
+      opp_ = std::move(adj.opposite);
+    }
     boundary_.assign(V_, 0);
     quadric_.assign(V_, {});
     for (uint32_t h = 0; h < 4 * T_; ++h) {
@@ -1420,6 +1425,7 @@ class Simplifier {
   const TetMesh& mesh_;
   const SimplifyOptions& opt_;
   SimplifyResult& out_;
+  FaceAdjacency* adjacency_;  // the caller's, taken over by init() (or none)
   uint32_t V_ = 0, T_ = 0, alive_ = 0, tetsAlive_ = 0, flatInput_ = 0;
   std::vector<double> pos_;
   const float* field_ = nullptr;
@@ -1468,10 +1474,10 @@ CollapseVerdict checkCollapse(const TetMesh& mesh, uint32_t i, uint32_t j, const
   return s.check(i, j);
 }
 
-Result simplifyMesh(const TetMesh& mesh, const SimplifyOptions& options, SimplifyResult& out) {
+Result simplifyMesh(const TetMesh& mesh, const SimplifyOptions& options, SimplifyResult& out, FaceAdjacency* adjacency) {
   assert(options.field >= 0 && size_t(options.field) < mesh.fields.size());
   out = SimplifyResult{};
-  Simplifier s(mesh, options, out);
+  Simplifier s(mesh, options, out, adjacency);
   return s.run();
 }
 

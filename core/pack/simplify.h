@@ -43,6 +43,7 @@
 #include <string>
 #include <vector>
 
+#include "adjacency.h"
 #include "mesh.h"
 #include "status.h"
 
@@ -116,6 +117,8 @@ CollapseVerdict checkCollapse(const TetMesh& mesh, uint32_t i, uint32_t j, const
 
 // Simplifies `mesh` (positions already on the packer's quantization grid; tets positively
 // oriented or flat). Fails only on a mesh the caller should have validated (asserted).
-Result simplifyMesh(const TetMesh& mesh, const SimplifyOptions& options, SimplifyResult& out);
+// `adjacency`, when given, is the face adjacency of `mesh` (buildFaceAdjacency), saving its rebuild.
+Result simplifyMesh(const TetMesh& mesh, const SimplifyOptions& options, SimplifyResult& out,
+                    FaceAdjacency* adjacency = nullptr);
 
 }  // namespace tetstream
