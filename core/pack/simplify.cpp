@@ -1087,8 +1087,11 @@ class Simplifier {
       ++edgeEdges;  // (k, ω) for the boundary face (i, j, k): one per face
     });
     if (common != edgeVerts + (boundaryEdge ? 1 : 0)) TS_LINK_RESULT(false);
-    // Edges: those of Lk(j) in a table, then the distinct ones of Lk(i) found there.
+    // Edges: those of Lk(j) in a table, then the distinct ones of Lk(i) found there. With the
+    // vertices equal, an edge in both links has both ends in Lk(ij) (stamped stampE; ω when the
+    // edge is on the boundary): only those are looked at.
     W.edgeTable.beginSet(++W.edgeTableStamp);
+    auto inEdgeLink = [&](uint32_t x) { return L.seen[x] == stampE; };
     auto linkEdgesOf = [&](uint32_t v, auto&& each) {
       for (uint32_t t : star_[v]) {
         const uint32_t* x = &out_.tets[4 * size_t(t)];
@@ -1096,14 +1099,16 @@ class Simplifier {
         int n = 0;
         for (int k = 0; k < 4; ++k)
           if (x[k] != v) o[n++] = x[k];
-        each(makeEdge(o[0], o[1]));
-        each(makeEdge(o[0], o[2]));
-        each(makeEdge(o[1], o[2]));
+        const bool in[3] = {inEdgeLink(o[0]), inEdgeLink(o[1]), inEdgeLink(o[2])};
+        if (in[0] && in[1]) each(makeEdge(o[0], o[1]));
+        if (in[0] && in[2]) each(makeEdge(o[0], o[2]));
+        if (in[1] && in[2]) each(makeEdge(o[1], o[2]));
       }
-      forBoundaryFaces(v, [&](uint32_t a, uint32_t b) {
-        each(makeEdge(a, kOmega));
-        each(makeEdge(b, kOmega));
-      });
+      if (boundaryEdge)
+        forBoundaryFaces(v, [&](uint32_t a, uint32_t b) {
+          if (inEdgeLink(a)) each(makeEdge(a, kOmega));
+          if (inEdgeLink(b)) each(makeEdge(b, kOmega));
+        });
     };
     linkEdgesOf(j, [&](uint64_t e) { W.edgeTable.mark(e, 1); });
     size_t commonEdges = 0;

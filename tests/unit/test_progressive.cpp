@@ -275,8 +275,10 @@ TEST(Progressive, HalvesCollapseTheSameOnOneThreadAndTwo) {
   SimplifyOptions o;
   o.targetVertices = 100;
   o.partitionMinVertices = 0;
+  o.verifyLinkCondition = true;  // (and the fast link check agrees with the reference throughout)
   o.threads = 1;
   ASSERT_TRUE(simplifyMesh(m, o, one));
+  EXPECT_EQ(one.linkMismatches, 0u);
   o.threads = 2;
   ASSERT_TRUE(simplifyMesh(m, o, two));
   EXPECT_GT(one.halvesCollapses, one.log.size() * 8 / 10);
