@@ -125,8 +125,9 @@ class Simplifier {
     if (std::find(L.nbr.begin(), L.nbr.end(), j) == L.nbr.end()) return CollapseVerdict::NotAnEdge;
     CollapseVerdict v = CollapseVerdict::Legal;
     prepareStar(L, i);
-    if (legal(L, i, j, &v)) {
-      Candidate c = boundTerms(L, i, j);
+    const size_t slot = size_t(std::find(L.nbr.begin(), L.nbr.end(), j) - L.nbr.begin());
+    if (legal(L, i, j, bitOf(slot), &v)) {
+      Candidate c = boundTerms(L, i, j, bitOf(slot));
       localTerm(L, i, c);
       finishCost(L, c, &v);
     }
@@ -300,9 +301,9 @@ class Simplifier {
     lastCost_.assign(V_, float(kInf));
     // Every vertex's first cost, on two threads (each with its own scratch lane; the mesh is
     // only read), then queued in vertex order so the result does not depend on the threads.
-    main_.lane.seen.assign(V_, 0);
+    main_.lane.reset(V_);
     lanes_.resize(kRoundSize);
-    for (Lane& L : lanes_) L.seen.assign(V_, 0);
+    for (Lane& L : lanes_) L.reset(V_);
     auto work = [this](Lane& L, uint32_t begin, uint32_t end) {
       for (uint32_t v = begin; v < end; ++v)
         if (out_.vertexAlive[v]) lastCost_[v] = bestCost(L, v);
@@ -366,6 +367,7 @@ class Simplifier {
   struct StarTet {
     uint32_t t;
     uint32_t other[3];        // the vertices besides i, in slot order
+    uint64_t mask;            // bitOf() their places in Lane::nbr (see removes())
     double g[3];              // det of the new tet with P in the slot of i: g·(P − x[0]) (newDet)
     double detOld;            // det with p_i (numerator for the slot of i)
     double fixedEdges, fixedFace;  // κ's terms of the edges and the face without p_i
@@ -384,6 +386,7 @@ class Simplifier {
     double base;     // the cost without the shape term
     double sj, region, eg, weight, shapeBound;  // parts of the cost (boundTerms)
     uint32_t j;
+    uint64_t bit;    // bitOf(j's place in Lane::nbr)
     float fieldErr;  // E_f (from stage Local on)
     Stage stage;
   };
@@ -398,6 +401,11 @@ class Simplifier {
     std::vector<uint32_t> nbr;
     std::vector<Candidate> candidates;
     std::vector<uint32_t> seen;  // neighbour stamps
+    std::vector<uint8_t> place;  // per vertex seen with the last stamp of neighbours(): its place in nbr (≤ 255)
+    void reset(uint32_t vertices) {
+      seen.assign(vertices, 0);
+      place.assign(vertices, 0);
+    }
     uint32_t stamp = 0;
     uint64_t evaluations = 0;
   };
@@ -483,6 +491,7 @@ class Simplifier {
       const uint32_t* v = &out_.tets[4 * size_t(t)];
       StarTet& st = L.star[n];
       st.t = t;
+      st.mask = 0;
       st.kappa = kappa_[t];
       st.quality = 3.0 / st.kappa;
       worstKappa = std::max(worstKappa, st.kappa);
@@ -491,6 +500,7 @@ class Simplifier {
         if (v[k] == i) { si = k; continue; }
         const double* q = p(v[k]);
         st.other[m] = v[k];
+        st.mask |= bitOf(L.place[v[k]]);
         st.f[m] = fit_[v[k]];
         for (int a = 0; a < 3; ++a) {
           st.x[m][a] = q[a];
@@ -535,6 +545,12 @@ class Simplifier {
     return d0 * d0 + d1 * d1 + d2 * d2;
   }
   static double dot(const double* u, const double* v) { return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]; }
+  // A bit for each of the first 64 neighbours (by place in Lane::nbr), 0 for the others.
+  static uint64_t bitOf(size_t place) { return place < 64 ? uint64_t(1) << place : 0; }
+  // Whether the collapse onto j (bit: bitOf(its place)) removes star tet st: st has j.
+  static bool removes(const StarTet& st, uint32_t j, uint64_t bit) {
+    return bit ? (st.mask & bit) != 0 : st.other[0] == j || st.other[1] == j || st.other[2] == j;
+  }
   // The determinant of st's tet with P in the slot of i (positive: properly oriented).
   static double newDet(const StarTet& st, const double* P) {
     return st.g[0] * (P[0] - st.x[0][0]) + st.g[1] * (P[1] - st.x[0][1]) + st.g[2] * (P[2] - st.x[0][2]);
@@ -550,7 +566,7 @@ class Simplifier {
   // rule and that no tet inverts or flattens, boundTerms() a lower bound from the geometric and
   // region terms, localTerm() adds the local field error, finishCost() the exact shape term and
   // the minimum-quality check.
-  bool legal(Lane& L, uint32_t i, uint32_t j, CollapseVerdict* verdict) {
+  bool legal(Lane& L, uint32_t i, uint32_t j, uint64_t bit, CollapseVerdict* verdict) {
     ++L.evaluations;
     *verdict = CollapseVerdict::Legal;
     if (boundary_[i] && !isBoundaryEdge(i, j)) return *verdict = CollapseVerdict::BoundaryRule, false;
@@ -558,7 +574,7 @@ class Simplifier {
     L.removedQuality = 0;  // Σ 3/κ of the tets the collapse removes, and their count
     L.removed = 0;
     for (const StarTet& st : L.star) {
-      if (st.other[0] == j || st.other[1] == j || st.other[2] == j) {
+      if (removes(st, j, bit)) {
         L.removedQuality += st.quality;
         ++L.removed;
         continue;
@@ -572,10 +588,11 @@ class Simplifier {
 
   // Everything of the cost but the local field error and the exact shape term: the geometric
   // error, the region term of the field error and a lower bound of the shape term.
-  Candidate boundTerms(Lane& L, uint32_t i, uint32_t j) {
+  Candidate boundTerms(Lane& L, uint32_t i, uint32_t j, uint64_t bit) {
     const double* P = p(j);
     Candidate c;
     c.j = j;
+    c.bit = bit;
     FieldQuadric fq = fieldQuadric_[i];
     fq.add(fieldQuadric_[j]);
     const uint32_t count = represented_[i] + represented_[j];
@@ -630,7 +647,7 @@ class Simplifier {
     const double d[3] = {pi[0] - P[0], pi[1] - P[1], pi[2] - P[2]};
     double bestInside = -kInf, interp = c.sj;
     for (const StarTet& st : L.star) {
-      if (st.other[0] == j || st.other[1] == j || st.other[2] == j) continue;  // removed
+      if (removes(st, j, c.bit)) continue;
       // The new tet is P and the others x0, x1, x2 with det = sign·(x0 − P)·((x1 − P) × (x2 − P)).
       // p_i's barycentric numerators: that det with p_i in place of the vertex (detOld for P).
       double a[3], b[3], e[3], be[3], de[3], bd[3];
@@ -662,7 +679,7 @@ class Simplifier {
     double qualitySum = qualitySum_[j];
     int64_t count = int64_t(star_[j].size());
     for (const StarTet& st : L.star) {
-      if (st.other[0] == j || st.other[1] == j || st.other[2] == j) {  // removed by the collapse
+      if (removes(st, j, c.bit)) {
         qualitySum -= st.quality;
         --count;
         continue;
@@ -708,9 +725,10 @@ class Simplifier {
       __builtin_prefetch(&qualitySum_[w]);
       __builtin_prefetch(&represented_[w]);
     }
-    for (uint32_t w : L.nbr) {
+    for (size_t n = 0; n < L.nbr.size(); ++n) {
       CollapseVerdict v;
-      if (legal(L, i, w, &v)) L.candidates.push_back(boundTerms(L, i, w));
+      const uint32_t w = L.nbr[n];
+      if (legal(L, i, w, bitOf(n), &v)) L.candidates.push_back(boundTerms(L, i, w, bitOf(n)));
     }
   }
 
@@ -746,6 +764,7 @@ class Simplifier {
         uint32_t w = out_.tets[4 * size_t(t) + k];
         if (L.seen[w] != L.stamp) {
           L.seen[w] = L.stamp;
+          L.place[w] = uint8_t(std::min<size_t>(out.size(), 255));
           out.push_back(w);
           __builtin_prefetch(p(w));  // prepareStar and legal() read it next
           __builtin_prefetch(&fit_[w]);
@@ -912,7 +931,7 @@ class Simplifier {
     };
     for (int part = 0; part < 2; ++part) {
       parts_[part].part = part;
-      parts_[part].lane.seen.assign(V_, 0);
+      parts_[part].lane.reset(V_);
     }
     for (;;) {
       const double leftV = budgetV - (parts_[0].collapsed + parts_[1].collapsed);
