@@ -929,9 +929,22 @@ class Simplifier {
           opt_.progress(parts_[0].collapsed + parts_[1].collapsed, planned);
       }
     };
+    // Each half's log sized for its share up front (a log grown by doubling holds up to twice
+    // its size): a collapse removes about (T − target tets) / planned tets and moves the rest of
+    // a star of 4T/V tets.
+    const double collapses = std::min(budgetV, budgetT * planned / std::max(1.0, double(tetsAlive_)));
+    const double removedEach = double(tetsAlive_ - std::min<uint32_t>(tetsAlive_, opt_.targetTets)) / std::max(1u, planned);
+    const double movedEach = std::max(0.0, 4.0 * tetsAlive_ / std::max<size_t>(order.size(), 1) - removedEach);
     for (int part = 0; part < 2; ++part) {
       parts_[part].part = part;
       parts_[part].lane.reset(V_);
+      const double share = 1.05 * collapses * inner[part] / (inner[0] + inner[1]);
+      CollapseLog& log = parts_[part].ownLog;
+      forEachArray(log, [&](auto& v) { v.reserve(size_t(share)); });
+      log.moved.reserve(size_t(share * movedEach));
+      log.removed.reserve(size_t(share * removedEach));
+      log.removedVertices.reserve(size_t(4 * share * removedEach));
+      parts_[part].keys.reserve(size_t(share));
     }
     for (;;) {
       const double leftV = budgetV - (parts_[0].collapsed + parts_[1].collapsed);
@@ -964,8 +977,13 @@ class Simplifier {
       tetsAlive_ -= W.tetsRemoved;
       W.heap = Heap();
     }
-    // Merged by key; ties: the first half first.
+    // Merged by key; ties: the first half first. (The logs are large: without their slack and
+    // with the merged one sized up front, the merge needs one log's worth of memory more, not 2.5.)
     const CollapseLog &a = parts_[0].ownLog, &b = parts_[1].ownLog;
+    forEachArray(parts_[0].ownLog, [](auto& v) { v.shrink_to_fit(); });
+    forEachArray(parts_[1].ownLog, [](auto& v) { v.shrink_to_fit(); });
+    const double merged = std::max(1.0, double(a.size()) + b.size());
+    reserveFor(out_.log, a, b, std::clamp(planned / merged, 1.0, 1.3));  // (and room for the rest)
     for (uint32_t x = 0, y = 0; x < a.size() || y < b.size();) {
       if (y >= b.size() || (x < a.size() && parts_[0].keys[x] <= parts_[1].keys[y])) appendCollapse(out_.log, a, x++);
       else appendCollapse(out_.log, b, y++);
@@ -984,6 +1002,23 @@ class Simplifier {
       if (side[v[0]] != side[v[1]] || side[v[0]] != side[v[2]] || side[v[0]] != side[v[3]])
         for (int k = 0; k < 4; ++k) inner_[v[k]] = 0;
     }
+  }
+
+  // Calls f on every array of a log.
+  template <class F>
+  static void forEachArray(CollapseLog& log, F f) {
+    f(log.i), f(log.j), f(log.fieldError), f(log.iValue), f(log.jValue), f(log.movedBegin), f(log.moved);
+    f(log.removedBegin), f(log.removed), f(log.removedVertices);
+  }
+
+  // Room in dst for the collapses of a and b, times `factor` for those still to come.
+  static void reserveFor(CollapseLog& dst, const CollapseLog& a, const CollapseLog& b, double factor) {
+    auto room = [&](auto& d, const auto& x, const auto& y) { d.reserve(size_t(factor * double(x.size() + y.size())) + 1); };
+    room(dst.i, a.i, b.i), room(dst.j, a.j, b.j), room(dst.fieldError, a.fieldError, b.fieldError);
+    room(dst.iValue, a.iValue, b.iValue), room(dst.jValue, a.jValue, b.jValue);
+    room(dst.movedBegin, a.movedBegin, b.movedBegin), room(dst.moved, a.moved, b.moved);
+    room(dst.removedBegin, a.removedBegin, b.removedBegin), room(dst.removed, a.removed, b.removed);
+    room(dst.removedVertices, a.removedVertices, b.removedVertices);
   }
 
   // Appends collapse c of `src` (whose begin arrays have no closing entry yet) to `dst`.
