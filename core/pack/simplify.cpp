@@ -472,7 +472,7 @@ class Simplifier {
     uint64_t pops = 0, requeued = 0, rejectedByLink = 0, flatTetsRemoved = 0, linkMismatches = 0;
     bool errorBound = false;
     std::vector<uint32_t> touched, around;
-    std::vector<uint64_t> linkEdges;
+    std::vector<uint64_t> linkEdges, edgeLink;
     EdgeTable edgeTable;
     uint32_t edgeTableStamp = 0;
   };
@@ -1089,31 +1089,12 @@ class Simplifier {
     return result_;                                                    \
   } while (0)
     Lane& L = W.lane;
-    // Triangles (a, b, c) in both links: tets (i, a, b, c) and (j, a, b, c) share that face.
-    for (uint32_t t : star_[i]) {
-      if (tetHas(t, j)) continue;
-      const uint32_t* x = &out_.tets[4 * size_t(t)];
-      int si = 0;
-      while (x[si] != i) ++si;
-      uint32_t h = opp_[4 * t + si];
-      if (h != kNoNeighbor && tetHas(h >> 2, j)) TS_LINK_RESULT(false);
-    }
     auto hasBoundaryFace = [&](uint32_t v) {
       bool any = false;
       forBoundaryFaces(v, [&](uint32_t, uint32_t) { any = true; });
       return any;
     };
     const bool bothBoundary = boundary_[i] && boundary_[j] && hasBoundaryFace(i) && hasBoundaryFace(j);
-    // Boundary triangles (a, b, ω) in both links: boundary faces (i, a, b) and (j, a, b).
-    if (bothBoundary) {
-      W.linkEdges.clear();  // edges (a, b) of the boundary faces at j
-      forBoundaryFaces(j, [&](uint32_t a, uint32_t b) { W.linkEdges.push_back(makeEdge(a, b)); });
-      bool shared = false;
-      forBoundaryFaces(i, [&](uint32_t a, uint32_t b) {
-        shared |= std::find(W.linkEdges.begin(), W.linkEdges.end(), makeEdge(a, b)) != W.linkEdges.end();
-      });
-      if (shared) TS_LINK_RESULT(false);
-    }
     // Vertices: common neighbours of i and j (and ω when both are on the boundary) against the
     // link of the edge.
     uint32_t stampJ = ++L.stamp;
@@ -1132,13 +1113,16 @@ class Simplifier {
     size_t edgeVerts = 0, edgeEdges = 0;
     bool boundaryEdge = false;
     uint32_t stampE = ++L.stamp;
+    W.edgeLink.clear();
     forEdgeLink(i, j, [&](const uint32_t o[2]) {
       for (int k = 0; k < 2; ++k)
         if (L.seen[o[k]] != stampE) { L.seen[o[k]] = stampE; ++edgeVerts; }
       ++edgeEdges;  // each tet around the edge has its own opposite edge
-    }, [&](uint32_t) {
+      W.edgeLink.push_back(makeEdge(o[0], o[1]));
+    }, [&](uint32_t k) {
       boundaryEdge = true;
       ++edgeEdges;  // (k, ω) for the boundary face (i, j, k): one per face
+      W.edgeLink.push_back(makeEdge(k, kOmega));
     });
     if (common != edgeVerts + (boundaryEdge ? 1 : 0)) TS_LINK_RESULT(false);
     // Edges: those of Lk(j) in a table, then the distinct ones of Lk(i) found there. With the
@@ -1172,8 +1156,54 @@ class Simplifier {
         ++commonEdges;
       }
     });
-    TS_LINK_RESULT(commonEdges == edgeEdges);
+    if (commonEdges != edgeEdges) TS_LINK_RESULT(false);
+    // Triangles: with vertices and edges equal, a triangle in both links has its three edges in
+    // Lk(ij). Most edge links are a cycle of four or more vertices (or a path closed through ω)
+    // without a triangle, and then none is shared; otherwise the faces are looked at.
+    if (!hasTriangle(W.edgeLink)) TS_LINK_RESULT(true);
+    // Triangles (a, b, c) in both links: tets (i, a, b, c) and (j, a, b, c) share that face.
+    for (uint32_t t : star_[i]) {
+      if (tetHas(t, j)) continue;
+      const uint32_t* x = &out_.tets[4 * size_t(t)];
+      int si = 0;
+      while (x[si] != i) ++si;
+      uint32_t h = opp_[4 * t + si];
+      if (h != kNoNeighbor && tetHas(h >> 2, j)) TS_LINK_RESULT(false);
+    }
+    // Boundary triangles (a, b, ω) in both links: boundary faces (i, a, b) and (j, a, b).
+    if (bothBoundary) {
+      W.linkEdges.clear();  // edges (a, b) of the boundary faces at j
+      forBoundaryFaces(j, [&](uint32_t a, uint32_t b) { W.linkEdges.push_back(makeEdge(a, b)); });
+      bool shared = false;
+      forBoundaryFaces(i, [&](uint32_t a, uint32_t b) {
+        shared |= std::find(W.linkEdges.begin(), W.linkEdges.end(), makeEdge(a, b)) != W.linkEdges.end();
+      });
+      if (shared) TS_LINK_RESULT(false);
+    }
+    TS_LINK_RESULT(true);
 #undef TS_LINK_RESULT
+  }
+
+  // Whether three of the edges (a few) form a triangle.
+  static bool hasTriangle(const std::vector<uint64_t>& edges) {
+    auto ends = [](uint64_t e, uint32_t& a, uint32_t& b) { a = uint32_t(e >> 32), b = uint32_t(e); };
+    for (size_t x = 0; x < edges.size(); ++x)
+      for (size_t y = x + 1; y < edges.size(); ++y) {
+        uint32_t a, b, c, d;
+        ends(edges[x], a, b);
+        ends(edges[y], c, d);
+        // Sharing one end, the other two ends must be joined too.
+        uint32_t p = ~0u, q = ~0u;
+        if (a == c) p = b, q = d;
+        else if (a == d) p = b, q = c;
+        else if (b == c) p = a, q = d;
+        else if (b == d) p = a, q = c;
+        if (p == ~0u || p == q) continue;
+        const uint64_t third = makeEdge(p, q);
+        for (size_t z = 0; z < edges.size(); ++z)
+          if (edges[z] == third) return true;
+      }
+    return false;
   }
 
   // The link of edge (i, j): calls edge(o) with the opposite edge o[2] of every tet around it,
