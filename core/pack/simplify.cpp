@@ -551,6 +551,14 @@ class Simplifier {
   static bool removes(const StarTet& st, uint32_t j, uint64_t bit) {
     return bit ? (st.mask & bit) != 0 : st.other[0] == j || st.other[1] == j || st.other[2] == j;
   }
+  // The edges from P to st's other vertices x0, x1, x2.
+  static void edgesFrom(const double* P, const StarTet& st, double* a, double* b, double* e) {
+    for (int k = 0; k < 3; ++k) {
+      a[k] = st.x[0][k] - P[k];
+      b[k] = st.x[1][k] - P[k];
+      e[k] = st.x[2][k] - P[k];
+    }
+  }
   // The determinant of st's tet with P in the slot of i (positive: properly oriented).
   static double newDet(const StarTet& st, const double* P) {
     return st.g[0] * (P[0] - st.x[0][0]) + st.g[1] * (P[1] - st.x[0][1]) + st.g[2] * (P[2] - st.x[0][2]);
@@ -651,17 +659,11 @@ class Simplifier {
       // The new tet is P and the others x0, x1, x2 with det = sign·(x0 − P)·((x1 − P) × (x2 − P)).
       // p_i's barycentric numerators: that det with p_i in place of the vertex (detOld for P).
       double a[3], b[3], e[3], be[3], de[3], bd[3];
-      for (int k = 0; k < 3; ++k) {
-        a[k] = st.x[0][k] - P[k];
-        b[k] = st.x[1][k] - P[k];
-        e[k] = st.x[2][k] - P[k];
-      }
+      edgesFrom(P, st, a, b, e);
       cross(b, e, be);
       cross(d, e, de);
       cross(b, d, bd);
-      double num[4] = {st.detOld, st.sign * (d[0] * be[0] + d[1] * be[1] + d[2] * be[2]),
-                       st.sign * (a[0] * de[0] + a[1] * de[1] + a[2] * de[2]),
-                       st.sign * (a[0] * bd[0] + a[1] * bd[1] + a[2] * bd[2])};
+      const double num[4] = {st.detOld, st.sign * dot(d, be), st.sign * dot(a, de), st.sign * dot(a, bd)};
       const double lo = std::min({num[0], num[1], num[2], num[3]});
       const double det = newDet(st, P);
       if (lo < 0 && lo / det <= bestInside) continue;
@@ -685,13 +687,9 @@ class Simplifier {
         continue;
       }
       const double det = newDet(st, P);
-      // The edges and faces at P: a, b, e run from P to the others.
+      // The edges and faces at P.
       double a[3], b[3], e[3], ab[3], be[3], ae[3];
-      for (int k = 0; k < 3; ++k) {
-        a[k] = st.x[0][k] - P[k];
-        b[k] = st.x[1][k] - P[k];
-        e[k] = st.x[2][k] - P[k];
-      }
+      edgesFrom(P, st, a, b, e);
       cross(a, b, ab);
       cross(b, e, be);
       cross(a, e, ae);

@@ -34,8 +34,17 @@
 // Consequences: no collapse creates an inverted or flat tet; flat tets of the input only ever
 // disappear (when they contain the collapsed edge) or become proper.
 //
+// Order: one priority queue of vertices by the cost of their cheapest out-edge, updated lazily.
+// Meshes of partitionMinVertices or more are first simplified in two halves at once (a cut
+// through the vertex numbering or a median plane, whichever crosses fewest vertices), each half
+// collapsing only vertices whose whole neighbourhood is its own, so the two threads touch
+// disjoint data; the halves' logs are merged by cost, and the one queue of the whole mesh then
+// takes the vertices along the cut and the last collapses. On such meshes a vertex whose cost
+// rose by at most 10% since it was queued is collapsed without going back into the queue.
+//
 // The result is a log of collapses for the encoder (split_encode.h); the simplifier knows
-// nothing of the file format. Deterministic: same input and options, same log.
+// nothing of the file format. Deterministic: same input and options, same log, whatever the
+// number of threads.
 #pragma once
 #include <cstdint>
 #include <functional>
@@ -68,8 +77,9 @@ struct SimplifyOptions {
   bool refitValues = true;
   std::function<void(uint32_t done, uint32_t planned)> progress;  // called now and then
   bool verifyLinkCondition = false;  // tests: also run the slow reference link check, count mismatches
-  // Threads for cost evaluation (1 or 2; the result is the same either way), used for meshes of
-  // at least parallelMinVertices vertices (below that, starting rounds costs more than it saves).
+  // Threads (1 or 2; the result is the same either way): the two halves run on one each, and the
+  // one queue evaluates its next entries on both for meshes of at least parallelMinVertices
+  // vertices (below that, starting rounds costs more than it saves).
   int threads = 2;
   uint32_t parallelMinVertices = 20000;
   // Meshes of at least this many vertices are simplified in two halves at once for most of the
