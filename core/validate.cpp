@@ -65,10 +65,8 @@ ValidationReport validateMesh(const TetMesh& m, FaceAdjacency* adjacency) {
     std::vector<std::array<uint32_t, 4>> quads(T);
     std::vector<uint32_t> start(size_t(V) + 1, 0);
     for (uint32_t t = 0; t < T; ++t) {
-      std::array<uint32_t, 4> q;
-      std::copy_n(&m.tets[4 * size_t(t)], 4, q.begin());
-      std::sort(q.begin(), q.end());
-      ++start[q[0] + 1];
+      const uint32_t* v = &m.tets[4 * size_t(t)];
+      ++start[std::min({v[0], v[1], v[2], v[3]}) + 1];
     }
     for (uint32_t v = 0; v < V; ++v) start[v + 1] += start[v];
     std::vector<uint32_t> fill(start.begin(), start.end() - 1);

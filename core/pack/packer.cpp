@@ -58,8 +58,8 @@ uint64_t snapToGrid(TetMesh& mesh, const Manifest& m) {
 }  // namespace
 
 // Packing needs about kPackBytesPerTet per input tet at its peak (measured: 229 B on Harmonic
-// 64³, 247 B on the carotid data, README). A mesh that would need more than the limit is refused up front with the figure,
-// rather than failing an allocation halfway through a long run.
+// 64³, 247 B on the carotid data, README). A mesh that would need more than the limit is refused
+// up front with the figure, rather than failing an allocation halfway through a long run.
 constexpr double kPackBytesPerTet = 260;
 
 Result checkMemoryFor(const TetMesh& mesh, const PackOptions& opt) {
@@ -111,12 +111,13 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
 
   // FORMAT.md §3 wants positively oriented tets: flip the others (an odd permutation).
   // (Swapping slots 2 and 3 swaps the faces opposite them: the adjacency follows.)
+  std::vector<uint32_t>& opp = adjacency.opposite;
+  const bool turnAdjacency = opp.size() == mesh.tets.size();
   for (uint32_t t = 0; t < mesh.tetCount(); ++t)
     if (tetVolume(mesh, t) < 0) {
       std::swap(mesh.tets[4 * size_t(t) + 2], mesh.tets[4 * size_t(t) + 3]);
       ++summary.flippedTets;
-      if (adjacency.opposite.size() != mesh.tets.size()) continue;
-      std::vector<uint32_t>& opp = adjacency.opposite;
+      if (!turnAdjacency) continue;
       std::swap(opp[4 * size_t(t) + 2], opp[4 * size_t(t) + 3]);
       for (uint32_t h = 4 * t + 2; h <= 4 * t + 3; ++h)
         if (opp[h] != kNoNeighbor) opp[opp[h]] = h;

@@ -12,6 +12,8 @@
 // changed since (no collapse of the round touched the vertex or its neighbours) and nothing
 // queued meanwhile comes first; otherwise the entry goes back. The result is therefore exactly
 // that of the one-thread loop, whatever the timing (tests compare the two).
+//
+// Before that, a large mesh is simplified in two halves at once, one thread each (runParts).
 #include "simplify.h"
 
 #include <algorithm>
@@ -122,10 +124,10 @@ class Simplifier {
     init();
     Lane& L = main_.lane;
     neighbours(L, i, L.nbr);
-    if (std::find(L.nbr.begin(), L.nbr.end(), j) == L.nbr.end()) return CollapseVerdict::NotAnEdge;
+    const size_t slot = size_t(std::find(L.nbr.begin(), L.nbr.end(), j) - L.nbr.begin());
+    if (slot == L.nbr.size()) return CollapseVerdict::NotAnEdge;
     CollapseVerdict v = CollapseVerdict::Legal;
     prepareStar(L, i);
-    const size_t slot = size_t(std::find(L.nbr.begin(), L.nbr.end(), j) - L.nbr.begin());
     if (legal(L, i, j, bitOf(slot), &v)) {
       Candidate c = boundTerms(L, i, j, bitOf(slot));
       localTerm(L, i, c);
@@ -361,9 +363,8 @@ class Simplifier {
     return false;
   }
 
-  // Per-tet data of star(i) shared by every candidate target j. With p_j at slot si, the
-  // determinant is affine in p_j (g·p_j + h), and the edge and face terms of κ need only a few
-  // products per candidate (tet_quality.h).
+  // Per-tet data of star(i) shared by every candidate target j: with P = p_j in the slot of i,
+  // the determinant is g·(P − x0) (newDet), and κ's edge and face terms without P are fixed.
   struct StarTet {
     uint32_t t;
     uint32_t other[3];        // the vertices besides i, in slot order
@@ -646,8 +647,7 @@ class Simplifier {
   // Adds the paper's local field error (eq. 6) to a candidate of boundTerms():
   // |S(p_i) − S'(p_i)| / range, where S' interpolates the coarse field at p_i among the new tets.
   // The first tet that contains p_i wins; if none does (p_i on the boundary, or round-off), the
-  // one it is least outside of. Only signs are needed until the tet is found: each barycentric
-  // numerator is affine in p_j and det > 0.
+  // one it is least outside of. Only signs are needed until the tet is found (det > 0).
   void localTerm(Lane& L, uint32_t i, Candidate& c) {
     const uint32_t j = c.j;
     const double* P = p(j);
@@ -878,7 +878,7 @@ class Simplifier {
     for (uint32_t v = 0; v < V_; ++v)
       if (out_.vertexAlive[v]) order.push_back(v);
     const size_t half = order.size() / 2;
-    std::vector<uint8_t> side(V_), best;
+    std::vector<uint8_t> side(V_), best, bestInner;
     size_t bestBorder = ~size_t(0);
     for (int axis = -1; axis < 3; ++axis) {
       if (axis >= 0)
@@ -893,25 +893,26 @@ class Simplifier {
       if (border < bestBorder) {
         bestBorder = border;
         best = side;
+        bestInner = inner_;
       }
     }
     side = std::move(best);
-    markInner(side);
+    inner_ = std::move(bestInner);
     double inner[2] = {0, 0};
     for (uint32_t v : order)
       if (inner_[v]) inner[side[v]] += 1;
     if (inner[0] + inner[1] == 0) return;
     for (uint32_t v : order)
       if (inner_[v] && queued_[v]) parts_[side[v]].heap.push({queueKey(v), v});
-    // Both halves collapse every entry up to a key τ, then τ doubles: so they advance through
-    // the same costs (with fixed quotas one half could end simplified further than the other).
-    // Each step's collapses are capped, in proportion to the inner vertices, by what is left of
-    // the budget.
     // The vertices along the cut wait for the whole mesh's queue, so the halves only take their
     // inner vertices' share of the planned collapses: their density then ends near the final one.
     const double innerShare = kPartShare * (inner[0] + inner[1]) / double(order.size());
     const double budgetV = innerShare * planned;
     const double budgetT = opt_.targetTets > 0 ? innerShare * (double(tetsAlive_) - opt_.targetTets) : kInf;
+    // Both halves collapse every entry up to a key τ, then τ doubles: so they advance through
+    // the same costs (with fixed quotas one half could end simplified further than the other).
+    // Each step's collapses are capped, in proportion to the inner vertices, by what is left of
+    // the budget.
     double capV[2], capT[2];
     float tau = 0;
     auto work = [&](int part) {
@@ -936,13 +937,13 @@ class Simplifier {
     for (int part = 0; part < 2; ++part) {
       parts_[part].part = part;
       parts_[part].lane.reset(V_);
-      const double share = 1.05 * collapses * inner[part] / (inner[0] + inner[1]);
+      const double expected = 1.05 * collapses * inner[part] / (inner[0] + inner[1]);
       CollapseLog& log = parts_[part].ownLog;
-      forEachArray(log, [&](auto& v) { v.reserve(size_t(share)); });
-      log.moved.reserve(size_t(share * movedEach));
-      log.removed.reserve(size_t(share * removedEach));
-      log.removedVertices.reserve(size_t(4 * share * removedEach));
-      parts_[part].keys.reserve(size_t(share));
+      forEachArray([&](auto& v) { v.reserve(size_t(expected)); }, log);
+      log.moved.reserve(size_t(expected * movedEach));
+      log.removed.reserve(size_t(expected * removedEach));
+      log.removedVertices.reserve(size_t(4 * expected * removedEach));
+      parts_[part].keys.reserve(size_t(expected));
     }
     for (;;) {
       const double leftV = budgetV - (parts_[0].collapsed + parts_[1].collapsed);
@@ -978,10 +979,10 @@ class Simplifier {
     // Merged by key; ties: the first half first. (The logs are large: without their slack and
     // with the merged one sized up front, the merge needs one log's worth of memory more, not 2.5.)
     const CollapseLog &a = parts_[0].ownLog, &b = parts_[1].ownLog;
-    forEachArray(parts_[0].ownLog, [](auto& v) { v.shrink_to_fit(); });
-    forEachArray(parts_[1].ownLog, [](auto& v) { v.shrink_to_fit(); });
+    forEachArray([](auto& x, auto& y) { x.shrink_to_fit(), y.shrink_to_fit(); }, parts_[0].ownLog, parts_[1].ownLog);
     const double merged = std::max(1.0, double(a.size()) + b.size());
-    reserveFor(out_.log, a, b, std::clamp(planned / merged, 1.0, 1.3));  // (and room for the rest)
+    const double room = std::clamp(planned / merged, 1.0, 1.3);  // (and room for the rest)
+    forEachArray([&](auto& d, auto& x, auto& y) { d.reserve(size_t(room * double(x.size() + y.size())) + 1); }, out_.log, a, b);
     for (uint32_t x = 0, y = 0; x < a.size() || y < b.size();) {
       if (y >= b.size() || (x < a.size() && parts_[0].keys[x] <= parts_[1].keys[y])) appendCollapse(out_.log, a, x++);
       else appendCollapse(out_.log, b, y++);
@@ -1002,21 +1003,11 @@ class Simplifier {
     }
   }
 
-  // Calls f on every array of a log.
-  template <class F>
-  static void forEachArray(CollapseLog& log, F f) {
-    f(log.i), f(log.j), f(log.fieldError), f(log.iValue), f(log.jValue), f(log.movedBegin), f(log.moved);
-    f(log.removedBegin), f(log.removed), f(log.removedVertices);
-  }
-
-  // Room in dst for the collapses of a and b, times `factor` for those still to come.
-  static void reserveFor(CollapseLog& dst, const CollapseLog& a, const CollapseLog& b, double factor) {
-    auto room = [&](auto& d, const auto& x, const auto& y) { d.reserve(size_t(factor * double(x.size() + y.size())) + 1); };
-    room(dst.i, a.i, b.i), room(dst.j, a.j, b.j), room(dst.fieldError, a.fieldError, b.fieldError);
-    room(dst.iValue, a.iValue, b.iValue), room(dst.jValue, a.jValue, b.jValue);
-    room(dst.movedBegin, a.movedBegin, b.movedBegin), room(dst.moved, a.moved, b.moved);
-    room(dst.removedBegin, a.removedBegin, b.removedBegin), room(dst.removed, a.removed, b.removed);
-    room(dst.removedVertices, a.removedVertices, b.removedVertices);
+  // Calls f with the same array of each log, for every array of a CollapseLog.
+  template <class F, class... Logs>
+  static void forEachArray(F f, Logs&... logs) {
+    f(logs.i...), f(logs.j...), f(logs.fieldError...), f(logs.iValue...), f(logs.jValue...);
+    f(logs.movedBegin...), f(logs.moved...), f(logs.removedBegin...), f(logs.removed...), f(logs.removedVertices...);
   }
 
   // Appends collapse c of `src` (whose begin arrays have no closing entry yet) to `dst`.
