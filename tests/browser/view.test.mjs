@@ -206,9 +206,20 @@ test('colour by a second field with a colour bar, and a slice plane drawn with t
 
 test('the slice follows refinement locally while the dataset streams in', async () => {
   const { page, problems } = await openViewer('?data=/slow/manifest.json');
-  await waitForState(page, ['streaming', 'complete', 'error']);
-  await page.evaluate(() => window.tetstream.setSlice({ on: true, normal: [0.3, -0.8, 0.5], offset: -0.1 }));
-  const early = await page.evaluate(() => window.tetstream.stats());
+  // Turned on in the page the moment the base is shown, with the download paused meanwhile:
+  // a round trip from here could come after the last chunk on a fast machine.
+  const early = await page.evaluate(() => new Promise((resolve) => {
+    const poll = () => {
+      const state = window.tetstream?.stats().state;
+      if (!['streaming', 'complete', 'error'].includes(state)) return setTimeout(poll, 1);
+      window.tetstream.pause();
+      window.tetstream.setSlice({ on: true, normal: [0.3, -0.8, 0.5], offset: -0.1 });
+      const stats = window.tetstream.stats();
+      window.tetstream.resume();
+      resolve(stats);
+    };
+    poll();
+  }));
   const s = await waitForState(page, ['complete', 'error']);
   assert.equal(s.state, 'complete', s.error);
   assert.ok(early.splitsApplied < s.splitsTotal, 'the slice was on before the last splits');
