@@ -212,6 +212,9 @@ Result parseManifest(std::string_view text, Manifest& m) {
     r.integer(c, "tets", path, 1, kMaxCount, t);
     r.integer(c, "splits", path, 0, kMaxCount, s);
     r.number(c, "fieldError", path, ci.fieldError);
+    // Measured errors (format 1 files written before them lack the keys: -1, not shown).
+    for (auto [key, out] : {std::pair{"fieldRms", &ci.fieldRms}, std::pair{"fieldMax", &ci.fieldMax}})
+      if (c.contains(key) && r.number(c, key, path, *out) && *out < 0) r.error = "'" + path + key + "' must not be negative";
     if (!r.error.empty()) return bad(r.error);
     if (!validChunkFileName(ci.file)) return bad("'" + path + "file' is not a plain name under chunks/");
     if (kind != (i == 0 ? "base" : "splits"))
@@ -265,6 +268,8 @@ std::string writeManifest(const Manifest& m) {
                       {"tets", c.tets},
                       {"splits", c.splits},
                       {"fieldError", c.fieldError}});
+    if (c.fieldRms >= 0) chunks.back()["fieldRms"] = c.fieldRms;
+    if (c.fieldMax >= 0) chunks.back()["fieldMax"] = c.fieldMax;
   }
   doc["chunks"] = chunks;
   return doc.dump(1) + "\n";

@@ -40,6 +40,8 @@ struct ChunkInfo {
   uint32_t tets = 0;
   uint32_t splits = 0;
   double fieldError = 0;
+  // Measured at the input's vertices (level_error.h), in units of isoField; -1 when not given.
+  double fieldRms = -1, fieldMax = -1;
 };
 
 struct Manifest {

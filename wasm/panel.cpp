@@ -150,8 +150,23 @@ void levelSection(ViewerState& s, float width, float pixelsPerCssPixel) {
   std::snprintf(pct, sizeof pct, " (%.1f%%)", 100 * levelFraction(s));
   row("vertices", grouped(nv) + (nv != m.vertices ? " of " + grouped(m.vertices) + pct : ""));
   row("tets", grouped(nt) + (nt != m.tets ? " of " + grouped(m.tets) : ""));
+  // The error of the field that steered the simplification: measured at the input's vertices
+  // when the manifest has it, the simplifier's estimate otherwise.
+  const ChunkInfo* level = levelChunk(s);
+  const int iso = m.findField(m.isoField);
   double err = fieldErrorBound(s);
-  if (err >= 0 && s.field >= 0) {
+  if (level && level->fieldRms >= 0 && iso >= 0) {
+    const Range r = m.fields[size_t(iso)].range;
+    char buf[96];
+    const double span = r.max - r.min;
+    if (level->fieldMax == 0)
+      std::snprintf(buf, sizeof buf, "none (full mesh)");
+    else if (span > 0)
+      std::snprintf(buf, sizeof buf, "RMS %.2g%%, max %.2g%% of range", 100 * level->fieldRms / span, 100 * level->fieldMax / span);
+    else
+      std::snprintf(buf, sizeof buf, "RMS %.3g, max %.3g", level->fieldRms, level->fieldMax);
+    row("field error", buf);
+  } else if (err >= 0 && s.field >= 0) {
     const Range r = m.fields[size_t(s.field)].range;
     char buf[64];
     if (err == 0)

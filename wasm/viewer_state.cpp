@@ -519,8 +519,13 @@ double levelFraction(const ViewerState& s) {
 }
 
 double fieldErrorBound(const ViewerState& s) {
+  const ChunkInfo* c = levelChunk(s);
+  return c ? c->fieldError : -1;
+}
+
+const ChunkInfo* levelChunk(const ViewerState& s) {
   uint32_t c = s.dataset.chunksApplied();
-  return c ? s.dataset.manifest.chunks[c - 1].fieldError : -1;
+  return c ? &s.dataset.manifest.chunks[c - 1] : nullptr;
 }
 
 // ------------------------------------------------------------------ the hull, from scratch
@@ -876,6 +881,8 @@ std::string statsJson(const ViewerState& s) {
       {"live", s.live},
       {"paused", s.paused},
       {"fieldError", fieldError >= 0 ? json(fieldError) : json(nullptr)},
+      {"fieldRms", levelChunk(s) && levelChunk(s)->fieldRms >= 0 ? json(levelChunk(s)->fieldRms) : json(nullptr)},
+      {"fieldMax", levelChunk(s) && levelChunk(s)->fieldMax >= 0 ? json(levelChunk(s)->fieldMax) : json(nullptr)},
       {"baseVertices", ds.pm.baseVertices},
       {"hullTriangles", s.hull.triangleCount()},
       {"hullLines", s.hull.lineCount()},

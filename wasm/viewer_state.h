@@ -309,6 +309,7 @@ void tick(ViewerState& s, double nowMs);
 // Derived figures for panel and stats.
 double levelFraction(const ViewerState& s);      // vertices shown / vertices of the full mesh
 double fieldErrorBound(const ViewerState& s);    // manifest estimate for the last complete chunk
+const ChunkInfo* levelChunk(const ViewerState& s);  // the last complete chunk (its measured errors), or null
 bool downloading(const ViewerState& s);          // chunks still to fetch, not paused, no error
 bool refining(const ViewerState& s);             // splits to apply or undo toward the target
 

@@ -18,7 +18,7 @@
 //                       applied), "error" (stopped: error says why; the level reached stays
 //                       usable). notice: a network problem being retried, in words. Level:
 //                       splitsApplied, splitsReceived, splitsTotal, targetSplits, level
-//                       (vertices shown / full), live, paused, fieldError; network:
+//                       (vertices shown / full), live, paused, fieldError (estimate), fieldRms and fieldMax (measured; null in older packs); network:
 //                       chunksReceived, chunksAllowed, bytesReceived, bytesDownloaded,
 //                       bytesTotal, rateBytesPerSec, secondsLeft, retries (requests made again
 //                       after a failure), chunksRefused (downloads that failed the size/hash

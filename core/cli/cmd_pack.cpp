@@ -14,6 +14,13 @@
 namespace tetstream::cli {
 namespace {
 
+// 0.0263 -> "2.6%", 0.000412 -> "0.041%": two significant digits.
+std::string formatPercent(double fraction) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.2g%%", 100 * fraction);
+  return buf;
+}
+
 // One-line progress on a terminal: phase, bar, percent, rate, time left. Silent otherwise.
 class ProgressLine {
  public:
@@ -151,7 +158,8 @@ Runner addPack(CLI::App& app) {
                  {"positionBits", m.positionBits}, {"baseVertices", s.baseVertices}, {"baseTets", s.baseTets},
                  {"splits", s.splits}, {"chunks", m.chunks.size()}, {"bytes", bytes}, {"baseBytes", baseBytes},
                  {"bitsPerTet", bitsPerTet}, {"bytesPerSplit", bytesPerSplit},
-                 {"baseFieldError", m.chunks[0].fieldError}, {"stopReason", s.stopReason},
+                 {"baseFieldError", m.chunks[0].fieldError}, {"baseFieldRms", m.chunks[0].fieldRms},
+                 {"baseFieldMax", m.chunks[0].fieldMax}, {"stopReason", s.stopReason},
                  {"flatTetsRemoved", s.flatTetsRemoved}, {"flatTetsLeft", s.flatTetsLeft},
                  {"queuePops", s.queuePops}, {"halvesCollapses", s.halvesCollapses}, {"requeued", s.requeued}, {"costEvaluations", s.costEvaluations},
                  {"readMs", readMs}, {"prepareMs", s.prepareMs}, {"simplifyMs", s.simplifyMs}, {"encodeMs", s.encodeMs}, {"writeMs", s.writeMs},
@@ -162,9 +170,15 @@ Runner addPack(CLI::App& app) {
     std::printf("packed %s -> %s/\n", o->input.c_str(), o->out.c_str());
     std::printf("  format    %s\n", in.format.c_str());
     std::printf("  input     %u vertices, %u tets, field '%s'\n", m.vertices, m.tets, m.isoField.c_str());
-    std::printf("  base      %u vertices (%.2f%%), %u tets, %.1f KB, field error <= %.3g (est.)\n", s.baseVertices,
-                100.0 * s.baseVertices / std::max<uint32_t>(m.vertices, 1), s.baseTets, baseBytes / 1024.0,
-                m.chunks[0].fieldError);
+    std::printf("  base      %u vertices (%.2f%%), %u tets, %.1f KB\n", s.baseVertices,
+                100.0 * s.baseVertices / std::max<uint32_t>(m.vertices, 1), s.baseTets, baseBytes / 1024.0);
+    if (const ChunkInfo& b = m.chunks[0]; b.fieldRms >= 0) {
+      const int iso = m.findField(m.isoField);
+      const double range = iso >= 0 ? m.fields[size_t(iso)].range.max - m.fields[size_t(iso)].range.min : 0.0;
+      auto share = [&](double e) { return range > 0 ? " (" + formatPercent(e / range) + " of the range)" : std::string(); };
+      std::printf("  error     base field error at the input's vertices: RMS %.3g%s, largest %.3g%s\n", b.fieldRms,
+                  share(b.fieldRms).c_str(), b.fieldMax, share(b.fieldMax).c_str());
+    }
     std::printf("  stream    %u splits in %zu chunks, %.2f MB in all, %.1f bits/tet, %.1f bytes/split\n", s.splits,
                 m.chunks.size() - 1, bytes / 1e6, bitsPerTet, bytesPerSplit);
     std::printf("  values    %s\n", m.lossless ? "lossless float32"

@@ -6,6 +6,7 @@
 #include <future>
 
 #include "pack/chunk_encode.h"
+#include "pack/level_error.h"
 #include "progressive.h"
 #include "quantize.h"
 #include "split_stream.h"
@@ -43,6 +44,7 @@ class Encoder {
     for (uint32_t c = 0; c < C; ++c)
       prefixMax_[c] = std::min(range, std::max(c ? prefixMax_[c - 1] : 0.0f, log.fieldError[c]));
     out_.baseFieldError = C ? prefixMax_[C - 1] : 0;
+    startMeter(iso);
     // The base chunk compresses on another thread while the splits are encoded.
     std::future<Result> base = std::async(std::launch::async, [this] {
       out_.baseInfo.fieldError = out_.baseFieldError;
@@ -68,6 +70,27 @@ class Encoder {
         }
     }
     return collect();
+  }
+
+  // Each level's field error, measured at the input's vertices (level_error.h) for the field
+  // that steered the simplification.
+  void startMeter(int iso) {
+    metered_ = iso >= 0;
+    if (!metered_) return;
+    const CollapseLog& log = s_.log;
+    std::vector<uint32_t> baseOf(mesh_.vertexCount());
+    for (uint32_t v = 0; v < baseOf.size(); ++v) baseOf[v] = v;
+    for (uint32_t c = log.size(); c-- > 0;) baseOf[log.i[c]] = baseOf[log.j[c]];
+    const LevelError e = meter_.begin(mesh_.positions, mesh_.fields[size_t(iso)].values, pm_, size_t(iso), out_.streamVertexOf, baseOf);
+    out_.baseInfo.fieldRms = e.rms;
+    out_.baseInfo.fieldMax = e.max;
+  }
+
+  void measure(ChunkInfo& info) const {
+    if (!metered_) return;
+    const LevelError e = meter_.current();
+    info.fieldRms = e.rms;
+    info.fieldMax = e.max;
   }
 
   void buildBase() {
@@ -202,13 +225,17 @@ class Encoder {
       putValue(fields_[f], pm_.mesh.fields[f].values[js], q_.field[f]);
     }
     float jValue = 0;
+    bool jValueChanged = false;
     if (s_.valuesField >= 0) {
       const size_t f = size_t(s_.valuesField);
       jValue = snapped(f, log.jValue[c]);
       putValue(jValue, pm_.mesh.fields[f].values[js], q_.field[f]);
+      jValueChanged = jValue != pm_.mesh.fields[f].values[js];
     }
     changed_.clear();
+    const uint32_t firstNew = pm_.tetCount();
     applySplit(pm_, SplitOp{js, moved_, newTets_, pi, fields_.data(), s_.valuesField >= 0 ? &jValue : nullptr}, changed_);
+    if (metered_) meter_.afterSplit(i, js, moved_, firstNew, jValueChanged);
   }
 
   // Closes the current chunk and compresses it on another thread while encoding goes on. The
@@ -271,6 +298,7 @@ class Encoder {
     job.info.splits = inChunk_;
     const uint32_t C = s_.log.size();
     job.info.fieldError = splitsApplied < C ? prefixMax_[C - splitsApplied - 1] : 0.0;
+    measure(job.info);
     job.done = std::async(std::launch::async, [&job, level = opt_.zstdLevel] {
       return finishChunk(job.raw, level, job.file, job.info);
     });
@@ -319,6 +347,8 @@ class Encoder {
   EncodedStream& out_;
   Quantizer q_;
   ProgressiveMesh pm_;
+  LevelErrorMeter meter_;
+  bool metered_ = false;
   std::vector<float> prefixMax_, fields_;
   std::vector<uint8_t> records_;
   std::vector<Pair> pairs_, chain_;

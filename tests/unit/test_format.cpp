@@ -116,6 +116,15 @@ TEST(Format, ManifestRoundTrip) {
   Manifest m;
   ASSERT_TRUE(parseManifest(writeManifest(s.manifest), m));
   EXPECT_EQ(writeManifest(m), writeManifest(s.manifest));
+  EXPECT_GE(m.chunks[0].fieldRms, 0.0);
+  // Manifests written before the measured errors still load: -1 (not given).
+  Manifest older = s.manifest, back;
+  for (ChunkInfo& c : older.chunks) c.fieldRms = c.fieldMax = -1;
+  const std::string text = writeManifest(older);
+  EXPECT_EQ(text.find("fieldRms"), std::string::npos);
+  ASSERT_TRUE(parseManifest(text, back));
+  EXPECT_EQ(back.chunks[0].fieldRms, -1.0);
+  EXPECT_EQ(back.chunks[0].fieldMax, -1.0);
 }
 
 TEST(Format, HashFormat) {
@@ -158,6 +167,8 @@ TEST(Format, HostileManifestsAreRefused) {
       with("\"name\": \"harmonic\"", "\"name\": 7"),
       with("\"chunks\": [", "\"chunks\": 5, \"x\": ["),
       with("\"min\": [", "\"min\": [1e39, "),
+      with("\"fieldRms\": ", "\"fieldRms\": -1, \"z\": "),
+      with("\"fieldMax\": ", "\"fieldMax\": \"x\", \"y\": "),
   };
   for (const std::string& c : cases) {
     Manifest m;

@@ -394,6 +394,42 @@ double fieldRms(const TetMesh& in, const TetMesh& coarse, int field) {
   return std::sqrt(sum / in.vertexCount());
 }
 
+// Each chunk's measured field error (FORMAT.md §1: fieldRms, fieldMax) equals a brute-force
+// measurement on the level the chunk leaves: every input vertex located among all of the level's
+// tets. The meter follows the splits locally; the brute force knows nothing of them.
+TEST(Progressive, MeasuredLevelErrorsMatchBruteForce) {
+  const TetMesh in = harmonic(12);
+  PackOptions o;
+  o.chunkKb = 1;
+  o.minBaseVertices = 0;
+  PackSummary s;
+  const std::string dir = pack("measured", in, o, &s);
+  const Manifest& m = s.manifest;
+  ASSERT_GE(m.chunks.size(), 4u);
+  const Range r = m.fields[0].range;
+  const double step = (r.max - r.min) / 65535.0;  // the input is measured on the stream's grid
+  for (size_t k = 1; k <= m.chunks.size(); ++k) {
+    Dataset level;
+    ASSERT_TRUE(loadPackedDir(dir, level, int(k)));
+    double sum = 0, max = 0;
+    for (uint32_t v = 0; v < in.vertexCount(); ++v) {
+      uint32_t tet = 0;
+      double w[4] = {}, value = 0;
+      bestTet(level.pm.mesh, &in.positions[3 * v], tet, w);
+      for (int c = 0; c < 4; ++c) value += w[c] * level.pm.mesh.fields[0].values[level.pm.mesh.tets[4 * tet + c]];
+      const double d = std::abs(value - in.fields[0].values[v]);
+      sum += d * d;
+      max = std::max(max, d);
+    }
+    const double rms = std::sqrt(sum / in.vertexCount());
+    const ChunkInfo& c = m.chunks[k - 1];
+    EXPECT_NEAR(c.fieldRms, rms, 3 * step) << "chunk " << k;  // (the level loaded has its positions on the grid too)
+    EXPECT_NEAR(c.fieldMax, max, 3 * step) << "chunk " << k;
+    if (k == 1) EXPECT_GT(c.fieldMax, 20 * step) << "the base is coarse";
+  }
+  EXPECT_LE(m.chunks.back().fieldMax, step);  // the full mesh: the input, on the grid
+}
+
 // Coarse levels carry values fitted to the region each vertex stands for (SimplifyOptions::
 // fitValues): a lower field error than keeping the samples; --samples keeps the input's values
 // at every level, and fields that did not steer keep them either way.
