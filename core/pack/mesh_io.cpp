@@ -90,6 +90,14 @@ Result readWholeFile(const std::string& path, std::string& bytes) {
   std::FILE* f = std::fopen(path.c_str(), "rb");
   if (!f) return fail(Status::IoError, path + ": cannot open (" + std::strerror(errno) + ")");
   bytes.clear();
+  // One read into a buffer of the file's size (growing a string 64 KB at a time copied a large
+  // mesh file several times over); then whatever follows if the file grew meanwhile.
+  std::error_code ec;
+  const uintmax_t size = std::filesystem::file_size(path, ec);
+  if (!ec && size > 0) {
+    bytes.resize(size_t(size));
+    bytes.resize(std::fread(bytes.data(), 1, bytes.size(), f));
+  }
   char buf[1 << 16];
   size_t n;
   while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) bytes.append(buf, n);
