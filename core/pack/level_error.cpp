@@ -21,8 +21,6 @@ double interpolate(const std::vector<uint32_t>& tets, const std::vector<float>& 
   return sum / weight;
 }
 
-// A well-mixed hash: samples by id alone would follow the numbering's pattern (every fourth
-// column of a grid, say).
 uint32_t mix(uint32_t x) {
   x *= 0x9e3779b1u;
   x ^= x >> 16;
@@ -36,8 +34,8 @@ uint32_t mix(uint32_t x) {
 // l_k = r_k · (x − p0) for k = 1..3, with r the rows of the inverse of the edge matrix
 // (r_m = e_{m+1} × e_{m+2} / det), and l_0 = 1 − l_1 − l_2 − l_3.
 bool LevelErrorMeter::TetFrame::make(const LevelErrorMeter& m, uint32_t t) {
-  const uint32_t* v = &m.pm_->mesh.tets[4 * size_t(t)];
-  const float* p = m.pm_->mesh.positions.data();
+  const uint32_t* v = &m.mesh_->tets[4 * size_t(t)];
+  const float* p = m.mesh_->positions.data();
   double e[3][3];
   for (int a = 0; a < 3; ++a) p0[a] = p[3 * size_t(v[0]) + a];
   for (int m = 0; m < 3; ++m)
@@ -89,7 +87,7 @@ void LevelErrorMeter::unlink(uint32_t v) {
 }
 
 void LevelErrorMeter::setError(uint32_t v, uint32_t t, const double l[4]) {
-  samples_[v].err = float(std::abs(samples_[v].value - interpolate(pm_->mesh.tets, levelValues(), t, l)));
+  samples_[v].err = float(std::abs(samples_[v].value - interpolate(mesh_->tets, levelValues(), t, l)));
 }
 
 void LevelErrorMeter::becomeVertex(uint32_t v, uint32_t level) {
@@ -124,56 +122,59 @@ void LevelErrorMeter::walk(uint32_t v, uint32_t t, std::span<const uint32_t> opp
   setError(v, bestTet, bestL);
 }
 
-LevelError LevelErrorMeter::begin(std::span<const float> positions, std::span<const float> values,
-                                  const ProgressiveMesh& pm, size_t field, std::span<const uint32_t> levelOf,
-                                  std::span<const uint32_t> baseOf) {
-  pm_ = &pm;
+void LevelErrorMeter::begin(std::span<const float> positions, std::span<const float> values, const TetMesh& level,
+                            const StarPool* stars, size_t field, std::span<const uint32_t> levelOf,
+                            std::span<const uint32_t> baseOf, uint32_t maxSamples) {
+  mesh_ = &level;
+  stars_ = stars;
   field_ = field;
-  const TetMesh& base = pm.mesh;
-  const std::vector<uint32_t>& tets = base.tets;
+  const std::vector<uint32_t>& tets = level.tets;
   const size_t V = values.size();
+  // An even sample: by a hash of the id, as samples by id alone would follow the numbering's
+  // pattern (every fourth column of a grid, say).
+  const uint64_t stride = (V + maxSamples - 1) / std::max(maxSamples, 1u);
   samples_.resize(V);
-  for (size_t v = 0; v < V; ++v) samples_[v] = {{positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]}, values[v], 0.0f, kNone, kNone, kNone};
-  head_.assign(base.tetCount(), kNone);
-  occupied_.resize(base.tetCount());
-  inputOf_.assign(base.vertexCount(), kNone);
-  std::vector<uint32_t> someTet(base.vertexCount(), kNone);  // per base vertex: a tet around it
+  sampled_.resize(V);
+  for (uint32_t v = 0; v < V; ++v) {
+    const bool in = stride <= 1 || mix(v) % stride == 0;
+    samples_[v] = {{positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]}, values[v], 0.0f, in ? kNone : kSkip, kNone, kNone};
+    if (in) sampled_.set(v);
+  }
+  head_.assign(level.tetCount(), kNone);
+  occupied_.resize(level.tetCount());
+  inputOf_.assign(level.vertexCount(), kNone);
+  std::vector<uint32_t> someTet(level.vertexCount(), kNone);  // per base vertex: a tet around it
   for (size_t c = 0; c < tets.size(); ++c) someTet[tets[c]] = uint32_t(c / 4);
   FaceAdjacency adjacency;
-  buildFaceAdjacency(tets, base.vertexCount(), adjacency);
+  buildFaceAdjacency(tets, level.vertexCount(), adjacency);
   for (uint32_t v = 0; v < V; ++v) {
+    if (levelOf[v] != kNone) inputOf_[levelOf[v]] = v;
+    if (!sampled_.test(v) || !std::isfinite(values[v])) continue;
     if (levelOf[v] != kNone) {
-      inputOf_[levelOf[v]] = v;
-      if (std::isfinite(values[v]) && someTet[levelOf[v]] != kNone) becomeVertex(v, levelOf[v]);
+      if (someTet[levelOf[v]] != kNone) becomeVertex(v, levelOf[v]);
       continue;
     }
     const uint32_t at = levelOf[baseOf[v]];
-    if (!std::isfinite(values[v]) || at == kNone || someTet[at] == kNone) continue;  // in no tet
+    if (at == kNone || someTet[at] == kNone) continue;  // in no tet
     walk(v, someTet[at], adjacency.opposite);
   }
-  // The base at every input vertex; the levels after it at an even sample of them.
-  const LevelError atBase = current();
-  const uint64_t stride = (V + kMaxSamples - 1) / kMaxSamples;
-  if (stride > 1)
-    for (uint32_t v = 0; v < V; ++v)
-      if (mix(v) % stride != 0) {
-        unlink(v);
-        samples_[v].tet = kSkip;
-      }
-  sampled_.resize(V);
-  for (uint32_t v = 0; v < V; ++v)
-    if (samples_[v].tet != kSkip) sampled_.set(v);
-  return atBase;
+}
+
+LevelError LevelErrorMeter::measure(std::span<const float> positions, std::span<const float> values, const TetMesh& level,
+                                    size_t field, std::span<const uint32_t> levelOf, std::span<const uint32_t> baseOf) {
+  LevelErrorMeter m;
+  m.begin(positions, values, level, nullptr, field, levelOf, baseOf, ~0u);
+  return m.current();
 }
 
 void LevelErrorMeter::afterSplit(uint32_t input, uint32_t j, std::span<const uint32_t> moved, uint32_t firstNew,
                                  bool jValueChanged) {
-  const uint32_t tetCount = pm_->mesh.tetCount();
+  const uint32_t tetCount = mesh_->tetCount();
   head_.resize(tetCount, kNone);
   occupied_.resize(tetCount);
   inputOf_.push_back(input);
   if (sampled_.test(input)) {
-    if (std::isfinite(samples_[input].value)) becomeVertex(input, pm_->mesh.vertexCount() - 1);
+    if (std::isfinite(samples_[input].value)) becomeVertex(input, mesh_->vertexCount() - 1);
     else unlink(input);
   }
 
@@ -240,7 +241,7 @@ void LevelErrorMeter::afterSplit(uint32_t input, uint32_t j, std::span<const uin
 void LevelErrorMeter::updateAroundJ(uint32_t j, bool jValueChanged) {
   if (!jValueChanged) return;
   if (inputOf_[j] != kNone && samples_[inputOf_[j]].tet == kVertex) becomeVertex(inputOf_[j], j);  // (not kSkip)
-  for (uint32_t c : pm_->stars.corners(j)) {
+  for (uint32_t c : stars_->corners(j)) {
     const uint32_t t = c >> 2;
     TetFrame f;
     if (!occupied_.test(t) || !f.make(*this, t)) continue;

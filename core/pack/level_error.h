@@ -27,17 +27,21 @@ struct LevelError {
 
 class LevelErrorMeter {
  public:
-  // `positions` and `values`: the input's (3 and 1 per input vertex); `pm`: the encoder's level
-  // mesh, now at the base, whose field `field` is measured (pm is read again at every split).
-  // levelOf[v]: input vertex v's id in the base, or ~0u when v was collapsed; then baseOf[v] is
-  // the input vertex of the base it was collapsed into (directly or not), where the search for
-  // its tet starts. Returns the base's error, at every input vertex. The levels after it are
-  // measured at an even sample of kMaxSamples input vertices (all of them in smaller meshes): on
-  // the encoder's thread, following all 262,144 vertices of Harmonic 64³ cost half as much time as
-  // encoding did; 16,384 add 0.2 s to its 1 s and give the RMS within 2% at every level.
-  LevelError begin(std::span<const float> positions, std::span<const float> values, const ProgressiveMesh& pm,
-                   size_t field, std::span<const uint32_t> levelOf, std::span<const uint32_t> baseOf);
+  // `positions` and `values`: the input's (3 and 1 per input vertex); `level`: the base level,
+  // whose field `field` is measured, and `stars` its vertices' tets: the encoder's ProgressiveMesh,
+  // read again at every split (afterSplit). levelOf[v]: input vertex v's id in the base, or ~0u
+  // when v was collapsed; then baseOf[v] is the input vertex of the base it was collapsed into
+  // (directly or not), where the search for its tet starts. Only an even sample of maxSamples
+  // input vertices is followed (all of them in smaller meshes): on the encoder's thread,
+  // following all 262,144 vertices of Harmonic 64³ cost half as much time as encoding did;
+  // 16,384 add 0.15 s to its 1 s and give the RMS within 2% at every level.
+  void begin(std::span<const float> positions, std::span<const float> values, const TetMesh& level, const StarPool* stars,
+             size_t field, std::span<const uint32_t> levelOf, std::span<const uint32_t> baseOf, uint32_t maxSamples);
   static constexpr uint32_t kMaxSamples = 16384;
+
+  // The error of a base level at every input vertex (no stars needed), e.g. on another thread.
+  static LevelError measure(std::span<const float> positions, std::span<const float> values, const TetMesh& level,
+                            size_t field, std::span<const uint32_t> levelOf, std::span<const uint32_t> baseOf);
 
   // After applySplit() restored input vertex `input` next to level vertex j, moving the listed
   // tets from j to the new vertex and appending tets from `firstNew` on. When the split gave p_j
@@ -76,9 +80,10 @@ class LevelErrorMeter {
     uint32_t next, prev;  // the others in its tet (a list per tet)
   };
   std::vector<Sample> samples_;
-  const ProgressiveMesh* pm_ = nullptr;  // the level mesh (the encoder's)
+  const TetMesh* mesh_ = nullptr;    // the level mesh
+  const StarPool* stars_ = nullptr;  // its vertices' tets
   size_t field_ = 0;
-  const std::vector<float>& levelValues() const { return pm_->mesh.fields[field_].values; }
+  const std::vector<float>& levelValues() const { return mesh_->fields[field_].values; }
   // A flat bit set: one that is tested for every tet a split moves fits in the cache.
   struct Bits {
     std::vector<uint64_t> words;

@@ -52,6 +52,11 @@ class Encoder {
     });
     Result r = encodeSplits(C);
     Result b = base.get();
+    if (metered_) {
+      const LevelError e = baseError_.get();
+      out_.baseInfo.fieldRms = e.rms;
+      out_.baseInfo.fieldMax = e.max;
+    }
     return r ? b : r;
   }
 
@@ -74,16 +79,21 @@ class Encoder {
 
   // Each level's field error, measured at the input's vertices (level_error.h) for the field
   // that steered the simplification.
+  // The base at every input vertex on another thread (out_.base and a copy of its vertex ids
+  // stay as they are); the levels after it at a sample, here.
   void startMeter(int iso) {
     metered_ = iso >= 0;
     if (!metered_) return;
     const CollapseLog& log = s_.log;
-    std::vector<uint32_t> baseOf(mesh_.vertexCount());
-    for (uint32_t v = 0; v < baseOf.size(); ++v) baseOf[v] = v;
-    for (uint32_t c = log.size(); c-- > 0;) baseOf[log.i[c]] = baseOf[log.j[c]];
-    const LevelError e = meter_.begin(mesh_.positions, mesh_.fields[size_t(iso)].values, pm_, size_t(iso), out_.streamVertexOf, baseOf);
-    out_.baseInfo.fieldRms = e.rms;
-    out_.baseInfo.fieldMax = e.max;
+    baseOf_.resize(mesh_.vertexCount());
+    for (uint32_t v = 0; v < baseOf_.size(); ++v) baseOf_[v] = v;
+    for (uint32_t c = log.size(); c-- > 0;) baseOf_[log.i[c]] = baseOf_[log.j[c]];
+    const std::span<const float> values = mesh_.fields[size_t(iso)].values;
+    baseError_ = std::async(std::launch::async, [this, iso, values, levelOf = out_.streamVertexOf] {
+      return LevelErrorMeter::measure(mesh_.positions, values, out_.base, size_t(iso), levelOf, baseOf_);
+    });
+    meter_.begin(mesh_.positions, values, pm_.mesh, &pm_.stars, size_t(iso), out_.streamVertexOf, baseOf_,
+                 LevelErrorMeter::kMaxSamples);
   }
 
   void measure(ChunkInfo& info) const {
@@ -349,6 +359,8 @@ class Encoder {
   ProgressiveMesh pm_;
   LevelErrorMeter meter_;
   bool metered_ = false;
+  std::vector<uint32_t> baseOf_;          // per input vertex: the base vertex it went into
+  std::future<LevelError> baseError_;     // measured on another thread
   std::vector<float> prefixMax_, fields_;
   std::vector<uint8_t> records_;
   std::vector<Pair> pairs_, chain_;
