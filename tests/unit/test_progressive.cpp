@@ -425,7 +425,9 @@ TEST(Progressive, MeasuredLevelErrorsMatchBruteForce) {
     const ChunkInfo& c = m.chunks[k - 1];
     EXPECT_NEAR(c.fieldRms, rms, 3 * step) << "chunk " << k;  // (the level loaded has its positions on the grid too)
     EXPECT_NEAR(c.fieldMax, max, 3 * step) << "chunk " << k;
-    if (k == 1) EXPECT_GT(c.fieldMax, 20 * step) << "the base is coarse";
+    if (k == 1) {
+      EXPECT_GT(c.fieldMax, 20 * step) << "the base is coarse";
+    }
   }
   EXPECT_LE(m.chunks.back().fieldMax, step);  // the full mesh: the input, on the grid
 }
@@ -634,6 +636,10 @@ TEST(Progressive, MaxErrorBoundsEveryCollapse) {
   const Range r = s.manifest.fields[0].range;
   EXPECT_GT(s.manifest.chunks[0].fieldError, 0.0);
   EXPECT_LE(s.manifest.chunks[0].fieldError, 0.02 * (r.max - r.min) * 1.0001);
+  // The estimate is no bound on the measured error: the packer says so when it goes above.
+  const bool above = s.manifest.chunks[0].fieldMax > 0.02 * (r.max - r.min);
+  const bool noted = std::any_of(s.notes.begin(), s.notes.end(), [](const std::string& n) { return n.find("--max-error") != std::string::npos; });
+  EXPECT_EQ(noted, above) << "measured largest error " << s.manifest.chunks[0].fieldMax / (r.max - r.min);
 }
 
 TEST(Progressive, CorruptSplitChunkKeepsTheLastCompleteLevel) {
