@@ -249,6 +249,9 @@ TEST(ViewerState, LevelMovesBackAndForthAndStaysWhereTheUserPutsIt) {
   settle(s);
   EXPECT_EQ(s.dataset.pm.vertexCount(), base);
   EXPECT_EQ(stats(s)["fieldError"].get<double>(), s.dataset.manifest.chunks[0].fieldError);
+  EXPECT_EQ(stats(s)["fieldRms"].get<double>(), s.dataset.manifest.chunks[0].fieldRms);  // measured by the packer
+  EXPECT_EQ(stats(s)["fieldMax"].get<double>(), s.dataset.manifest.chunks[0].fieldMax);
+  EXPECT_GE(s.dataset.manifest.chunks[0].fieldMax, s.dataset.manifest.chunks[0].fieldRms);
   expectMatchesFromScratch(s, "back at the base");
 
   // New data does not move a level the user put back.
