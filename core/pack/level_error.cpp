@@ -96,9 +96,11 @@ void LevelErrorMeter::becomeVertex(uint32_t v, uint32_t level) {
   samples_[v].err = float(std::abs(samples_[v].value - double(levelValues()[level])));
 }
 
-// From tet t across the face of the most negative coordinate; the best tet seen wins when the
-// walk leaves the mesh or takes too long.
-void LevelErrorMeter::walk(uint32_t v, uint32_t t, std::span<const uint32_t> opposite) {
+// From tet t across the face of the most negative coordinate (across(t, k): the tet beyond the
+// face opposite corner k, or kNone); the best tet seen wins when the walk leaves the mesh or
+// takes too long. Returns the smallest coordinate there (negative: outside the mesh).
+template <typename Across>
+double LevelErrorMeter::walk(uint32_t v, uint32_t t, Across across) {
   const float* x = samples_[v].x;
   uint32_t bestTet = kNone;
   double best = -HUGE_VAL, bestL[4];
@@ -113,13 +115,55 @@ void LevelErrorMeter::walk(uint32_t v, uint32_t t, std::span<const uint32_t> opp
       std::copy(l, l + 4, bestL);
     }
     if (lo >= 0) break;
-    const uint32_t across = opposite[4 * size_t(t) + size_t(std::min_element(l, l + 4) - l)];
-    if (across == kNoNeighbor) break;
-    t = across >> 2;
+    const uint32_t next = across(t, int(std::min_element(l, l + 4) - l));
+    if (next == kNone) break;
+    t = next;
   }
-  if (bestTet == kNone) return;
+  if (bestTet == kNone) return best;
+  unlink(v);
   link(v, bestTet);
   setError(v, bestTet, bestL);
+  markOutside(v, best < 0);
+  return best;
+}
+
+void LevelErrorMeter::markOutside(uint32_t v, bool outside) {
+  if (!outside) return outside_.clear(v);
+  outside_.set(v);
+  if (!listed_.test(v)) {
+    listed_.set(v);
+    outsideList_.push_back(v);
+  }
+}
+
+// The tet beyond the face of t opposite corner k, from the stars of the face's vertices.
+uint32_t LevelErrorMeter::acrossByStars(uint32_t t, int k) const {
+  const uint32_t* v = &mesh_->tets[4 * size_t(t)];
+  const uint32_t b = v[(k + 2) & 3], c = v[(k + 3) & 3];
+  for (uint32_t corner : stars_->corners(v[(k + 1) & 3])) {
+    const uint32_t u = corner >> 2;
+    const uint32_t* w = &mesh_->tets[4 * size_t(u)];
+    if (u != t && (w[0] == b || w[1] == b || w[2] == b || w[3] == b) && (w[0] == c || w[1] == c || w[2] == c || w[3] == c))
+      return u;
+  }
+  return kNone;
+}
+
+// The input vertices outside the level mesh keep the tet they were least outside of, but splits
+// elsewhere move the boundary: walk each from there again (the boundary layer of Blunt Fin's
+// samples kept 5× the RMS of a fresh location without this).
+void LevelErrorMeter::relocateOutside() {
+  size_t keep = 0;
+  for (uint32_t v : outsideList_) {
+    if (outside_.test(v) && samples_[v].tet < kVertex &&
+        walk(v, samples_[v].tet, [this](uint32_t t, int k) { return acrossByStars(t, k); }) < 0) {
+      outsideList_[keep++] = v;
+    } else {
+      outside_.clear(v);
+      listed_.clear(v);
+    }
+  }
+  outsideList_.resize(keep);
 }
 
 void LevelErrorMeter::begin(std::span<const float> positions, std::span<const float> values, const TetMesh& level,
@@ -135,6 +179,8 @@ void LevelErrorMeter::begin(std::span<const float> positions, std::span<const fl
   const uint64_t stride = (V + maxSamples - 1) / std::max(maxSamples, 1u);
   samples_.resize(V);
   sampled_.resize(V);
+  outside_.resize(V);
+  listed_.resize(V);
   for (uint32_t v = 0; v < V; ++v) {
     const bool in = stride <= 1 || mix(v) % stride == 0;
     samples_[v] = {{positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]}, values[v], 0.0f, in ? kNone : kSkip, kNone, kNone};
@@ -156,7 +202,10 @@ void LevelErrorMeter::begin(std::span<const float> positions, std::span<const fl
     }
     const uint32_t at = levelOf[baseOf[v]];
     if (at == kNone || someTet[at] == kNone) continue;  // in no tet
-    walk(v, someTet[at], adjacency.opposite);
+    walk(v, someTet[at], [&](uint32_t t, int k) {
+      const uint32_t h = adjacency.opposite[4 * size_t(t) + size_t(k)];
+      return h == kNoNeighbor ? kNone : h >> 2;
+    });
   }
 }
 
@@ -203,6 +252,7 @@ void LevelErrorMeter::afterSplit(uint32_t input, uint32_t j, std::span<const uin
       const TetFrame* f = frame(k);
       if (f && f->coordinates(samples_[v].x, l, 0.0) >= 0) {
         setError(v, moved[k], l);
+        markOutside(v, false);
       } else {
         unlink(v);
         pending_.push_back(v);
@@ -219,6 +269,7 @@ void LevelErrorMeter::afterSplit(uint32_t input, uint32_t j, std::span<const uin
       const TetFrame* f = c != old ? frame(c) : nullptr;
       if (f && f->coordinates(x, l, 0.0) >= 0) found = c;
     }
+    markOutside(v, found == n);
     if (found == n) {  // outside all of them: the one it is least outside of
       double best = -HUGE_VAL;
       for (size_t c = 0; c < n; ++c) {
@@ -253,7 +304,8 @@ void LevelErrorMeter::updateAroundJ(uint32_t j, bool jValueChanged) {
   }
 }
 
-LevelError LevelErrorMeter::current() const {
+LevelError LevelErrorMeter::current() {
+  if (stars_) relocateOutside();
   double sum = 0, max = 0;
   size_t n = 0;
   for (const Sample& s : samples_) {

@@ -9,8 +9,10 @@
 // T_moved (j becomes i) and adds T_new around the new edge (i, j); together they cover exactly
 // what T_moved covered before. So only the input vertices inside T_moved are located again, among
 // T_new and T_moved; the rest keep their tet (paper §4.3's locality, applied to the samples).
-// An input vertex outside the level mesh (a boundary that moved inwards) takes the tet it is
-// least outside of, with its coordinates clamped to that tet.
+// An input vertex outside the level mesh (where a coarse level cuts across a curved or
+// non-convex boundary) takes the tet at which a walk towards it leaves the mesh, with its
+// coordinates clamped to that tet; as splits move the boundary, those are walked again from
+// there before each measurement.
 #pragma once
 #include <cmath>
 #include <cstdint>
@@ -48,7 +50,8 @@ class LevelErrorMeter {
   // a value back, every tet around j interpolates anew.
   void afterSplit(uint32_t input, uint32_t j, std::span<const uint32_t> moved, uint32_t firstNew, bool jValueChanged);
 
-  LevelError current() const;
+  // The error of the level now (after relocating the input vertices outside it).
+  LevelError current();
 
  private:
   static constexpr uint32_t kNone = ~uint32_t(0);
@@ -69,7 +72,11 @@ class LevelErrorMeter {
   void unlink(uint32_t v);
   void becomeVertex(uint32_t v, uint32_t level);
   void setError(uint32_t v, uint32_t t, const double l[4]);
-  void walk(uint32_t v, uint32_t t, std::span<const uint32_t> opposite);
+  template <typename Across>
+  double walk(uint32_t v, uint32_t t, Across across);
+  uint32_t acrossByStars(uint32_t t, int k) const;
+  void markOutside(uint32_t v, bool outside);
+  void relocateOutside();
   void updateAroundJ(uint32_t j, bool jValueChanged);
 
   // Per input vertex, in one place (they are visited in no useful order).
@@ -95,6 +102,8 @@ class LevelErrorMeter {
   std::vector<uint32_t> head_;         // per level tet: its first input vertex, or kNone
   Bits occupied_;                      // per level tet: head_ is not kNone
   Bits sampled_;                       // per input vertex: in the sample
+  Bits outside_, listed_;              // per input vertex: outside the level mesh; in outsideList_
+  std::vector<uint32_t> outsideList_;
   std::vector<uint32_t> inputOf_;      // per level vertex: the input vertex it is
   std::vector<uint32_t> pending_, pendingFrom_, candidates_;  // (pendingFrom_: the old tet's place in candidates_)
   std::vector<TetFrame> frames_;

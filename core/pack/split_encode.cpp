@@ -96,7 +96,7 @@ class Encoder {
                  LevelErrorMeter::kMaxSamples);
   }
 
-  void measure(ChunkInfo& info) const {
+  void measure(ChunkInfo& info) {
     if (!metered_) return;
     const LevelError e = meter_.current();
     info.fieldRms = e.rms;
