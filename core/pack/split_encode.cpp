@@ -78,9 +78,9 @@ class Encoder {
   }
 
   // Each level's field error, measured at the input's vertices (level_error.h) for the field
-  // that steered the simplification.
-  // The base at every input vertex on another thread (out_.base and a copy of its vertex ids
-  // stay as they are); the levels after it at a sample, here.
+  // that steered the simplification: the base at every input vertex on another thread (it reads
+  // out_.base and a copy of its vertex ids, which stay as they are), the levels after it at a
+  // sample, here, as the splits are replayed.
   void startMeter(int iso) {
     metered_ = iso >= 0;
     if (!metered_) return;
