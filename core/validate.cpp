@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <thread>
 
 #include "adjacency.h"
 #include "tet_tables.h"
@@ -62,25 +63,38 @@ ValidationReport validateMesh(const TetMesh& m, FaceAdjacency* adjacency) {
   if (indicesOk && T > 0) {
     // Duplicates: the sorted vertex quadruples, bucketed by their smallest vertex (a counting
     // sort; duplicates share a bucket), sorted within each small bucket.
-    std::vector<std::array<uint32_t, 4>> quads(T);
-    std::vector<uint32_t> start(size_t(V) + 1, 0);
-    for (uint32_t t = 0; t < T; ++t) {
-      const uint32_t* v = &m.tets[4 * size_t(t)];
-      ++start[std::min({v[0], v[1], v[2], v[3]}) + 1];
-    }
-    for (uint32_t v = 0; v < V; ++v) start[v + 1] += start[v];
-    std::vector<uint32_t> fill(start.begin(), start.end() - 1);
-    for (uint32_t t = 0; t < T; ++t) {
-      std::array<uint32_t, 4> q;
-      std::copy_n(&m.tets[4 * size_t(t)], 4, q.begin());
-      std::sort(q.begin(), q.end());
-      quads[fill[q[0]]++] = q;
-    }
-    for (uint32_t v = 0; v < V; ++v) {
-      auto b = quads.begin() + start[v], e = quads.begin() + start[v + 1];
-      std::sort(b, e);
-      for (auto it = b; it != e && it + 1 != e; ++it) r.duplicateTets += *it == *(it + 1);
-    }
+    auto countDuplicates = [&m, T, V] {
+      uint64_t duplicates = 0;
+      std::vector<std::array<uint32_t, 4>> quads(T);
+      std::vector<uint32_t> start(size_t(V) + 1, 0);
+      for (uint32_t t = 0; t < T; ++t) {
+        const uint32_t* v = &m.tets[4 * size_t(t)];
+        ++start[std::min({v[0], v[1], v[2], v[3]}) + 1];
+      }
+      for (uint32_t v = 0; v < V; ++v) start[v + 1] += start[v];
+      std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+      for (uint32_t t = 0; t < T; ++t) {
+        std::array<uint32_t, 4> q;
+        std::copy_n(&m.tets[4 * size_t(t)], 4, q.begin());
+        std::sort(q.begin(), q.end());
+        quads[fill[q[0]]++] = q;
+      }
+      for (uint32_t v = 0; v < V; ++v) {
+        auto b = quads.begin() + start[v], e = quads.begin() + start[v + 1];
+        std::sort(b, e);
+        for (auto it = b; it != e && it + 1 != e; ++it) duplicates += *it == *(it + 1);
+      }
+      return duplicates;
+    };
+    // Natively, on a second thread while the faces are paired (the two are independent and
+    // take about as long); the web build has no threads.
+#if defined(__EMSCRIPTEN__)
+    r.duplicateTets = countDuplicates();
+#else
+    std::jthread duplicates;  // (joins on the way out, an exception included)
+    if (T >= 100000) duplicates = std::jthread([&] { r.duplicateTets = countDuplicates(); });
+    else r.duplicateTets = countDuplicates();
+#endif
 
     FaceAdjacency adj;
     buildFaceAdjacency(m.tets, V, adj);
@@ -90,6 +104,9 @@ ValidationReport validateMesh(const TetMesh& m, FaceAdjacency* adjacency) {
     r.boundaryFaces = boundary.size() / 3;
     r.nonManifoldBoundaryEdges = countNonManifoldBoundaryEdges(boundary);
     if (adjacency) *adjacency = std::move(adj);
+#if !defined(__EMSCRIPTEN__)
+    if (duplicates.joinable()) duplicates.join();
+#endif
   }
 
   if (r.noTets) r.findings.push_back("the mesh has no tetrahedra");
