@@ -142,8 +142,9 @@ test('streams a multi-chunk pack to complete, matches the CLI surface, and the i
   assert.ok(diff.differing <= 0.001 * diff.pixels && diff.large <= 0.0001 * diff.pixels,
     `streamed and rebuilt surfaces draw the same: ${JSON.stringify(diff)}`);
 
-  // Drag the ImGui isovalue slider from its middle to 85% of its width with the mouse.
-  const r = s.sliderRect;
+  // Drag the ImGui isovalue slider from its middle to 85% of its width with the mouse. (Where
+  // it is now: lines of the panel above it may have changed since the stream completed.)
+  const r = (await page.evaluate(() => window.tetstream.stats())).sliderRect;
   assert.ok(r.w > 50 && r.h > 5, `slider rectangle recorded: ${JSON.stringify(r)}`);
   const y = r.y + r.h / 2;
   await page.mouse.move(r.x + 0.5 * r.w, y);
