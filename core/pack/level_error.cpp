@@ -191,8 +191,15 @@ void LevelErrorMeter::begin(std::span<const float> positions, std::span<const fl
   inputOf_.assign(level.vertexCount(), kNone);
   std::vector<uint32_t> someTet(level.vertexCount(), kNone);  // per base vertex: a tet around it
   for (size_t c = 0; c < tets.size(); ++c) someTet[tets[c]] = uint32_t(c / 4);
+  // Across faces by the level's stars when it has them (the encoder's meter), else by a face
+  // adjacency built here (measure(), on its own thread): the base's faces are not paired twice.
   FaceAdjacency adjacency;
-  buildFaceAdjacency(tets, level.vertexCount(), adjacency);
+  if (!stars_) buildFaceAdjacency(tets, level.vertexCount(), adjacency);
+  auto across = [&](uint32_t t, int k) {
+    if (stars_) return acrossByStars(t, k);
+    const uint32_t h = adjacency.opposite[4 * size_t(t) + size_t(k)];
+    return h == kNoNeighbor ? kNone : h >> 2;
+  };
   for (uint32_t v = 0; v < V; ++v) {
     if (levelOf[v] != kNone) inputOf_[levelOf[v]] = v;
     if (!sampled_.test(v) || !std::isfinite(values[v])) continue;
@@ -202,10 +209,7 @@ void LevelErrorMeter::begin(std::span<const float> positions, std::span<const fl
     }
     const uint32_t at = levelOf[baseOf[v]];
     if (at == kNone || someTet[at] == kNone) continue;  // in no tet
-    walk(v, someTet[at], [&](uint32_t t, int k) {
-      const uint32_t h = adjacency.opposite[4 * size_t(t) + size_t(k)];
-      return h == kNoNeighbor ? kNone : h >> 2;
-    });
+    walk(v, someTet[at], across);
   }
 }
 
