@@ -29,7 +29,7 @@ struct PackOptions {
   uint32_t chunkKb = 256;                 // largest split chunk, compressed
   double maxMemoryBytes = 0;              // refuse meshes that need more (0: 90% of physical memory)
   int threads = 2;                        // threads that evaluate collapse costs (1 or 2; same output)
-  uint32_t partitionMinVertices = 50000;  // simplify in two halves at once from this size (SimplifyOptions)
+  uint32_t partitionMinVertices = 50000;  // simplify in slabs at once from this size (SimplifyOptions)
   // Progress for displays: phase ("validate", "simplify", "encode", "write"), items done and
   // planned in that phase (collapses, splits; 0 planned when not countable).
   std::function<void(const char* phase, uint64_t done, uint64_t planned)> progress;
@@ -41,7 +41,7 @@ struct PackSummary {
   uint32_t baseVertices = 0, baseTets = 0, splits = 0;
   uint32_t flatTetsRemoved = 0, flatTetsLeft = 0;
   uint64_t queuePops = 0, requeued = 0, costEvaluations = 0;  // simplifier work, for benchmarks
-  uint32_t halvesCollapses = 0;      // of the collapses, those made in two halves at once
+  uint32_t halvesCollapses = 0;      // of the collapses, those made in slabs at once (the parallel phase)
   std::string stopReason;            // why simplification stopped
   double prepareMs = 0, simplifyMs = 0, encodeMs = 0, writeMs = 0;  // prepare: checks, orientation, grid
   std::vector<std::string> notes;    // what the packer changed or found, in plain words

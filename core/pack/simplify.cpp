@@ -20,6 +20,7 @@
 #include <cassert>
 #include <cmath>
 #include <cstdlib>
+#include <deque>
 #include <queue>
 #include <thread>
 #include <atomic>
@@ -122,7 +123,7 @@ class Simplifier {
 
   CollapseVerdict check(uint32_t i, uint32_t j) {
     init();
-    Lane& L = main_.lane;
+    Lane& L = *main_.lane;
     neighbours(L, i, L.nbr);
     const size_t slot = size_t(std::find(L.nbr.begin(), L.nbr.end(), j) - L.nbr.begin());
     if (slot == L.nbr.size()) return CollapseVerdict::NotAnEdge;
@@ -184,17 +185,19 @@ class Simplifier {
     }
     if (W.errorBound) out_.stopReason = "error bound reached";
     if (opt_.progress) opt_.progress(out_.log.size(), planned);
-    for (const Worker* w : {&main_, &parts_[0], &parts_[1]}) {
+    std::vector<const Worker*> workers{&main_};
+    for (const Worker& w : parts_) workers.push_back(&w);
+    for (const Worker* w : workers) {
       out_.queuePops += w->pops;
       out_.requeued += w->requeued;
       out_.rejectedByLink += w->rejectedByLink;
       out_.flatTetsRemoved += w->flatTetsRemoved;
-      out_.costEvaluations += w->lane.evaluations;
       out_.linkMismatches += w->linkMismatches;
     }
     alive_ -= W.collapsed;
     tetsAlive_ -= W.tetsRemoved;
     out_.vertices = alive_;
+    for (const Lane* L : {&mainLane_}) out_.costEvaluations += L->evaluations;
     for (const Lane& L : lanes_) out_.costEvaluations += L.evaluations;
     out_.tetCount = 0;
     for (uint32_t t = 0; t < T_; ++t) {
@@ -303,7 +306,8 @@ class Simplifier {
     lastCost_.assign(V_, float(kInf));
     // Every vertex's first cost, on two threads (each with its own scratch lane; the mesh is
     // only read), then queued in vertex order so the result does not depend on the threads.
-    main_.lane.reset(V_);
+    mainLane_.reset(V_);
+    main_.lane = &mainLane_;
     lanes_.resize(kRoundSize);
     for (Lane& L : lanes_) L.reset(V_);
     auto work = [this](Lane& L, uint32_t begin, uint32_t end) {
@@ -459,16 +463,16 @@ class Simplifier {
 
   using Heap = std::priority_queue<Entry, std::vector<Entry>, EntryAfter>;
 
-  // What one thread of the collapse loop works with: the queue of the whole mesh, or of one half
-  // in the parallel phase (runParts), with its own log and scratch.
+  // What the collapse loop works with: the queue of the whole mesh, or of one block in the
+  // parallel phase (runParts), with its own log and scratch.
   struct Worker {
-    int part = -1;          // -1: the whole mesh
+    int part = -1;          // -1: the whole mesh; else the block
     Heap heap;
-    CollapseLog ownLog;     // a part's collapses (merged into out_.log afterwards)
+    CollapseLog ownLog;     // a block's collapses in this round (merged into out_.log after it)
     CollapseLog* log = &ownLog;
-    std::vector<float> keys;  // a part's collapses: the queue key each was taken at
-    Lane lane;              // link condition and collapse (and a part's evaluations)
-    std::atomic<uint32_t> collapsed{0};  // (read by the progress report of the other part)
+    std::vector<float> keys;  // a block's collapses: the queue key each was taken at
+    Lane* lane = nullptr;   // link condition and collapse (and a block's evaluations): its thread's
+    std::atomic<uint32_t> collapsed{0};  // (read by the progress report on the other thread)
     uint32_t tetsRemoved = 0;
     uint64_t pops = 0, requeued = 0, rejectedByLink = 0, flatTetsRemoved = 0, linkMismatches = 0;
     bool errorBound = false;
@@ -815,7 +819,7 @@ class Simplifier {
   // Collapses i along its cheapest legal out-edge (evaluated in L) unless that costs more than
   // slack_ × `next`, the key of the next entry: then i goes back into the queue under its new
   // cost. Most pops find that the cost went up since a neighbour collapsed. On meshes large
-  // enough to be cut in halves, those within 10% are taken anyway: a quarter fewer pops (each
+  // enough to be cut in slabs, those within 10% are taken anyway: a quarter fewer pops (each
   // evaluates every out-edge of i), a field error 0.3–1.2% higher on Harmonic 64³ and up to 0.6%
   // on the carotid data, 1.8% fewer bytes. Small meshes pack in moments: they keep the exact
   // order (the 8,750 tets of post.vtk got up to 12% worse with the slack).
@@ -856,109 +860,148 @@ class Simplifier {
   }
 
   // ------------------------------------------------------------------ the parallel phase
-  // Most collapses happen in the two halves of the mesh at once. A half owns the vertices on its
-  // side of a cut (below), and only collapses i → j where i and j are inner: all their
-  // neighbours are its own. A collapse changes the tets around i and j (vertices, κ, faces) and
-  // the stars, κ sums, quadrics and values of i's neighbours; an evaluation reads those of v, its
-  // star and its neighbours. For inner vertices all of that is the half's own, so the two threads
-  // touch disjoint data, neither half's collapses depend on the other's or on timing (one thread
-  // gives the same result), and any interleaving of the two sequences is a valid sequence of
-  // collapses: they are merged by the key each was taken at, close to the order of one queue.
-  // The halves take kPartShare of their inner vertices' share of the planned collapses; the
-  // vertices along the cut and the rest are left to the one queue of the whole mesh, which evens
-  // out what the halves did. (On Harmonic 64³ shares from 0.9 to 1 give the same field error
-  // within 0.3%, 1 packs 0.3 s faster than 0.9; simplified to 2% of its vertices, Harmonic 20³
-  // gets a 9% larger error with 1, none with 0.9 to 0.97.)
+  // Most collapses happen in slabs of the mesh, one thread each. A slab owns the vertices inside
+  // it, and only collapses i → j where i and j are inner: all their neighbours are its own. A
+  // collapse changes the tets around i and j (vertices, κ, faces) and the stars, κ sums, quadrics
+  // and values of i's neighbours; an evaluation reads those of v, its star and its neighbours.
+  // For inner vertices all of that is the slab's own, so slabs touch disjoint data, no slab's
+  // collapses depend on another's or on timing (one thread gives the same result), and any
+  // interleaving of their sequences is a valid sequence of collapses: each round's are merged by
+  // the key each was taken at, close to the order of one queue.
+  //
+  // Rounds: every slab collapses its entries up to a key τ, then τ grows by kTauGrowth. The
+  // rounds alternate between two slabs cut at the median and three cut at the quartiles, so a
+  // vertex left waiting along one round's cut is inner in the next and is collapsed within a
+  // step of τ of its turn. (With one fixed cut its vertices waited for the whole mesh's queue at
+  // the end: they were the last collapses and so the first splits, and the levels around 12% of
+  // Harmonic 64³'s vertices spent a quarter of their vertices on a refined slab along the cut.
+  // Parallel cuts never cross, so no vertex waits on two; more slabs, for smaller working sets,
+  // made the stream up to 10% larger and were no faster.) Growth 2 left the levels up to 3%
+  // worse than √2; 2^¼ was no better than √2 and takes twice the rounds (each ~10 ms on
+  // Harmonic 64³).
+  // The slabs take kPartShare of the planned collapses; the one queue of the whole mesh then
+  // takes the vertices along the last round's cuts and the rest. (Shares from 0.9 to 1 gave the
+  // same field error within 0.3% on Harmonic 64³; with 1, Harmonic 20³ cut to 2% of its vertices
+  // got 9% worse, with 0.9 to 0.97 not.)
   static constexpr double kPartShare = 0.95;
+  static constexpr float kTauGrowth = 1.41421356f;
+  static constexpr uint32_t kMaxSlabs = 3;
+
+  // The slab of every alive vertex: two cut at the median of `order`'s alive vertices or, on
+  // staggered rounds, three cut at the quartiles. Returns the number of slabs.
+  uint32_t slabsOf(const std::vector<uint32_t>& order, uint32_t alive, bool staggered, std::vector<uint32_t>& slab) const {
+    const uint32_t count = staggered ? 3 : 2;
+    uint32_t rank = 0, s = 0;
+    for (uint32_t v : order) {
+      if (!out_.vertexAlive[v]) continue;
+      // Slab s holds the ranks below its upper quantile: 1/2, or 1/4 and 3/4.
+      while (s + 1 < count && 4 * uint64_t(rank) >= uint64_t(alive) * (staggered ? 2 * s + 1 : 2)) ++s;
+      slab[v] = s;
+      ++rank;
+    }
+    return count;
+  }
+
   void runParts(uint32_t planned) {
-    // The cut: the one with the fewest vertices along it among the halves by vertex id (meshes
-    // are mostly numbered coherently, and then the split stream compresses best: Harmonic 64³'s
-    // grew by 8.6% when cut across its numbering) and by the median plane on each axis.
-    std::vector<uint32_t> order;
+    // The order the slabs follow: the vertex numbering (meshes are mostly numbered coherently,
+    // and the split stream then compresses best: Harmonic 64³'s grew by 9% with slabs across its
+    // numbering) or an axis, whichever crosses fewest vertices when halved.
+    std::vector<uint32_t> order, candidate, slab(V_, 0);
     for (uint32_t v = 0; v < V_; ++v)
-      if (out_.vertexAlive[v]) order.push_back(v);
-    const size_t half = order.size() / 2;
-    std::vector<uint8_t> side(V_), best, bestInner;
-    size_t bestBorder = ~size_t(0);
+      if (out_.vertexAlive[v]) candidate.push_back(v);
+    size_t fewest = ~size_t(0);
     for (int axis = -1; axis < 3; ++axis) {
       if (axis >= 0)
-        std::nth_element(order.begin(), order.begin() + ptrdiff_t(half), order.end(), [&](uint32_t a, uint32_t b) {
-          return p(a)[axis] < p(b)[axis] || (p(a)[axis] == p(b)[axis] && a < b);
-        });
-      std::fill(side.begin(), side.end(), 0);
-      for (size_t k = half; k < order.size(); ++k) side[order[k]] = 1;
-      markInner(side);
+        std::stable_sort(candidate.begin(), candidate.end(), [&](uint32_t a, uint32_t b) { return p(a)[axis] < p(b)[axis]; });
+      slabsOf(candidate, alive_, false, slab);
+      markInner(slab);
       size_t border = 0;
-      for (uint32_t v : order) border += !inner_[v];
-      if (border < bestBorder) {
-        bestBorder = border;
-        best = side;
-        bestInner = inner_;
+      for (uint32_t v : candidate) border += !inner_[v];
+      if (border < fewest) {
+        fewest = border;
+        order = candidate;
       }
     }
-    side = std::move(best);
-    inner_ = std::move(bestInner);
-    double inner[2] = {0, 0};
-    for (uint32_t v : order)
-      if (inner_[v]) inner[side[v]] += 1;
-    if (inner[0] + inner[1] == 0) return;
-    for (uint32_t v : order)
-      if (inner_[v] && queued_[v]) parts_[side[v]].heap.push({queueKey(v), v});
-    // The vertices along the cut wait for the whole mesh's queue, so the halves only take their
-    // inner vertices' share of the planned collapses: their density then ends near the final one.
-    const double innerShare = kPartShare * (inner[0] + inner[1]) / double(order.size());
-    const double budgetV = innerShare * planned;
-    const double budgetT = opt_.targetTets > 0 ? innerShare * (double(tetsAlive_) - opt_.targetTets) : kInf;
-    // Both halves collapse every entry up to a key τ, then τ doubles: so they advance through
-    // the same costs (with fixed quotas one half could end simplified further than the other).
-    // Each step's collapses are capped, in proportion to the inner vertices, by what is left of
-    // the budget.
-    double capV[2], capT[2];
+    for (uint32_t s = 0; s < kMaxSlabs; ++s) parts_.emplace_back().part = int(s);
+    // The log sized up front (a log grown by doubling holds up to twice its size): a collapse
+    // removes about (T − target tets) / planned tets and moves the rest of a star of 4T/V tets.
+    const double removedEach = double(tetsAlive_ - std::min<uint32_t>(tetsAlive_, opt_.targetTets)) / std::max(1u, planned);
+    const double movedEach = std::max(0.0, 4.0 * tetsAlive_ / std::max<uint32_t>(alive_, 1) - removedEach);
+    const double expected = planned + 1.0;
+    forEachArray([&](auto& v) { v.reserve(size_t(expected)); }, out_.log);
+    out_.log.moved.reserve(size_t(expected * movedEach));
+    out_.log.removed.reserve(size_t(expected * removedEach));
+    out_.log.removedVertices.reserve(size_t(4 * expected * removedEach));
+
+    const double budgetV = kPartShare * planned;
+    const double budgetT = opt_.targetTets > 0 ? kPartShare * (double(tetsAlive_) - opt_.targetTets) : kInf;
+    double capV[kMaxSlabs], capT[kMaxSlabs], inner[kMaxSlabs];
+    std::vector<uint32_t> thread[2];
     float tau = 0;
-    auto work = [&](int part) {
-      Worker& W = parts_[part];
-      Entry e, top;
-      while (W.collapsed < capV[part] && W.tetsRemoved < capT[part] && !W.errorBound && peekValid(W.heap, e) &&
-             e.cost <= tau) {
-        W.heap.pop();
-        queued_[e.vertex] = 0;
-        evaluateVertex(W.lane, e.vertex);
-        tryCollapse(W, e.vertex, W.lane, peekValid(W.heap, top) ? top.cost : float(kInf));
-        if (part == 0 && opt_.progress && (W.collapsed & 4095) == 0)
-          opt_.progress(parts_[0].collapsed + parts_[1].collapsed, planned);
+    uint32_t collapsedAll = 0, removedAll = 0;
+    auto work = [&](int t) {
+      for (uint32_t s : thread[t]) {
+        Worker& W = parts_[s];
+        Entry e, top;
+        while (W.collapsed < capV[s] && W.tetsRemoved < capT[s] && !W.errorBound && peekValid(W.heap, e) &&
+               e.cost <= tau) {
+          W.heap.pop();
+          queued_[e.vertex] = 0;
+          evaluateVertex(*W.lane, e.vertex);
+          tryCollapse(W, e.vertex, *W.lane, peekValid(W.heap, top) ? top.cost : float(kInf));
+          if (t == 0 && opt_.progress && (W.collapsed & 4095) == 0) {
+            uint32_t done = collapsedAll;
+            for (const Worker& x : parts_) done += x.collapsed;
+            opt_.progress(done, planned);
+          }
+        }
       }
     };
-    // Each half's log sized for its share up front (a log grown by doubling holds up to twice
-    // its size): a collapse removes about (T − target tets) / planned tets and moves the rest of
-    // a star of 4T/V tets.
-    const double collapses = std::min(budgetV, budgetT * planned / std::max(1.0, double(tetsAlive_)));
-    const double removedEach = double(tetsAlive_ - std::min<uint32_t>(tetsAlive_, opt_.targetTets)) / std::max(1u, planned);
-    const double movedEach = std::max(0.0, 4.0 * tetsAlive_ / std::max<size_t>(order.size(), 1) - removedEach);
-    for (int part = 0; part < 2; ++part) {
-      parts_[part].part = part;
-      parts_[part].lane.reset(V_);
-      const double expected = 1.05 * collapses * inner[part] / (inner[0] + inner[1]);
-      CollapseLog& log = parts_[part].ownLog;
-      forEachArray([&](auto& v) { v.reserve(size_t(expected)); }, log);
-      log.moved.reserve(size_t(expected * movedEach));
-      log.removed.reserve(size_t(expected * removedEach));
-      log.removedVertices.reserve(size_t(4 * expected * removedEach));
-      parts_[part].keys.reserve(size_t(expected));
-    }
-    for (;;) {
-      const double leftV = budgetV - (parts_[0].collapsed + parts_[1].collapsed);
-      const double leftT = budgetT - (double(parts_[0].tetsRemoved) + parts_[1].tetsRemoved);
-      float least = float(kInf);
-      for (Worker& W : parts_) {
-        Entry e;
-        if (peekValid(W.heap, e)) least = std::min(least, e.cost);
+    // Rounds end when the budget is spent, nothing is queued, or two rounds in a row (one of each
+    // kind) collapsed nothing: what is left waits along the cuts for the whole mesh's queue.
+    for (int round = 0, idle = 0; idle < 2; ++round) {
+      const uint32_t slabs = slabsOf(order, alive_ - collapsedAll, round & 1, slab);
+      markInner(slab);
+      // The slabs' queues anew: every queued inner vertex under its last known cost.
+      std::vector<Entry> entries[kMaxSlabs];
+      std::fill(inner, inner + kMaxSlabs, 0.0);
+      for (uint32_t v : order) {
+        if (!out_.vertexAlive[v] || !inner_[v]) continue;
+        inner[slab[v]] += 1;
+        if (queued_[v]) entries[slab[v]].push_back({queueKey(v), v});
       }
-      if (leftV < 1 || leftT < 1 || least == float(kInf) || parts_[0].errorBound || parts_[1].errorBound) break;
-      tau = std::max(2 * tau, least);
-      for (int part = 0; part < 2; ++part) {
-        const double share = inner[part] / (inner[0] + inner[1]);
-        capV[part] = parts_[part].collapsed + leftV * share;
-        capT[part] = parts_[part].tetsRemoved + leftT * share;
+      float least = float(kInf);
+      bool errorBound = false;
+      double innerAll = 0;
+      for (uint32_t s = 0; s < slabs; ++s) {
+        Worker& W = parts_[s];
+        W.heap = Heap(EntryAfter(), std::move(entries[s]));
+        if (!W.heap.empty()) least = std::min(least, W.heap.top().cost);
+        errorBound |= W.errorBound;
+        innerAll += inner[s];
+      }
+      const double leftV = budgetV - collapsedAll, leftT = budgetT - removedAll;
+      if (leftV < 1 || leftT < 1 || least == float(kInf) || errorBound) break;
+      tau = std::max(kTauGrowth * tau, least);
+      // Each slab's collapses this round are capped, in proportion to its inner vertices, by
+      // what is left of the budget; the slabs go to the threads by size, largest first.
+      uint32_t bySize[kMaxSlabs];
+      for (uint32_t s = 0; s < slabs; ++s) bySize[s] = s;
+      std::stable_sort(bySize, bySize + slabs, [&](uint32_t a, uint32_t b) { return inner[a] > inner[b]; });
+      double load[2] = {0, 0};
+      thread[0].clear();
+      thread[1].clear();
+      for (uint32_t k = 0; k < slabs; ++k) {
+        const uint32_t s = bySize[k];
+        Worker& W = parts_[s];
+        W.collapsed = 0;
+        W.tetsRemoved = 0;
+        capV[s] = leftV * inner[s] / innerAll;
+        capT[s] = leftT * inner[s] / innerAll;
+        const int t = load[1] < load[0] ? 1 : 0;
+        load[t] += inner[s];
+        thread[t].push_back(s);
+        W.lane = &lanes_[size_t(t)];
       }
       if (opt_.threads > 1) {
         std::thread second(work, 1);
@@ -968,37 +1011,52 @@ class Simplifier {
         work(0);
         work(1);
       }
+      mergeRound(slabs);
+      uint32_t collapsed = 0;
+      for (uint32_t s = 0; s < slabs; ++s) {
+        collapsed += parts_[s].collapsed;
+        removedAll += parts_[s].tetsRemoved;
+      }
+      collapsedAll += collapsed;
+      idle = collapsed ? 0 : idle + 1;
     }
-    // What is left in the halves' queues stays marked queued_ for the whole mesh's queue.
+    // What is left in the slabs' queues stays marked queued_ for the whole mesh's queue.
+    out_.halvesCollapses += collapsedAll;
+    alive_ -= collapsedAll;
+    tetsAlive_ -= removedAll;
     for (Worker& W : parts_) {
-      out_.halvesCollapses += W.collapsed;
-      alive_ -= W.collapsed;
-      tetsAlive_ -= W.tetsRemoved;
       W.heap = Heap();
-    }
-    // Merged by key; ties: the first half first. (The logs are large: without their slack and
-    // with the merged one sized up front, the merge needs one log's worth of memory more, not 2.5.)
-    const CollapseLog &a = parts_[0].ownLog, &b = parts_[1].ownLog;
-    forEachArray([](auto& x, auto& y) { x.shrink_to_fit(), y.shrink_to_fit(); }, parts_[0].ownLog, parts_[1].ownLog);
-    const double merged = std::max(1.0, double(a.size()) + b.size());
-    const double room = std::clamp(planned / merged, 1.0, 1.3);  // (and room for the rest)
-    forEachArray([&](auto& d, auto& x, auto& y) { d.reserve(size_t(room * double(x.size() + y.size())) + 1); }, out_.log, a, b);
-    for (uint32_t x = 0, y = 0; x < a.size() || y < b.size();) {
-      if (y >= b.size() || (x < a.size() && parts_[0].keys[x] <= parts_[1].keys[y])) appendCollapse(out_.log, a, x++);
-      else appendCollapse(out_.log, b, y++);
-    }
-    for (Worker& W : parts_) {
       W.ownLog = CollapseLog();
       W.keys = std::vector<float>();
     }
   }
 
-  // inner_[v]: every tet around v lies on v's side.
-  void markInner(const std::vector<uint8_t>& side) {
+  // Appends the collapses of this round's slabs to the log, merged by the key each was taken at
+  // (ties: the lower slab first), and empties the slabs' logs for the next round.
+  void mergeRound(uint32_t slabs) {
+    uint32_t next[kMaxSlabs] = {};
+    for (;;) {
+      int best = -1;
+      for (uint32_t s = 0; s < slabs; ++s)
+        if (next[s] < parts_[s].ownLog.size() &&
+            (best < 0 || parts_[s].keys[next[s]] < parts_[size_t(best)].keys[next[size_t(best)]]))
+          best = int(s);
+      if (best < 0) break;
+      appendCollapse(out_.log, parts_[size_t(best)].ownLog, next[size_t(best)]++);
+    }
+    for (uint32_t s = 0; s < slabs; ++s) {
+      forEachArray([](auto& x) { x.clear(); }, parts_[s].ownLog);
+      parts_[s].keys.clear();
+    }
+  }
+
+  // inner_[v]: every alive tet around v lies in v's slab.
+  void markInner(const std::vector<uint32_t>& slab) {
     inner_.assign(V_, 1);
     for (uint32_t t = 0; t < T_; ++t) {
+      if (!out_.tetAlive[t]) continue;
       const uint32_t* v = &out_.tets[4 * size_t(t)];
-      if (side[v[0]] != side[v[1]] || side[v[0]] != side[v[2]] || side[v[0]] != side[v[3]])
+      if (slab[v[0]] != slab[v[1]] || slab[v[0]] != slab[v[2]] || slab[v[0]] != slab[v[3]])
         for (int k = 0; k < 4; ++k) inner_[v[k]] = 0;
     }
   }
@@ -1077,7 +1135,7 @@ class Simplifier {
     if (verify && result_ != reference) ++W.linkMismatches;            \
     return result_;                                                    \
   } while (0)
-    Lane& L = W.lane;
+    Lane& L = *W.lane;
     auto hasBoundaryFace = [&](uint32_t v) {
       bool any = false;
       forBoundaryFaces(v, [&](uint32_t, uint32_t) { any = true; });
@@ -1274,7 +1332,7 @@ class Simplifier {
     const uint32_t n = uint32_t(free.size());
     std::vector<uint32_t> rowStart(n + 1, 0), cols;
     for (uint32_t r = 0; r < n; ++r) {
-      Lane& L = main_.lane;
+      Lane& L = mainLane_;
       neighbours(L, free[r], L.nbr);
       L.nbr.push_back(free[r]);
       std::sort(L.nbr.begin(), L.nbr.end());
@@ -1477,7 +1535,7 @@ class Simplifier {
     // Everything around j changed. j and its neighbours are re-evaluated lazily, when they reach
     // the top: those already queued keep their entry; a blocked one (no legal collapse last
     // time) is queued again under its last known cost, as its neighbourhood changed.
-    Lane& L = W.lane;
+    Lane& L = *W.lane;
     W.touched.clear();
     ++L.stamp;
     L.seen[i] = L.stamp;
@@ -1520,13 +1578,14 @@ class Simplifier {
   std::vector<FieldQuadric> fieldQuadric_;
   std::vector<double> qualitySum_;  // per vertex: Σ 3/κ over its star
   std::vector<uint8_t> queued_;  // per vertex: has an entry in the queue (or in the current round)
-  std::vector<Lane> lanes_;  // one per entry of a round (and the two threads of init())
+  Lane mainLane_;
+  std::vector<Lane> lanes_;  // one per entry of a round (and per thread in init() and runParts())
   static constexpr uint32_t kRoundSize = 4;
   std::vector<Entry> round_;
   std::vector<uint32_t> changed_;  // per vertex: roundStamp_ of the last round that touched it
   uint32_t roundStamp_ = 0;
   Worker main_;     // the one queue of the whole mesh (its log is out_.log)
-  Worker parts_[2];  // the two halves of the parallel phase
+  std::deque<Worker> parts_;  // the blocks of the parallel phase (a deque: a Worker does not move)
   float slack_ = 1.0f;  // see tryCollapse
   std::vector<uint8_t> inner_;  // per vertex: every neighbour is on its side of the cut (runParts)
 };

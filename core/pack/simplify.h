@@ -35,11 +35,12 @@
 // disappear (when they contain the collapsed edge) or become proper.
 //
 // Order: one priority queue of vertices by the cost of their cheapest out-edge, updated lazily.
-// Meshes of partitionMinVertices or more are first simplified in two halves at once (a cut
-// through the vertex numbering or a median plane, whichever crosses fewest vertices), each half
+// Meshes of partitionMinVertices or more are first simplified in slabs, one thread each (cut
+// along the vertex numbering or an axis, whichever crosses fewest vertices), each slab
 // collapsing only vertices whose whole neighbourhood is its own, so the two threads touch
-// disjoint data; the halves' logs are merged by cost, and the one queue of the whole mesh then
-// takes the vertices along the cut and the last collapses. On such meshes a vertex whose cost
+// disjoint data. Rounds of rising cost alternate between two slabs cut at the median and three
+// cut at the quartiles, so no vertex waits along a cut for long; each round's logs are merged by
+// cost, and the one queue of the whole mesh then takes the last collapses. On such meshes a vertex whose cost
 // rose by at most 10% since it was queued is collapsed without going back into the queue.
 //
 // The result is a log of collapses for the encoder (split_encode.h); the simplifier knows
@@ -77,12 +78,12 @@ struct SimplifyOptions {
   bool refitValues = true;
   std::function<void(uint32_t done, uint32_t planned)> progress;  // called now and then
   bool verifyLinkCondition = false;  // tests: also run the slow reference link check, count mismatches
-  // Threads (1 or 2; the result is the same either way): the two halves run on one each, and the
+  // Threads (1 or 2; the result is the same either way): the slabs run on one each, and the
   // one queue evaluates its next entries on both for meshes of at least parallelMinVertices
   // vertices (below that, starting rounds costs more than it saves).
   int threads = 2;
   uint32_t parallelMinVertices = 20000;
-  // Meshes of at least this many vertices are simplified in two halves at once for most of the
+  // Meshes of at least this many vertices are simplified in slabs at once for most of the
   // way (simplify.cpp, runParts); the result depends on this, not on `threads`.
   uint32_t partitionMinVertices = 50000;
 };
@@ -113,7 +114,7 @@ struct SimplifyResult {
   uint32_t flatTetsLeft = 0;
   uint64_t costEvaluations = 0, rejectedByLink = 0;
   uint64_t queuePops = 0, requeued = 0;  // pops of current entries, and those pushed back costlier
-  uint32_t halvesCollapses = 0;          // collapses made in the two halves at once (partitionMinVertices)
+  uint32_t halvesCollapses = 0;          // collapses made in the slabs at once (partitionMinVertices)
   uint64_t linkMismatches = 0;           // with verifyLinkCondition: fast and reference disagreed
   std::string stopReason;          // "target reached", "no legal collapse left", "error bound"
 };
