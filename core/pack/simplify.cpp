@@ -235,6 +235,11 @@ class Simplifier {
     out_.tetAlive.assign(T_, 1);
     out_.vertexAlive.assign(V_, 0);
     star_.assign(V_, {});
+    {
+      std::vector<uint32_t> size(V_, 0);  // each star reserved at its size (no regrowth)
+      for (uint32_t v : out_.tets) ++size[v];
+      for (uint32_t v = 0; v < V_; ++v) star_[v].reserve(size[v]);
+    }
     for (uint32_t t = 0; t < T_; ++t)
       for (int k = 0; k < 4; ++k) star_[out_.tets[4 * size_t(t) + k]].push_back(t);
     alive_ = 0;
@@ -267,39 +272,39 @@ class Simplifier {
     }
     kappa_.resize(T_);
     qualitySum_.assign(V_, 0.0);
-    for (uint32_t t = 0; t < T_; ++t) {
-      kappa_[t] = tetKappa(t);
-      if (kappa_[t] >= kKappaCap) ++flatInput_;
-      for (int k = 0; k < 4; ++k) qualitySum_[out_.tets[4 * size_t(t) + k]] += 3.0 / kappa_[t];
-    }
     fieldQuadric_.assign(V_, {});
-    for (uint32_t t = 0; t < T_; ++t) {
-      const uint32_t* v = &out_.tets[4 * size_t(t)];
-      const double *p0 = p(v[0]), *p1 = p(v[1]), *p2 = p(v[2]), *p3 = p(v[3]);
-      double e[3][3], ds[3];
-      for (int k = 0; k < 3; ++k) {
-        e[0][k] = p1[k] - p0[k];
-        e[1][k] = p2[k] - p0[k];
-        e[2][k] = p3[k] - p0[k];
+    // κ of every tet and the per-vertex sums over them (3/κ, field quadrics) on two threads: each
+    // adds to the vertices of its own range only, taking the tets in order, so every sum is
+    // formed in the same order as on one thread; a tet with vertices in both ranges is computed
+    // by both (few, in a mesh numbered coherently).
+    uint32_t flat[2] = {0, 0};
+    auto sums = [&](int part, uint32_t lo, uint32_t hi) {
+      for (uint32_t t = 0; t < T_; ++t) {
+        const uint32_t* v = &out_.tets[4 * size_t(t)];
+        bool mine[4], any = false;
+        for (int k = 0; k < 4; ++k) any |= mine[k] = v[k] >= lo && v[k] < hi;
+        if (!any) continue;
+        const float kappa = tetKappa(t);
+        if (mine[0]) {  // (the owner of its first vertex writes κ)
+          kappa_[t] = kappa;
+          flat[part] += kappa >= kKappaCap;
+        }
+        for (int k = 0; k < 4; ++k)
+          if (mine[k]) qualitySum_[v[k]] += 3.0 / kappa;
+        double hyperplane[5], w;
+        if (fieldHyperplane(v, hyperplane, w))
+          for (int k = 0; k < 4; ++k)
+            if (mine[k]) fieldQuadric_[v[k]].addSquare(hyperplane, w);
       }
-      for (int k = 0; k < 3; ++k) ds[k] = double(field_[v[k + 1]]) - field_[v[0]];
-      // Gradient g solves e·g = ds (Cramer's rule).
-      double det = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) - e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
-                   e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
-      if (!(std::abs(det) > 0)) continue;
-      double g[3];
-      for (int col = 0; col < 3; ++col) {
-        double m[3][3];
-        for (int r = 0; r < 3; ++r)
-          for (int k = 0; k < 3; ++k) m[r][k] = k == col ? ds[r] : e[r][k];
-        g[col] = (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
-                  m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])) / det;
-      }
-      double c = field_[v[0]] - (g[0] * p0[0] + g[1] * p0[1] + g[2] * p0[2]);
-      double w = std::abs(det) / 24.0;  // a quarter of the volume to each vertex
-      const double hyperplane[5] = {g[0], g[1], g[2], -1.0, c};
-      for (int k = 0; k < 4; ++k) fieldQuadric_[v[k]].addSquare(hyperplane, w);
+    };
+    if (opt_.threads > 1) {
+      std::thread second(sums, 1, V_ / 2, V_);
+      sums(0, 0, V_ / 2);
+      second.join();
+    } else {
+      sums(0, 0, V_);
     }
+    flatInput_ += flat[0] + flat[1];
     queued_.assign(V_, 0);
     changed_.assign(V_, 0);
     represented_.assign(V_, 1);
@@ -343,6 +348,36 @@ class Simplifier {
   static constexpr uint8_t kFaces[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
 
   const double* p(uint32_t v) const { return &pos_[3 * size_t(v)]; }
+
+  // The linear field s(x) = g·x + c of tet v (its four vertex values) as the hyperplane
+  // (g, −1, c) of the field quadric, with a quarter of the volume as weight (one quarter to each
+  // vertex). False for a flat tet, which defines no gradient.
+  bool fieldHyperplane(const uint32_t* v, double (&hyperplane)[5], double& w) const {
+    const double *p0 = p(v[0]), *p1 = p(v[1]), *p2 = p(v[2]), *p3 = p(v[3]);
+    double e[3][3], ds[3];
+    for (int k = 0; k < 3; ++k) {
+      e[0][k] = p1[k] - p0[k];
+      e[1][k] = p2[k] - p0[k];
+      e[2][k] = p3[k] - p0[k];
+    }
+    for (int k = 0; k < 3; ++k) ds[k] = double(field_[v[k + 1]]) - field_[v[0]];
+    // Gradient g solves e·g = ds (Cramer's rule).
+    double det = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) - e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+                 e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
+    if (!(std::abs(det) > 0)) return false;
+    double g[3];
+    for (int col = 0; col < 3; ++col) {
+      double m[3][3];
+      for (int r = 0; r < 3; ++r)
+        for (int k = 0; k < 3; ++k) m[r][k] = k == col ? ds[r] : e[r][k];
+      g[col] = (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])) / det;
+    }
+    const double c = field_[v[0]] - (g[0] * p0[0] + g[1] * p0[1] + g[2] * p0[2]);
+    w = std::abs(det) / 24.0;
+    hyperplane[0] = g[0], hyperplane[1] = g[1], hyperplane[2] = g[2], hyperplane[3] = -1.0, hyperplane[4] = c;
+    return true;
+  }
 
   float tetKappa(uint32_t t) const {
     const uint32_t* v = &out_.tets[4 * size_t(t)];
