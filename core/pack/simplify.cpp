@@ -297,13 +297,7 @@ class Simplifier {
             if (mine[k]) fieldQuadric_[v[k]].addSquare(hyperplane, w);
       }
     };
-    if (opt_.threads > 1) {
-      std::thread second(sums, 1, V_ / 2, V_);
-      sums(0, 0, V_ / 2);
-      second.join();
-    } else {
-      sums(0, 0, V_);
-    }
+    onBoth([&](int part) { sums(part, part ? V_ / 2 : 0, part ? V_ : V_ / 2); });
     flatInput_ += flat[0] + flat[1];
     queued_.assign(V_, 0);
     changed_.assign(V_, 0);
@@ -319,14 +313,22 @@ class Simplifier {
       for (uint32_t v = begin; v < end; ++v)
         if (out_.vertexAlive[v]) lastCost_[v] = bestCost(L, v);
     };
+    onBoth([&](int part) { work(lanes_[size_t(part)], part ? V_ / 2 : 0, part ? V_ : V_ / 2); });
+    for (uint32_t v = 0; v < V_; ++v) queued_[v] = lastCost_[v] < float(kInf);  // (run() queues them)
+  }
+
+  // Runs f(0) and f(1) at once on two threads, or one after the other with threads = 1. Neither
+  // may touch what the other writes, so the result is the same either way.
+  template <typename F>
+  void onBoth(F f) const {
     if (opt_.threads > 1) {
-      std::thread second(work, std::ref(lanes_[1]), V_ / 2, V_);
-      work(lanes_[0], 0, V_ / 2);
+      std::thread second(f, 1);
+      f(0);
       second.join();
     } else {
-      work(lanes_[0], 0, V_);
+      f(0);
+      f(1);
     }
-    for (uint32_t v = 0; v < V_; ++v) queued_[v] = lastCost_[v] < float(kInf);  // (run() queues them)
   }
 
   // Whether j's value is fitted after a collapse that leaves it standing for `count` input
@@ -1039,14 +1041,7 @@ class Simplifier {
         thread[t].push_back(s);
         W.lane = &lanes_[size_t(t)];
       }
-      if (opt_.threads > 1) {
-        std::thread second(work, 1);
-        work(0);
-        second.join();
-      } else {
-        work(0);
-        work(1);
-      }
+      onBoth(work);
       mergeRound(slabs);
       uint32_t collapsed = 0;
       for (uint32_t s = 0; s < slabs; ++s) {
@@ -1382,31 +1377,48 @@ class Simplifier {
       assert(it != cols.begin() + rowStart[r + 1] && *it == c);
       return a[size_t(it - cols.begin())];
     };
-    for (uint32_t v = 0; v < V_; ++v) {
+    // Every input vertex located in the coarse mesh (two threads, each a range of vertices),
+    // then its squared error added to the rows of the unknowns around it (two threads, each its
+    // own rows, taking the vertices in order: every sum is formed as on one thread).
+    struct Located {
       uint32_t t4[4];
       double w[4];
-      if (out_.vertexAlive[v]) {
-        t4[0] = v;
-        w[0] = 1;
-        for (int k = 1; k < 4; ++k) t4[k] = v, w[k] = 0;
-      } else if (star_[rep[v]].empty() || !locate(v, star_[rep[v]].front(), t4, w)) {
-        continue;  // (a vertex of no tet stands nowhere)
+      bool usable;  // inside the mesh, and a sample and neighbour values that are numbers
+    };
+    std::vector<Located> located(V_);
+    onBoth([&](int part) {
+      for (uint32_t v = part ? V_ / 2 : 0, end = part ? V_ : V_ / 2; v < end; ++v) {
+        Located& l = located[v];
+        l.usable = false;
+        if (out_.vertexAlive[v]) {
+          l.t4[0] = v;
+          l.w[0] = 1;
+          for (int k = 1; k < 4; ++k) l.t4[k] = v, l.w[k] = 0;
+        } else if (star_[rep[v]].empty() || !locate(v, star_[rep[v]].front(), l.t4, l.w)) {
+          continue;  // (a vertex of no tet stands nowhere)
+        }
+        l.usable = std::isfinite(field_[v]);  // a NaN or infinite sample (or neighbour value) fits nothing
+        for (int x = 0; x < 4; ++x) l.usable = l.usable && (l.w[x] == 0 || std::isfinite(fit_[l.t4[x]]));
       }
-      const double f = field_[v];
-      bool usable = std::isfinite(f);  // a NaN or infinite sample (or neighbour value) fits nothing
-      for (int x = 0; x < 4; ++x) usable = usable && (w[x] == 0 || std::isfinite(fit_[t4[x]]));
-      if (!usable) continue;
-      for (int x = 0; x < 4; ++x) {
-        const uint32_t r = col[t4[x]];
-        if (r == none || w[x] == 0) continue;
-        rhs[r] += w[x] * f;
-        for (int y = 0; y < 4; ++y) {
-          if (w[y] == 0) continue;
-          if (col[t4[y]] == none) rhs[r] -= w[x] * w[y] * fit_[t4[y]];  // a fixed value
-          else at(r, col[t4[y]]) += w[x] * w[y];
+    });
+    onBoth([&](int part) {
+      const uint32_t lo = part ? n / 2 : 0, hi = part ? n : n / 2;
+      for (uint32_t v = 0; v < V_; ++v) {
+        const Located& l = located[v];
+        if (!l.usable) continue;
+        const double f = field_[v];
+        for (int x = 0; x < 4; ++x) {
+          const uint32_t r = col[l.t4[x]];
+          if (r == none || r < lo || r >= hi || l.w[x] == 0) continue;
+          rhs[r] += l.w[x] * f;
+          for (int y = 0; y < 4; ++y) {
+            if (l.w[y] == 0) continue;
+            if (col[l.t4[y]] == none) rhs[r] -= l.w[x] * l.w[y] * fit_[l.t4[y]];  // a fixed value
+            else at(r, col[l.t4[y]]) += l.w[x] * l.w[y];
+          }
         }
       }
-    }
+    });
     // Conjugate gradients with a Jacobi preconditioner, from the values the collapses fitted.
     // The values must stay inside the field's range (the stream's grid covers just that): one
     // that ends up outside is held at the bound it crossed and the others are solved again.
