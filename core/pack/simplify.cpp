@@ -20,7 +20,6 @@
 #include <cassert>
 #include <cmath>
 #include <cstdlib>
-#include <deque>
 #include <queue>
 #include <thread>
 #include <atomic>
@@ -185,19 +184,19 @@ class Simplifier {
     }
     if (W.errorBound) out_.stopReason = "error bound reached";
     if (opt_.progress) opt_.progress(out_.log.size(), planned);
-    std::vector<const Worker*> workers{&main_};
-    for (const Worker& w : parts_) workers.push_back(&w);
-    for (const Worker* w : workers) {
-      out_.queuePops += w->pops;
-      out_.requeued += w->requeued;
-      out_.rejectedByLink += w->rejectedByLink;
-      out_.flatTetsRemoved += w->flatTetsRemoved;
-      out_.linkMismatches += w->linkMismatches;
-    }
+    auto count = [&](const Worker& w) {
+      out_.queuePops += w.pops;
+      out_.requeued += w.requeued;
+      out_.rejectedByLink += w.rejectedByLink;
+      out_.flatTetsRemoved += w.flatTetsRemoved;
+      out_.linkMismatches += w.linkMismatches;
+    };
+    count(main_);
+    for (const Worker& w : parts_) count(w);
     alive_ -= W.collapsed;
     tetsAlive_ -= W.tetsRemoved;
     out_.vertices = alive_;
-    for (const Lane* L : {&mainLane_}) out_.costEvaluations += L->evaluations;
+    out_.costEvaluations += mainLane_.evaluations;
     for (const Lane& L : lanes_) out_.costEvaluations += L.evaluations;
     out_.tetCount = 0;
     for (uint32_t t = 0; t < T_; ++t) {
@@ -500,15 +499,15 @@ class Simplifier {
 
   using Heap = std::priority_queue<Entry, std::vector<Entry>, EntryAfter>;
 
-  // What the collapse loop works with: the queue of the whole mesh, or of one block in the
+  // What the collapse loop works with: the queue of the whole mesh, or of one slab in the
   // parallel phase (runParts), with its own log and scratch.
   struct Worker {
-    int part = -1;          // -1: the whole mesh; else the block
+    int part = -1;          // -1: the whole mesh; else the slab
     Heap heap;
-    CollapseLog ownLog;     // a block's collapses in this round (merged into out_.log after it)
+    CollapseLog ownLog;     // a slab's collapses in this round (merged into out_.log after it)
     CollapseLog* log = &ownLog;
-    std::vector<float> keys;  // a block's collapses: the queue key each was taken at
-    Lane* lane = nullptr;   // link condition and collapse (and a block's evaluations): its thread's
+    std::vector<float> keys;  // a slab's collapses: the queue key each was taken at
+    Lane* lane = nullptr;   // link condition and collapse (and a slab's evaluations): its thread's
     std::atomic<uint32_t> collapsed{0};  // (read by the progress report on the other thread)
     uint32_t tetsRemoved = 0;
     uint64_t pops = 0, requeued = 0, rejectedByLink = 0, flatTetsRemoved = 0, linkMismatches = 0;
@@ -960,7 +959,7 @@ class Simplifier {
         order = candidate;
       }
     }
-    for (uint32_t s = 0; s < kMaxSlabs; ++s) parts_.emplace_back().part = int(s);
+    for (uint32_t s = 0; s < kMaxSlabs; ++s) parts_[s].part = int(s);
     // The log sized up front (a log grown by doubling holds up to twice its size): a collapse
     // removes about (T − target tets) / planned tets and moves the rest of a star of 4T/V tets.
     const double removedEach = double(tetsAlive_ - std::min<uint32_t>(tetsAlive_, opt_.targetTets)) / std::max(1u, planned);
@@ -1633,9 +1632,9 @@ class Simplifier {
   std::vector<uint32_t> changed_;  // per vertex: roundStamp_ of the last round that touched it
   uint32_t roundStamp_ = 0;
   Worker main_;     // the one queue of the whole mesh (its log is out_.log)
-  std::deque<Worker> parts_;  // the blocks of the parallel phase (a deque: a Worker does not move)
+  Worker parts_[kMaxSlabs];  // the slabs of the parallel phase
   float slack_ = 1.0f;  // see tryCollapse
-  std::vector<uint8_t> inner_;  // per vertex: every neighbour is on its side of the cut (runParts)
+  std::vector<uint8_t> inner_;  // per vertex: every neighbour is in its slab (runParts)
 };
 
 }  // namespace

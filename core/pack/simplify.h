@@ -40,8 +40,9 @@
 // collapsing only vertices whose whole neighbourhood is its own, so the two threads touch
 // disjoint data. Rounds of rising cost alternate between two slabs cut at the median and three
 // cut at the quartiles, so no vertex waits along a cut for long; each round's logs are merged by
-// cost, and the one queue of the whole mesh then takes the last collapses. On such meshes a vertex whose cost
-// rose by at most 10% since it was queued is collapsed without going back into the queue.
+// cost, and the one queue of the whole mesh then takes the last collapses. On such meshes a
+// vertex whose cost rose by at most 10% since it was queued is collapsed without going back into
+// the queue.
 //
 // The result is a log of collapses for the encoder (split_encode.h); the simplifier knows
 // nothing of the file format. Deterministic: same input and options, same log, whatever the

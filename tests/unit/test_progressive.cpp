@@ -545,7 +545,18 @@ TetMesh coarseMesh(const TetMesh& in, const SimplifyResult& r) {
   return m;
 }
 
-// The halves' logs are merged into one: every prefix must still be a valid mesh, the last level
+// `m` simplified to `target` vertices with the parallel phase (forced, whatever the mesh's size)
+// and with one queue for the whole mesh.
+void simplifyInSlabsAndWhole(const TetMesh& m, uint32_t target, SimplifyResult& slabs, SimplifyResult& whole) {
+  SimplifyOptions so;
+  so.targetVertices = target;
+  so.partitionMinVertices = 0;
+  ASSERT_TRUE(simplifyMesh(m, so, slabs));
+  so.partitionMinVertices = ~0u;
+  ASSERT_TRUE(simplifyMesh(m, so, whole));
+}
+
+// The slabs' logs are merged into one: every prefix must still be a valid mesh, the last level
 // the input, and the coarse field no worse than with one queue for the whole mesh.
 TEST(Progressive, HalvesGiveValidLevelsAndTheSameQuality) {
   TetMesh m = harmonic(20);
@@ -553,12 +564,7 @@ TEST(Progressive, HalvesGiveValidLevelsAndTheSameQuality) {
   o.partitionMinVertices = 0;
   roundTrip("halves", m, o);
   SimplifyResult halves, whole;
-  SimplifyOptions so;
-  so.targetVertices = 200;
-  so.partitionMinVertices = 0;
-  ASSERT_TRUE(simplifyMesh(m, so, halves));
-  so.partitionMinVertices = ~0u;
-  ASSERT_TRUE(simplifyMesh(m, so, whole));
+  simplifyInSlabsAndWhole(m, 200, halves, whole);
   EXPECT_EQ(whole.halvesCollapses, 0u);
   const double a = fieldRms(m, coarseMesh(m, halves), 0), b = fieldRms(m, coarseMesh(m, whole), 0);
   std::printf("field RMS at 200 vertices: halves %.6f, one queue %.6f\n", a, b);
@@ -593,12 +599,7 @@ TEST(Progressive, LevelsOfTheParallelPhaseHaveNoSlabAlongACut) {
   const uint32_t n = 20;
   TetMesh m = harmonic(n);
   SimplifyResult blocks, whole;
-  SimplifyOptions so;
-  so.targetVertices = 100;
-  so.partitionMinVertices = 0;
-  ASSERT_TRUE(simplifyMesh(m, so, blocks));
-  so.partitionMinVertices = ~0u;
-  ASSERT_TRUE(simplifyMesh(m, so, whole));
+  simplifyInSlabsAndWhole(m, 100, blocks, whole);
   EXPECT_GT(blocks.halvesCollapses, blocks.log.size() * 8 / 10);
   for (double share : {0.08, 0.15, 0.3}) {
     const uint32_t alive = uint32_t(share * m.vertexCount());
