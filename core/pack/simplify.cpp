@@ -437,6 +437,7 @@ class Simplifier {
     std::vector<StarTet> star;
     double flatBound = 0;  // see prepareStar
     double qualityFloor = 0;  // the least 3/κ a changed tet may have (see prepareStar)
+    uint64_t boundaryEdges = 0;  // bitOf() the neighbours joined to the vertex by a boundary edge
     double removedQuality = 0;  // of the last legal() candidate: Σ 3/κ of the tets it removes
     int removed = 0;            // ... and their count
     std::vector<uint32_t> nbr;
@@ -527,9 +528,15 @@ class Simplifier {
     // threshold of the longest possible edge bounds every tet's own threshold from above.
     double lo[3] = {pi[0], pi[1], pi[2]}, hi[3] = {pi[0], pi[1], pi[2]};
     float worstKappa = 0;
+    L.boundaryEdges = 0;
     for (size_t n = 0; n < star.size(); ++n) {
       const uint32_t t = star[n];
       const uint32_t* v = &out_.tets[4 * size_t(t)];
+      if (boundary_[i])  // the boundary faces at i give its boundary edges (see legal())
+        for (int f = 0; f < 4; ++f)
+          if (v[f] != i && opp_[4 * size_t(t) + f] == kNoNeighbor)
+            for (int k = 0; k < 4; ++k)
+              if (k != f && v[k] != i) L.boundaryEdges |= bitOf(L.place[v[k]]);
       StarTet& st = L.star[n];
       st.t = t;
       st.mask = 0;
@@ -618,7 +625,8 @@ class Simplifier {
   bool legal(Lane& L, uint32_t i, uint32_t j, uint64_t bit, CollapseVerdict* verdict) {
     ++L.evaluations;
     *verdict = CollapseVerdict::Legal;
-    if (boundary_[i] && !isBoundaryEdge(i, j)) return *verdict = CollapseVerdict::BoundaryRule, false;
+    if (boundary_[i] && !(bit ? (L.boundaryEdges & bit) != 0 : isBoundaryEdge(i, j)))
+      return *verdict = CollapseVerdict::BoundaryRule, false;
     const double* P = p(j);
     L.removedQuality = 0;  // Σ 3/κ of the tets the collapse removes, and their count
     L.removed = 0;
@@ -811,6 +819,12 @@ class Simplifier {
     }
   }
 
+  // Asks for the tets around v, which neighbours(v) reads first: called for the vertex likely
+  // to be evaluated next, while the current one is.
+  void prefetchStar(uint32_t v) const {
+    for (uint32_t t : star_[v]) __builtin_prefetch(&out_.tets[4 * size_t(t)]);
+  }
+
   // The cost of v's cheapest legal out-edge (infinity when it has none).
   float bestCost(Lane& L, uint32_t v) {
     neighbours(L, v, L.nbr);
@@ -984,6 +998,7 @@ class Simplifier {
                e.cost <= tau) {
           W.heap.pop();
           queued_[e.vertex] = 0;
+          if (!W.heap.empty()) prefetchStar(W.heap.top().vertex);
           evaluateVertex(*W.lane, e.vertex);
           tryCollapse(W, e.vertex, *W.lane, peekValid(W.heap, top) ? top.cost : float(kInf));
           if (t == 0 && opt_.progress && (W.collapsed & 4095) == 0) {

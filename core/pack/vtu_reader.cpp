@@ -70,6 +70,15 @@ class ByteSource {
     return true;
   }
 
+  // The next n bytes where they are, for a raw source that holds them (no copy); else null,
+  // and read() copies them.
+  const uint8_t* inPlace(size_t n) {
+    if (b64_ || data_.size() - pos_ < n) return nullptr;
+    const uint8_t* at = reinterpret_cast<const uint8_t*>(data_.data()) + pos_;
+    pos_ += n;
+    return at;
+  }
+
   const std::string& error() const { return error_; }
 
  private:
@@ -159,10 +168,11 @@ bool readHeaderWord(const Vtu& vtu, ByteSource& src, uint64_t& out) {
   return true;
 }
 
-// Reads one binary payload (header + data, compressed or not) into `bytes`: exactly
-// expectedBytes bytes, still in the file's byte order.
+// Reads one binary payload (header + data, compressed or not): exactly expectedBytes bytes at
+// `data`, still in the file's byte order. Raw appended data stays where it is in the file's
+// bytes (a large mesh's arrays were copied once more for nothing); the rest goes to `bytes`.
 Result readPayload(const Vtu& vtu, ByteSource& src, const ArrayRef& ref, uint64_t expectedBytes,
-                   std::vector<uint8_t>& bytes) {
+                   std::vector<uint8_t>& bytes, const uint8_t*& data) {
   auto srcError = [&](const char* stage) {
     Status s = src.error().find("invalid") != std::string::npos || src.error().find("padding") != std::string::npos
                    ? Status::Corrupt
@@ -181,8 +191,10 @@ Result readPayload(const Vtu& vtu, ByteSource& src, const ArrayRef& ref, uint64_
     if (n > src.available())
       return fail(Status::Truncated, ref.str() + ": needs " + std::to_string(n) + " bytes, at most " +
                                          std::to_string(src.available()) + " remain");
+    if ((data = src.inPlace(n))) return Result::success();
     bytes.resize(n);
     if (!src.read(bytes.data(), n)) return srcError("reading the data");
+    data = bytes.data();
     return Result::success();
   }
 
@@ -248,6 +260,7 @@ Result readPayload(const Vtu& vtu, ByteSource& src, const ArrayRef& ref, uint64_
     }
     at += usize;
   }
+  data = bytes.data();
   return Result::success();
 }
 
@@ -337,14 +350,15 @@ Result readDataArray(Vtu& vtu, pugi::xml_node da, const ArrayRef& ref, uint64_t 
   }
 
   std::vector<uint8_t> bytes;
-  if (Result r = readPayload(vtu, src, ref, expectedBytes, bytes); !r) return r;
+  const uint8_t* data = nullptr;
+  if (Result r = readPayload(vtu, src, ref, expectedBytes, bytes, data); !r) return r;
   out.resize(expectedValues);
   if constexpr (wantInts) {
-    size_t ok = decodeInts(bytes.data(), expectedValues, type, vtu.bigEndian, out.data());
+    size_t ok = decodeInts(data, expectedValues, type, vtu.bigEndian, out.data());
     if (ok != expectedValues)
       return fail(Status::OutOfRange, ref.str() + ": value " + std::to_string(ok) + " exceeds the Int64 range");
   } else {
-    decodeDoubles(bytes.data(), expectedValues, type, vtu.bigEndian, out.data());
+    decodeDoubles(data, expectedValues, type, vtu.bigEndian, out.data());
   }
   return Result::success();
 }
