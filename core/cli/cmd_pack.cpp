@@ -161,7 +161,7 @@ Runner addPack(CLI::App& app) {
                  {"baseFieldError", m.chunks[0].fieldError}, {"baseFieldRms", m.chunks[0].fieldRms},
                  {"baseFieldMax", m.chunks[0].fieldMax}, {"stopReason", s.stopReason},
                  {"flatTetsRemoved", s.flatTetsRemoved}, {"flatTetsLeft", s.flatTetsLeft},
-                 {"queuePops", s.queuePops}, {"halvesCollapses", s.halvesCollapses}, {"requeued", s.requeued}, {"costEvaluations", s.costEvaluations},
+                 {"queuePops", s.queuePops}, {"slabCollapses", s.slabCollapses}, {"requeued", s.requeued}, {"costEvaluations", s.costEvaluations},
                  {"readMs", readMs}, {"prepareMs", s.prepareMs}, {"simplifyMs", s.simplifyMs}, {"encodeMs", s.encodeMs}, {"writeMs", s.writeMs},
                  {"ms", total.ms()}, {"peakMemoryMB", peakMemoryMB()}, {"notes", notes}});
       return 0;

@@ -186,7 +186,7 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   summary.flatTetsRemoved = simplified.flatTetsRemoved;
   summary.flatTetsLeft = simplified.flatTetsLeft;
   summary.queuePops = simplified.queuePops;
-  summary.halvesCollapses = simplified.halvesCollapses;
+  summary.slabCollapses = simplified.slabCollapses;
   summary.requeued = simplified.requeued;
   summary.costEvaluations = simplified.costEvaluations;
 

@@ -41,7 +41,7 @@ struct PackSummary {
   uint32_t baseVertices = 0, baseTets = 0, splits = 0;
   uint32_t flatTetsRemoved = 0, flatTetsLeft = 0;
   uint64_t queuePops = 0, requeued = 0, costEvaluations = 0;  // simplifier work, for benchmarks
-  uint32_t halvesCollapses = 0;      // of the collapses, those made in slabs at once (the parallel phase)
+  uint32_t slabCollapses = 0;      // of the collapses, those made in slabs at once (the parallel phase)
   std::string stopReason;            // why simplification stopped
   double prepareMs = 0, simplifyMs = 0, encodeMs = 0, writeMs = 0;  // prepare: checks, orientation, grid
   std::vector<std::string> notes;    // what the packer changed or found, in plain words

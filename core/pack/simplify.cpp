@@ -13,7 +13,8 @@
 // queued meanwhile comes first; otherwise the entry goes back. The result is therefore exactly
 // that of the one-thread loop, whatever the timing (tests compare the two).
 //
-// Before that, a large mesh is simplified in two halves at once, one thread each (runParts).
+// Before that, a large mesh is simplified in slabs, one thread each, in rounds of rising cost
+// (runParts).
 #include "simplify.h"
 
 #include <algorithm>
@@ -1066,7 +1067,7 @@ class Simplifier {
       idle = collapsed ? 0 : idle + 1;
     }
     // What is left in the slabs' queues stays marked queued_ for the whole mesh's queue.
-    out_.halvesCollapses += collapsedAll;
+    out_.slabCollapses += collapsedAll;
     alive_ -= collapsedAll;
     tetsAlive_ -= removedAll;
     for (Worker& W : parts_) {

@@ -115,7 +115,7 @@ struct SimplifyResult {
   uint32_t flatTetsLeft = 0;
   uint64_t costEvaluations = 0, rejectedByLink = 0;
   uint64_t queuePops = 0, requeued = 0;  // pops of current entries, and those pushed back costlier
-  uint32_t halvesCollapses = 0;          // collapses made in the slabs at once (partitionMinVertices)
+  uint32_t slabCollapses = 0;          // collapses made in the slabs at once (partitionMinVertices)
   uint64_t linkMismatches = 0;           // with verifyLinkCondition: fast and reference disagreed
   std::string stopReason;          // "target reached", "no legal collapse left", "error bound"
 };

@@ -271,12 +271,12 @@ TEST(Progressive, TwoThreadsCollapseExactlyAsOne) {
   o.parallelMinVertices = 0;
   expectSameOnOneThreadAndTwo(harmonic(14), o, one, two);
   EXPECT_GT(one.log.size(), 2500u);
-  EXPECT_EQ(one.halvesCollapses, 0u);
+  EXPECT_EQ(one.slabCollapses, 0u);
 }
 
-// Large meshes are simplified in two halves at once for most of the way: each half's collapses
-// depend on nothing the other does, so one thread gives exactly the result of two.
-TEST(Progressive, HalvesCollapseTheSameOnOneThreadAndTwo) {
+// Large meshes are simplified in slabs for most of the way: each slab's collapses depend on
+// nothing another does, so one thread gives exactly the result of two.
+TEST(Progressive, SlabsCollapseTheSameOnOneThreadAndTwo) {
   SimplifyResult one, two;
   SimplifyOptions o;
   o.targetVertices = 100;
@@ -284,8 +284,8 @@ TEST(Progressive, HalvesCollapseTheSameOnOneThreadAndTwo) {
   o.verifyLinkCondition = true;  // (and the fast link check agrees with the reference throughout)
   expectSameOnOneThreadAndTwo(harmonic(20), o, one, two);
   EXPECT_EQ(one.linkMismatches, 0u);
-  EXPECT_GT(one.halvesCollapses, one.log.size() * 8 / 10);
-  EXPECT_EQ(one.halvesCollapses, two.halvesCollapses);
+  EXPECT_GT(one.slabCollapses, one.log.size() * 8 / 10);
+  EXPECT_EQ(one.slabCollapses, two.slabCollapses);
 }
 
 // The star pool against plain vectors: stars that grow through many block sizes, removals,
@@ -558,16 +558,16 @@ void simplifyInSlabsAndWhole(const TetMesh& m, uint32_t target, SimplifyResult& 
 
 // The slabs' logs are merged into one: every prefix must still be a valid mesh, the last level
 // the input, and the coarse field no worse than with one queue for the whole mesh.
-TEST(Progressive, HalvesGiveValidLevelsAndTheSameQuality) {
+TEST(Progressive, SlabsGiveValidLevelsAndTheSameQuality) {
   TetMesh m = harmonic(20);
   PackOptions o;
   o.partitionMinVertices = 0;
-  roundTrip("halves", m, o);
-  SimplifyResult halves, whole;
-  simplifyInSlabsAndWhole(m, 200, halves, whole);
-  EXPECT_EQ(whole.halvesCollapses, 0u);
-  const double a = fieldRms(m, coarseMesh(m, halves), 0), b = fieldRms(m, coarseMesh(m, whole), 0);
-  std::printf("field RMS at 200 vertices: halves %.6f, one queue %.6f\n", a, b);
+  roundTrip("slabs", m, o);
+  SimplifyResult slabs, whole;
+  simplifyInSlabsAndWhole(m, 200, slabs, whole);
+  EXPECT_EQ(whole.slabCollapses, 0u);
+  const double a = fieldRms(m, coarseMesh(m, slabs), 0), b = fieldRms(m, coarseMesh(m, whole), 0);
+  std::printf("field RMS at 200 vertices: slabs %.6f, one queue %.6f\n", a, b);
   EXPECT_LT(a, 1.05 * b);
 }
 
@@ -598,12 +598,12 @@ double busiestLayerPair(uint32_t n, const SimplifyResult& r, uint32_t alive) {
 TEST(Progressive, LevelsOfTheParallelPhaseHaveNoSlabAlongACut) {
   const uint32_t n = 20;
   TetMesh m = harmonic(n);
-  SimplifyResult blocks, whole;
-  simplifyInSlabsAndWhole(m, 100, blocks, whole);
-  EXPECT_GT(blocks.halvesCollapses, blocks.log.size() * 8 / 10);
+  SimplifyResult slabs, whole;
+  simplifyInSlabsAndWhole(m, 100, slabs, whole);
+  EXPECT_GT(slabs.slabCollapses, slabs.log.size() * 8 / 10);
   for (double share : {0.08, 0.15, 0.3}) {
     const uint32_t alive = uint32_t(share * m.vertexCount());
-    const double a = busiestLayerPair(n, blocks, alive), b = busiestLayerPair(n, whole, alive);
+    const double a = busiestLayerPair(n, slabs, alive), b = busiestLayerPair(n, whole, alive);
     std::printf("%u vertices left: busiest pair of layers holds %.3f (one queue: %.3f)\n", alive, a, b);
     EXPECT_LT(a, 1.3 * b) << alive << " vertices left";
   }
