@@ -52,7 +52,7 @@ Result openDataset(Dataset& ds, std::string_view manifestJson) {
   ds.bytesReceived = 0;
   ds.payloads.clear();
   ds.chunkFirstSplit.clear();
-  ds.recordStart.assign(1, 0);
+  ds.recordStart.assign(kSplitColumns, 0);
   ds.splitsDecoded = 0;
   return Result::success();
 }
@@ -90,7 +90,7 @@ void dropChunksFrom(Dataset& ds, uint32_t chunk) {
   ds.bytesReceived = 0;
   for (uint32_t c = 0; c < chunk; ++c) ds.bytesReceived += ds.manifest.chunks[c].bytes;
   ds.splitsDecoded = std::min(ds.splitsDecoded, ds.chunkFirstSplit.back());
-  ds.recordStart.resize(ds.splitsDecoded + 1);
+  ds.recordStart.resize(kSplitColumns * (size_t(ds.splitsDecoded) + 1));
 }
 
 // Applies split g = ds.splitsApplied() from its chunk's payload.
@@ -100,16 +100,19 @@ Result redoNext(Dataset& ds, std::vector<uint32_t>& changed) {
   while (ds.chunkFirstSplit[c + 1] <= g) ++c;
   const uint32_t first = ds.chunkFirstSplit[c], end = ds.chunkFirstSplit[c + 1];
   SplitReader& r = ds.reader;
-  r.in = ByteReader{ds.payloads[c], g == first ? 8 : ds.recordStart[g]};
-  r.remaining = end - g;
-  r.prevJ = g == first ? 0 : ds.pm.splitJ[g - 1];
-  r.lossless = ds.manifest.lossless;
-  Result res = applyNextSplit(r, ds.pm, ds.quant, changed);
+  // The chunk's header was checked when it was received: this only sets the cursors.
+  Result res = beginSplits(r, ds.payloads[c], ds.manifest.chunks[c], ds.manifest);
+  if (res && g != first) {
+    r.seek(&ds.recordStart[kSplitColumns * size_t(g)]);
+    r.remaining = end - g;
+    r.prevJ = ds.pm.splitJ[g - 1];
+  }
+  if (res) res = applyNextSplit(r, ds.pm, ds.quant, changed);
   if (res && g + 1 == end) {
     const ChunkInfo& info = ds.manifest.chunks[c];
     if (ds.pm.vertexCount() != info.vertices || ds.pm.tetCount() != info.tets)
       res = fail(Status::Corrupt, "split chunk: counts after the chunk differ from the manifest");
-    else if (!r.in.atEnd())
+    else if (!r.atEnd())
       res = fail(Status::Corrupt, "split chunk: bytes after the last split");
     if (!res) undoSplit(ds.pm, changed);
   }
@@ -120,8 +123,8 @@ Result redoNext(Dataset& ds, std::vector<uint32_t>& changed) {
     return res;
   }
   if (g == ds.splitsDecoded) {
-    ds.recordStart.push_back(uint32_t(r.in.pos));
-    ds.recordStart[g] = g == first ? 8 : ds.recordStart[g];
+    ds.recordStart.resize(kSplitColumns * (size_t(g) + 2));
+    r.tell(&ds.recordStart[kSplitColumns * (size_t(g) + 1)]);
     ++ds.splitsDecoded;
   }
   return res;

@@ -32,7 +32,7 @@ struct Dataset {
   uint64_t bytesReceived = 0;      // compressed bytes of the verified chunks
   std::vector<std::vector<uint8_t>> payloads;  // per received chunk: split records (empty for the base)
   std::vector<uint32_t> chunkFirstSplit;       // per received chunk, plus one past the last
-  std::vector<uint32_t> recordStart;           // payload offset of every split decoded so far, plus the next
+  std::vector<uint32_t> recordStart;           // per split decoded so far, plus the next: where its record starts in each column (SplitReader::tell)
   uint32_t splitsDecoded = 0;                  // splits read at least once (the frontier)
   SplitReader reader;                          // scratch
 

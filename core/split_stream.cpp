@@ -11,14 +11,45 @@ Result corrupt(const std::string& what) { return fail(Status::Corrupt, "split ch
 
 }  // namespace
 
+void SplitReader::tell(uint32_t* offsets) const {
+  for (uint32_t k = 0; k < kSplitColumns; ++k) offsets[k] = uint32_t(in[k].pos);
+}
+
+void SplitReader::seek(const uint32_t* offsets) {
+  for (uint32_t k = 0; k < kSplitColumns; ++k) in[k].pos = offsets[k];
+}
+
+bool SplitReader::atEnd() const {
+  for (const ByteReader& c : in)
+    if (!c.atEnd()) return false;
+  return true;
+}
+
 Result beginSplits(SplitReader& r, std::span<const uint8_t> payload, const ChunkInfo& info, const Manifest& m) {
-  r.in = ByteReader{payload, 0};
+  ByteReader header{payload, 0};
   uint32_t count = 0, flags = 0;
-  if (!r.in.u32(count) || !r.in.u32(flags)) return fail(Status::Truncated, "split chunk: payload shorter than its header");
+  if (!header.u32(count) || !header.u32(flags)) return fail(Status::Truncated, "split chunk: payload shorter than its header");
   if (count != info.splits)
     return corrupt(std::to_string(count) + " splits where the manifest says " + std::to_string(info.splits));
-  if (flags & ~(kSplitFlagLossless | kSplitFlagKeptValues | kSplitFlagKeptIsoValue))
+  if (flags & ~(kSplitFlagLossless | kSplitFlagKeptValues | kSplitFlagKeptIsoValue | kSplitFlagColumns))
     return fail(Status::Unsupported, "split chunk: unknown flags");
+  r.columns = flags & kSplitFlagColumns;
+  for (ByteReader& c : r.in) c = ByteReader{};
+  if (r.columns) {
+    // The columns' byte lengths, then the columns, which must fill the payload exactly.
+    uint32_t length[kSplitColumns];
+    for (uint32_t& n : length)
+      if (!header.u32(n)) return fail(Status::Truncated, "split chunk: payload shorter than its header");
+    size_t at = header.pos;
+    for (uint32_t k = 0; k < kSplitColumns; ++k) {
+      if (length[k] > payload.size() - at) return fail(Status::Truncated, "split chunk: a column runs past the payload end");
+      r.in[k] = ByteReader{payload.subspan(at, length[k]), 0};
+      at += length[k];
+    }
+    if (at != payload.size()) return corrupt("bytes after the last column");
+  } else {
+    r.in[0] = ByteReader{payload.subspan(header.pos), 0};
+  }
   if ((flags & kSplitFlagKeptValues) && (flags & kSplitFlagKeptIsoValue)) return corrupt("both kinds of kept values flagged");
   r.lossless = flags & kSplitFlagLossless;
   r.keptFirst = r.keptCount = 0;
@@ -40,7 +71,7 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
   if (r.remaining == 0) return corrupt("no split left in the chunk");
   const uint32_t V = pm.vertexCount(), i = V;
   uint32_t u;
-  if (!r.in.varint(u)) return fail(Status::Truncated, "split chunk: record ends early");
+  if (!r.column(SplitColumn::KeptVertex).varint(u)) return fail(Status::Truncated, "split chunk: record ends early");
   const int64_t j64 = int64_t(r.prevJ) + unzigzag(u);
   if (j64 < 0 || j64 >= V) return fail(Status::OutOfRange, "split chunk: kept vertex " + std::to_string(j64) + " does not exist");
   const uint32_t j = uint32_t(j64);
@@ -48,7 +79,7 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
   // T_moved: a bit per tet around j, in ascending tet order.
   starOf(pm, j, r.star);
   const uint8_t* mask;
-  if (!r.in.bytes((r.star.size() + 7) / 8, mask)) return fail(Status::Truncated, "split chunk: record ends early");
+  if (!r.column(SplitColumn::Moved).bytes((r.star.size() + 7) / 8, mask)) return fail(Status::Truncated, "split chunk: record ends early");
   r.moved.clear();
   for (size_t k = 0; k < r.star.size(); ++k)
     if (mask[k >> 3] >> (k & 7) & 1) r.moved.push_back(r.star[k]);
@@ -58,15 +89,16 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
   // for an explicit vertex id; listed as pairs or as the chain of the edge's link.
   neighboursOf(pm, j, r.candidates);
   uint32_t header;
-  if (!r.in.varint(header)) return fail(Status::Truncated, "split chunk: record ends early");
+  if (!r.column(SplitColumn::NewTetCount).varint(header)) return fail(Status::Truncated, "split chunk: record ends early");
   const uint32_t m = header >> 2, mode = header & 3;
   if (m > kMaxNewTetsPerSplit) return corrupt(std::to_string(m) + " new tets in one split");
   if (mode > uint32_t(RingMode::Path)) return corrupt("unknown new-tet list mode");
   r.newTets.clear();
   const uint32_t nc = uint32_t(r.candidates.size());
+  ByteReader& tetsIn = r.column(SplitColumn::NewTets);
   auto read = [&](uint32_t& v) {
     uint32_t x;
-    if (!r.in.varint(x)) return false;
+    if (!tetsIn.varint(x)) return false;
     v = x < nc ? r.candidates[x] : x - nc;
     return true;
   };
@@ -103,19 +135,21 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
   if (r.keptFirst + r.keptCount > F) return corrupt("kept values of a field the mesh does not have");
   if (pm.keptFixed && (pm.keptFirst != r.keptFirst || pm.keptCount != r.keptCount))
     return corrupt("kept values of other fields than the dataset's earlier splits");
+  ByteReader& positionIn = r.column(SplitColumn::Position);
+  ByteReader& valuesIn = r.column(SplitColumn::Values);
   if (r.lossless) {
     for (float& x : position)
-      if (!r.in.f32(x)) return fail(Status::Truncated, "split chunk: record ends early");
+      if (!positionIn.f32(x)) return fail(Status::Truncated, "split chunk: record ends early");
     for (float& x : r.fields)
-      if (!r.in.f32(x)) return fail(Status::Truncated, "split chunk: record ends early");
+      if (!valuesIn.f32(x)) return fail(Status::Truncated, "split chunk: record ends early");
     for (float& x : r.jFields)
-      if (!r.in.f32(x)) return fail(Status::Truncated, "split chunk: record ends early");
+      if (!valuesIn.f32(x)) return fail(Status::Truncated, "split chunk: record ends early");
     for (float x : position)
       if (!std::isfinite(x)) return fail(Status::NonFinite, "split chunk: a vertex position is not finite");
   } else {
-    auto predicted = [&](const QuantAxis& axis, float base, float& out) {
+    auto predicted = [&](ByteReader& in, const QuantAxis& axis, float base, float& out) {
       uint32_t d;
-      if (!r.in.varint(d)) return false;
+      if (!in.varint(d)) return false;
       int64_t qv = int64_t(axis.quantize(base)) + unzigzag(d);
       if (qv < 0 || qv > int64_t(axis.maxQ)) return false;
       out = axis.dequantize(uint32_t(qv));
@@ -123,15 +157,15 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
     };
     const float* pj = &pm.mesh.positions[3 * size_t(j)];
     for (int k = 0; k < 3; ++k)
-      if (!predicted(q.position[k], pj[k], position[k])) return corrupt("a position leaves the grid or the record ends early");
+      if (!predicted(positionIn, q.position[k], pj[k], position[k])) return corrupt("a position leaves the grid or the record ends early");
     for (size_t f = 0; f < F; ++f)
-      if (!predicted(q.field[f], pm.mesh.fields[f].values[j], r.fields[f])) return corrupt("a field value leaves its range or the record ends early");
+      if (!predicted(valuesIn, q.field[f], pm.mesh.fields[f].values[j], r.fields[f])) return corrupt("a field value leaves its range or the record ends early");
     for (uint32_t k = 0; k < r.keptCount; ++k) {
       const size_t f = r.keptFirst + k;
-      if (!predicted(q.field[f], pm.mesh.fields[f].values[j], r.jFields[k])) return corrupt("a field value leaves its range or the record ends early");
+      if (!predicted(valuesIn, q.field[f], pm.mesh.fields[f].values[j], r.jFields[k])) return corrupt("a field value leaves its range or the record ends early");
     }
   }
-  if (r.remaining == 1 && !r.in.atEnd()) return corrupt("bytes after the last split");
+  if (r.remaining == 1 && !r.atEnd()) return corrupt("bytes after the last split");
 
   pm.keptFirst = r.keptFirst;
   pm.keptCount = r.keptCount;
@@ -145,7 +179,7 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
 
 Result endSplits(const SplitReader& r) {
   if (r.remaining != 0) return corrupt(std::to_string(r.remaining) + " splits not applied");
-  if (!r.in.atEnd()) return corrupt("bytes after the last split");
+  if (!r.atEnd()) return corrupt("bytes after the last split");
   return Result::success();
 }
 

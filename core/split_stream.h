@@ -20,6 +20,14 @@ inline constexpr uint32_t kSplitFlagLossless = 1;
 // (bit 2). Never both.
 inline constexpr uint32_t kSplitFlagKeptValues = 2;
 inline constexpr uint32_t kSplitFlagKeptIsoValue = 4;
+// The records' fields are stored column by column (FORMAT.md §4): all kept-vertex deltas, then
+// all moved masks, and so on. zstd's entropy stage codes each block with one table, so a column
+// of one kind of number compresses far better than records that interleave six kinds.
+inline constexpr uint32_t kSplitFlagColumns = 8;
+
+// The fields of a split record, in record order; with kSplitFlagColumns each is a column.
+enum class SplitColumn : uint32_t { KeptVertex, Moved, NewTetCount, NewTets, Position, Values };
+inline constexpr uint32_t kSplitColumns = 6;
 
 // How a split record lists its recreated tets (i, j, a, b) (FORMAT.md §4).
 enum class RingMode : uint32_t {
@@ -30,7 +38,9 @@ enum class RingMode : uint32_t {
 inline constexpr uint32_t kMaxNewTetsPerSplit = 4096;
 
 struct SplitReader {
-  ByteReader in;
+  // One cursor per column; records in one row (no kSplitFlagColumns) use in[0] for every field.
+  ByteReader in[kSplitColumns];
+  bool columns = false;
   uint32_t remaining = 0;  // records left in the chunk
   uint32_t prevJ = 0;
   bool lossless = false;
@@ -39,10 +49,16 @@ struct SplitReader {
   // scratch, reused across records
   std::vector<uint32_t> star, candidates, moved, newTets, ring;
   std::vector<float> fields, jFields;  // jFields: keptCount values
+
+  ByteReader& column(SplitColumn c) { return in[columns ? uint32_t(c) : 0]; }
+  // Where the next record starts (one offset per column), and going back there.
+  void tell(uint32_t* offsets) const;
+  void seek(const uint32_t* offsets);
+  bool atEnd() const;
 };
 
-// Starts reading a split chunk's payload (after the chunk header). The payload must outlive
-// the reader's use.
+// Starts reading a split chunk's payload (after the chunk header) at its first record. The
+// payload must outlive the reader's use.
 Result beginSplits(SplitReader& r, std::span<const uint8_t> payload, const ChunkInfo& info, const Manifest& m);
 
 // Decodes the next record and applies it; appends changed tet ids (moved, then new) to

@@ -11,7 +11,7 @@ namespace {
 constexpr double kPerVertex = 12 + 9 + 4;   // position; star block (start, size, class); the de-duplication stamp (seen)
 constexpr double kPerFieldValue = 4;
 constexpr double kPerTet = 16 + 23;         // vertex ids; 4 corners in the star pool at 1.4 slots each
-constexpr double kPerSplit = 4 + 4 + 4;     // undo log (splitJ, splitTetsBefore); record offset
+constexpr double kPerSplit = 4 + 4 + 24;    // undo log (splitJ, splitTetsBefore); record offsets (one per column)
 constexpr double kPerSplitKept = 4;         // undo log: j's isoField value before the split (FORMAT.md §4, flag bit 2)
 constexpr double kSurfacePerTet = 56;       // isosurface + interval tree, measured 49 plus margin
 constexpr double kHullPerTriangle = 110;

@@ -68,7 +68,7 @@ class Encoder {
       encodeSplit(c);
       ++inChunk_;
       if (opt_.progress && (c & 4095) == 0) opt_.progress(C - c, C);
-      if (records_.size() >= target_ * ratio_ || c == 0 || tapers(C - c, c))
+      if (recordBytes() >= target_ * ratio_ || c == 0 || tapers(C - c, c))
         if (Result r = flushChunk(C - c); !r) {
           collect();
           return r;
@@ -137,13 +137,21 @@ class Encoder {
   // byte arrives, instead of a whole large one. A rest smaller than that stays in the chunk.
   bool tapers(uint32_t done, uint32_t left) const {
     const double least = opt_.firstChunkBytes * ratio_;
-    const double rest = double(left) * double(flushedRaw_ + records_.size()) / double(done);
-    return double(records_.size()) >= std::max(least, rest) && rest >= least;
+    const double rest = double(left) * double(flushedRaw_ + recordBytes()) / double(done);
+    return double(recordBytes()) >= std::max(least, rest) && rest >= least;
   }
 
+  // The current chunk's records so far, in bytes (all columns).
+  size_t recordBytes() const {
+    size_t n = 0;
+    for (const std::vector<uint8_t>& c : columns_) n += c.size();
+    return n;
+  }
+  std::vector<uint8_t>& column(SplitColumn c) { return columns_[size_t(c)]; }
+
   void startChunk() {
-    flushedRaw_ += records_.size();
-    records_.clear();
+    flushedRaw_ += recordBytes();
+    for (std::vector<uint8_t>& c : columns_) c.clear();
     inChunk_ = 0;
     prevJ_ = 0;  // each chunk decodes on its own (FORMAT.md §4)
   }
@@ -162,9 +170,9 @@ class Encoder {
     return uint32_t(candidates_.size()) + v;  // explicit id (FORMAT.md §4)
   }
 
-  void putValue(float value, float predictor, const QuantAxis& axis) {
-    if (q_.lossless) putF32(records_, value);
-    else putVarint(records_, zigzag(int32_t(axis.quantize(value)) - int32_t(axis.quantize(predictor))));
+  void putValue(std::vector<uint8_t>& out, float value, float predictor, const QuantAxis& axis) {
+    if (q_.lossless) putF32(out, value);
+    else putVarint(out, zigzag(int32_t(axis.quantize(value)) - int32_t(axis.quantize(predictor))));
   }
 
   void encodeSplit(uint32_t c) {
@@ -173,7 +181,7 @@ class Encoder {
     const uint32_t js = out_.streamVertexOf[j], is = pm_.vertexCount();
     assert(js != kNone && out_.streamVertexOf[i] == kNone);
     out_.streamVertexOf[i] = is;
-    putVarint(records_, zigzag(int32_t(js) - int32_t(prevJ_)));
+    putVarint(column(SplitColumn::KeptVertex), zigzag(int32_t(js) - int32_t(prevJ_)));
     prevJ_ = js;
 
     // Moved tets as a bit mask over star(j), ascending.
@@ -181,11 +189,12 @@ class Encoder {
     for (uint32_t k = log.movedBegin[c]; k < log.movedBegin[c + 1]; ++k) moved_.push_back(out_.streamTetOf[log.moved[k]]);
     std::sort(moved_.begin(), moved_.end());
     starOf(pm_, js, star_);
-    size_t maskAt = records_.size();
-    records_.resize(maskAt + (star_.size() + 7) / 8, 0);
+    std::vector<uint8_t>& mask = column(SplitColumn::Moved);
+    size_t maskAt = mask.size();
+    mask.resize(maskAt + (star_.size() + 7) / 8, 0);
     for (size_t k = 0, x = 0; k < star_.size() && x < moved_.size(); ++k)
       if (star_[k] == moved_[x]) {
-        records_[maskAt + (k >> 3)] |= uint8_t(1u << (k & 7));
+        mask[maskAt + (k >> 3)] |= uint8_t(1u << (k & 7));
         ++x;
       }
 
@@ -207,15 +216,16 @@ class Encoder {
       pairs_.push_back({out_.streamVertexOf[v[slot[2]]], out_.streamVertexOf[v[slot[3]]], log.removed[first + n]});
     }
     const RingMode mode = chainPairs();
-    putVarint(records_, count << 2 | uint32_t(mode));
+    putVarint(column(SplitColumn::NewTetCount), count << 2 | uint32_t(mode));
+    std::vector<uint8_t>& list = column(SplitColumn::NewTets);
     if (mode == RingMode::Pairs) {
       for (const Pair& p : pairs_) {
-        putVarint(records_, candidateIndex(p.a));
-        putVarint(records_, candidateIndex(p.b));
+        putVarint(list, candidateIndex(p.a));
+        putVarint(list, candidateIndex(p.b));
       }
     } else {
-      for (const Pair& p : pairs_) putVarint(records_, candidateIndex(p.a));
-      if (mode == RingMode::Path) putVarint(records_, candidateIndex(pairs_.back().b));
+      for (const Pair& p : pairs_) putVarint(list, candidateIndex(p.a));
+      if (mode == RingMode::Path) putVarint(list, candidateIndex(pairs_.back().b));
     }
     newTets_.clear();
     for (uint32_t n = 0; n < count; ++n) {
@@ -225,21 +235,21 @@ class Encoder {
 
     const float* pi = &mesh_.positions[3 * size_t(i)];
     const float* pj = &pm_.mesh.positions[3 * size_t(js)];
-    for (int k = 0; k < 3; ++k) putValue(pi[k], pj[k], q_.position[k]);
+    for (int k = 0; k < 3; ++k) putValue(column(SplitColumn::Position), pi[k], pj[k], q_.position[k]);
     // p_i's values as they were when it was removed, then (with fitted values) the values p_j
     // had before the collapse, which the split gives back.
     const size_t F = mesh_.fields.size();
     fields_.resize(F);
     for (size_t f = 0; f < F; ++f) {
       fields_[f] = int(f) == s_.valuesField ? snapped(f, log.iValue[c]) : mesh_.fields[f].values[i];
-      putValue(fields_[f], pm_.mesh.fields[f].values[js], q_.field[f]);
+      putValue(column(SplitColumn::Values), fields_[f], pm_.mesh.fields[f].values[js], q_.field[f]);
     }
     float jValue = 0;
     bool jValueChanged = false;
     if (s_.valuesField >= 0) {
       const size_t f = size_t(s_.valuesField);
       jValue = snapped(f, log.jValue[c]);
-      putValue(jValue, pm_.mesh.fields[f].values[js], q_.field[f]);
+      putValue(column(SplitColumn::Values), jValue, pm_.mesh.fields[f].values[js], q_.field[f]);
       jValueChanged = jValue != pm_.mesh.fields[f].values[js];
     }
     changed_.clear();
@@ -300,8 +310,9 @@ class Encoder {
     const uint32_t index = uint32_t(jobs_.size());
     beginChunk(job.raw, ChunkKind::Splits, index);
     putU32(job.raw, inChunk_);
-    putU32(job.raw, (q_.lossless ? kSplitFlagLossless : 0) | (s_.valuesField >= 0 ? kSplitFlagKeptIsoValue : 0));
-    job.raw.insert(job.raw.end(), records_.begin(), records_.end());
+    putU32(job.raw, kSplitFlagColumns | (q_.lossless ? kSplitFlagLossless : 0) | (s_.valuesField >= 0 ? kSplitFlagKeptIsoValue : 0));
+    for (const std::vector<uint8_t>& c : columns_) putU32(job.raw, uint32_t(c.size()));
+    for (const std::vector<uint8_t>& c : columns_) job.raw.insert(job.raw.end(), c.begin(), c.end());
     job.info.kind = ChunkKind::Splits;
     job.info.vertices = pm_.vertexCount();
     job.info.tets = pm_.tetCount();
@@ -362,7 +373,7 @@ class Encoder {
   std::vector<uint32_t> baseOf_;          // per input vertex: the base vertex it went into
   std::future<LevelError> baseError_;     // measured on another thread
   std::vector<float> prefixMax_, fields_;
-  std::vector<uint8_t> records_;
+  std::vector<uint8_t> columns_[kSplitColumns];  // the current chunk's records, column by column
   std::vector<Pair> pairs_, chain_;
   std::deque<Job> jobs_;  // chunks being compressed, in order (stable addresses)
   std::vector<uint32_t> star_, moved_, candidates_, newTets_, changed_;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -14,8 +15,10 @@
 
 #include <zstd.h>
 
+#include "chunk.h"
 #include "pack/chunk_encode.h"
 #include "pack/generators.h"
+#include "split_stream.h"
 
 namespace tetstream::test {
 
@@ -79,6 +82,16 @@ std::vector<uint8_t> forgeTruncatedChunk(const std::vector<uint8_t>& file, Chunk
   std::vector<uint8_t> raw(info.rawBytes);
   if (ZSTD_decompress(raw.data(), raw.size(), file.data(), file.size()) != raw.size()) return {};
   raw.pop_back();  // the last record ends early
+  // In columns, the last column (Values) one byte shorter too, so the chunk passes its header.
+  uint32_t flags, last;
+  std::memcpy(&flags, &raw[kChunkHeaderBytes + 4], 4);
+  if (flags & kSplitFlagColumns) {
+    const size_t at = kChunkHeaderBytes + 8 + 4 * (kSplitColumns - 1);
+    std::memcpy(&last, &raw[at], 4);
+    if (last == 0) return {};
+    --last;
+    std::memcpy(&raw[at], &last, 4);
+  }
   std::vector<uint8_t> bad;
   ChunkInfo forged = info;
   if (!finishChunk(raw, 3, bad, forged)) return {};

@@ -718,7 +718,8 @@ TEST(Progressive, KeptValueFlagsAreReadAsDocumented) {
     EXPECT_EQ(ZSTD_decompress(raw.data(), raw.size(), file.data(), file.size()), raw.size());
     uint32_t old;
     std::memcpy(&old, &raw[kChunkHeaderBytes + 4], 4);
-    EXPECT_EQ(old, kSplitFlagKeptIsoValue);
+    EXPECT_EQ(old, kSplitFlagKeptIsoValue | kSplitFlagColumns);
+    flags |= kSplitFlagColumns;
     std::memcpy(&raw[kChunkHeaderBytes + 4], &flags, 4);
     ChunkInfo& entry = ds.manifest.chunks[1];
     EXPECT_TRUE(finishChunk(raw, 3, file, entry));
@@ -734,6 +735,104 @@ TEST(Progressive, KeptValueFlagsAreReadAsDocumented) {
   ASSERT_TRUE(r) << r.message;
   EXPECT_EQ(old.pm.mesh.tets, ref.pm.mesh.tets);
   EXPECT_EQ(old.pm.mesh.fields[0].values, ref.pm.mesh.fields[0].values);
+}
+
+static void readRowsAndColumns(bool lossless);
+
+// The packer writes split records in columns (flag bit 3); packs written before that hold them
+// one record after the other, and readers still read those. Rewriting every chunk of a pack
+// back into rows, record by record, gives the same mesh at every chunk.
+TEST(Progressive, SplitRecordsReadTheSameInRowsAsInColumns) {
+  for (bool lossless : {false, true}) {
+    SCOPED_TRACE(lossless ? "lossless" : "quantized");
+    readRowsAndColumns(lossless);
+  }
+}
+
+static void readRowsAndColumns(bool lossless) {
+  PackOptions o;
+  o.chunkKb = 1;
+  o.lossless = lossless;
+  const TetMesh m = harmonic(10);
+  const std::string dir = pack(lossless ? "rows-lossless" : "rows", m, o);
+  Dataset cols;
+  ASSERT_TRUE(loadPackedDir(dir, cols, 1));
+  std::string json;
+  {
+    std::vector<uint8_t> bytes = test::loadBytes(dir + "/manifest.json");
+    json.assign(bytes.begin(), bytes.end());
+  }
+  Dataset rows;
+  ASSERT_TRUE(openDataset(rows, json));
+  ASSERT_TRUE(applyChunk(rows, 0, test::loadBytes(dir + "/" + rows.manifest.chunks[0].file)));
+  ASSERT_GE(cols.manifest.chunks.size(), 4u);
+  for (uint32_t c = 1; c < cols.manifest.chunks.size(); ++c) {
+    const ChunkInfo info = cols.manifest.chunks[c];
+    const std::vector<uint8_t> file = test::loadBytes(dir + "/" + info.file);
+    std::vector<uint8_t> raw(info.rawBytes);
+    ASSERT_EQ(ZSTD_decompress(raw.data(), raw.size(), file.data(), file.size()), raw.size());
+    uint32_t flags, length[kSplitColumns];
+    std::memcpy(&flags, &raw[kChunkHeaderBytes + 4], 4);
+    ASSERT_TRUE(flags & kSplitFlagColumns);
+    std::memcpy(length, &raw[kChunkHeaderBytes + 8], sizeof length);
+    size_t columnAt[kSplitColumns], at = kChunkHeaderBytes + 8 + sizeof length;
+    for (uint32_t k = 0; k < kSplitColumns; ++k) {
+      columnAt[k] = at;
+      at += length[k];
+    }
+    ASSERT_EQ(at, raw.size());
+    // Each record's bytes in each column, from where the reader was before and after it.
+    std::vector<uint8_t> row(raw.begin(), raw.begin() + kChunkHeaderBytes + 8);
+    flags &= ~kSplitFlagColumns;
+    std::memcpy(&row[kChunkHeaderBytes + 4], &flags, 4);
+    ASSERT_TRUE(receiveChunk(cols, c, file));
+    const uint32_t first = cols.splitsApplied();
+    for (uint32_t g = first; g < first + info.splits; ++g) {
+      std::vector<uint32_t> changed;
+      bool reached;
+      ASSERT_TRUE(stepTowards(cols, g + 1, 1, changed, &reached));
+      for (uint32_t k = 0; k < kSplitColumns; ++k) {
+        const uint32_t from = g == first ? 0 : cols.recordStart[kSplitColumns * g + k];
+        const uint32_t to = cols.recordStart[kSplitColumns * (g + 1) + k];
+        row.insert(row.end(), raw.begin() + long(columnAt[k] + from), raw.begin() + long(columnAt[k] + to));
+      }
+    }
+    std::vector<uint8_t> rowFile;
+    ASSERT_TRUE(finishChunk(row, 3, rowFile, rows.manifest.chunks[c]));
+    Result r = applyChunk(rows, c, rowFile);
+    ASSERT_TRUE(r) << "chunk " << c << ": " << r.message;
+    EXPECT_EQ(rows.pm.mesh.tets, cols.pm.mesh.tets) << "chunk " << c;
+    EXPECT_EQ(rows.pm.mesh.positions, cols.pm.mesh.positions) << "chunk " << c;
+    for (size_t f = 0; f < m.fields.size(); ++f)
+      EXPECT_EQ(rows.pm.mesh.fields[f].values, cols.pm.mesh.fields[f].values) << "chunk " << c << ", field " << f;
+  }
+  EXPECT_EQ(rows.pm.vertexCount(), m.vertexCount());
+}
+
+// A chunk whose column lengths do not add up to its payload is refused when it arrives.
+TEST(Progressive, SplitColumnsThatDoNotFillThePayloadAreRefused) {
+  PackOptions o;
+  o.chunkKb = 2;
+  const std::string dir = pack("columns-bad", harmonic(8), o);
+  for (int change : {-1, +1}) {
+    Dataset ds;
+    ASSERT_TRUE(loadPackedDir(dir, ds, 1));
+    const ChunkInfo info = ds.manifest.chunks[1];
+    std::vector<uint8_t> file = test::loadBytes(dir + "/" + info.file), raw(info.rawBytes);
+    ASSERT_EQ(ZSTD_decompress(raw.data(), raw.size(), file.data(), file.size()), raw.size());
+    uint32_t length;
+    const size_t at = kChunkHeaderBytes + 8 + 4 * uint32_t(SplitColumn::NewTets);
+    std::memcpy(&length, &raw[at], 4);
+    length += uint32_t(change);
+    std::memcpy(&raw[at], &length, 4);
+    ASSERT_TRUE(finishChunk(raw, 3, file, ds.manifest.chunks[1]));
+    const uint32_t v = ds.pm.vertexCount();
+    Result r = applyChunk(ds, 1, file);
+    EXPECT_TRUE(r.status == Status::Corrupt || r.status == Status::Truncated) << r.message;
+    EXPECT_NE(r.message.find("column"), std::string::npos) << r.message;
+    EXPECT_EQ(ds.pm.vertexCount(), v);
+    EXPECT_EQ(ds.chunksReceived, 1u);
+  }
 }
 
 // The undo log holds one value a split, the isoField's, however many fields there are (none
@@ -754,7 +853,7 @@ TEST(Progressive, UndoLogKeepsOnlyTheFittedFieldsValue) {
   const ChunkInfo info = ds.manifest.chunks[3];
   std::vector<uint8_t> file = test::loadBytes(dir + "/" + info.file), raw(info.rawBytes);
   ASSERT_EQ(ZSTD_decompress(raw.data(), raw.size(), file.data(), file.size()), raw.size());
-  const uint32_t none = 0;
+  const uint32_t none = kSplitFlagColumns;
   std::memcpy(&raw[kChunkHeaderBytes + 4], &none, 4);
   ASSERT_TRUE(finishChunk(raw, 3, file, ds.manifest.chunks[3]));
   const uint32_t v = ds.pm.vertexCount();
