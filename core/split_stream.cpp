@@ -31,9 +31,10 @@ Result beginSplits(SplitReader& r, std::span<const uint8_t> payload, const Chunk
   if (!header.u32(count) || !header.u32(flags)) return fail(Status::Truncated, "split chunk: payload shorter than its header");
   if (count != info.splits)
     return corrupt(std::to_string(count) + " splits where the manifest says " + std::to_string(info.splits));
-  if (flags & ~(kSplitFlagLossless | kSplitFlagKeptValues | kSplitFlagKeptIsoValue | kSplitFlagColumns))
+  if (flags & ~(kSplitFlagLossless | kSplitFlagKeptValues | kSplitFlagKeptIsoValue | kSplitFlagColumns | kSplitFlagImpliedMoved))
     return fail(Status::Unsupported, "split chunk: unknown flags");
   r.columns = flags & kSplitFlagColumns;
+  r.impliedMoved = flags & kSplitFlagImpliedMoved;
   for (ByteReader& c : r.in) c = ByteReader{};
   if (r.columns) {
     // The columns' byte lengths, then the columns, which must fill the payload exactly.
@@ -76,14 +77,25 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
   if (j64 < 0 || j64 >= V) return fail(Status::OutOfRange, "split chunk: kept vertex " + std::to_string(j64) + " does not exist");
   const uint32_t j = uint32_t(j64);
 
-  // T_moved: a bit per tet around j, in ascending tet order.
+  // T_moved: a bit per tet around j, in ascending tet order, or (a marker byte says which)
+  // found from T_new below.
   starOf(pm, j, r.star);
-  const uint8_t* mask;
-  if (!r.column(SplitColumn::Moved).bytes((r.star.size() + 7) / 8, mask)) return fail(Status::Truncated, "split chunk: record ends early");
+  ByteReader& movedIn = r.column(SplitColumn::Moved);
+  uint8_t marker = 1;
+  if (r.impliedMoved) {
+    const uint8_t* m;
+    if (!movedIn.bytes(1, m)) return fail(Status::Truncated, "split chunk: record ends early");
+    marker = *m;
+    if (marker > 1) return corrupt("a moved-tets marker other than 0 or 1");
+  }
   r.moved.clear();
-  for (size_t k = 0; k < r.star.size(); ++k)
-    if (mask[k >> 3] >> (k & 7) & 1) r.moved.push_back(r.star[k]);
-  if (r.star.size() % 8 && mask[r.star.size() / 8] >> (r.star.size() % 8)) return corrupt("mask bits beyond the star");
+  if (marker == 1) {
+    const uint8_t* mask;
+    if (!movedIn.bytes((r.star.size() + 7) / 8, mask)) return fail(Status::Truncated, "split chunk: record ends early");
+    for (size_t k = 0; k < r.star.size(); ++k)
+      if (mask[k >> 3] >> (k & 7) & 1) r.moved.push_back(r.star[k]);
+    if (r.star.size() % 8 && mask[r.star.size() / 8] >> (r.star.size() % 8)) return corrupt("mask bits beyond the star");
+  }
 
   // T_new: (i, j, a, b), vertices named by index into j's sorted neighbours, or past the end
   // for an explicit vertex id; listed as pairs or as the chain of the edge's link.
@@ -125,6 +137,8 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
       r.newTets.insert(r.newTets.end(), {i, j, a, b});
     }
   }
+
+  if (marker == 0) r.movedFinder.find(pm.mesh, j, r.star, r.candidates, r.newTets, r.moved);
 
   // Position and field values of p_i: raw floats, or grid steps relative to p_j.
   float position[3];

@@ -157,7 +157,7 @@ Runner addPack(CLI::App& app) {
                  {"inputVertices", inputVertices}, {"inputFormat", in.format}, {"field", m.isoField}, {"lossless", m.lossless},
                  {"positionBits", m.positionBits}, {"baseVertices", s.baseVertices}, {"baseTets", s.baseTets},
                  {"splits", s.splits}, {"chunks", m.chunks.size()}, {"bytes", bytes}, {"baseBytes", baseBytes},
-                 {"bitsPerTet", bitsPerTet}, {"bytesPerSplit", bytesPerSplit},
+                 {"bitsPerTet", bitsPerTet}, {"bytesPerSplit", bytesPerSplit}, {"movedMasks", s.movedMasks},
                  {"baseFieldError", m.chunks[0].fieldError}, {"baseFieldRms", m.chunks[0].fieldRms},
                  {"baseFieldMax", m.chunks[0].fieldMax}, {"stopReason", s.stopReason},
                  {"flatTetsRemoved", s.flatTetsRemoved}, {"flatTetsLeft", s.flatTetsLeft},

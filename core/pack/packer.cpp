@@ -208,6 +208,7 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   if (report.unusedVertices)
     summary.notes.push_back("dropped " + std::to_string(report.unusedVertices) + " vertices that no tetrahedron uses");
   summary.baseVertices = enc.base.vertexCount();
+  summary.movedMasks = enc.movedMasks;
   summary.baseTets = enc.base.tetCount();
   summary.splits = simplified.log.size();
   // --max-error stops on the simplifier's per-collapse estimate; say so when the measured error

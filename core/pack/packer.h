@@ -40,6 +40,7 @@ struct PackSummary {
   uint64_t flippedTets = 0;          // negatively oriented tets re-oriented (FORMAT.md §3)
   uint32_t baseVertices = 0, baseTets = 0, splits = 0;
   uint32_t flatTetsRemoved = 0, flatTetsLeft = 0;
+  uint32_t movedMasks = 0;           // splits that carry a mask of T_moved (it does not follow from T_new)
   uint64_t queuePops = 0, requeued = 0, costEvaluations = 0;  // simplifier work, for benchmarks
   uint32_t slabCollapses = 0;      // of the collapses, those made in slabs at once (the parallel phase)
   std::string stopReason;            // why simplification stopped

@@ -189,14 +189,6 @@ class Encoder {
     for (uint32_t k = log.movedBegin[c]; k < log.movedBegin[c + 1]; ++k) moved_.push_back(out_.streamTetOf[log.moved[k]]);
     std::sort(moved_.begin(), moved_.end());
     starOf(pm_, js, star_);
-    std::vector<uint8_t>& mask = column(SplitColumn::Moved);
-    size_t maskAt = mask.size();
-    mask.resize(maskAt + (star_.size() + 7) / 8, 0);
-    for (size_t k = 0, x = 0; k < star_.size() && x < moved_.size(); ++k)
-      if (star_[k] == moved_[x]) {
-        mask[maskAt + (k >> 3)] |= uint8_t(1u << (k & 7));
-        ++x;
-      }
 
     // New tets (i, j, a, b), ordered as an even permutation of the original tet. Around an
     // edge of a consistently oriented mesh the pairs (a, b) chain into the edge's link: a cycle
@@ -232,6 +224,7 @@ class Encoder {
       newTets_.insert(newTets_.end(), {is, js, pairs_[n].a, pairs_[n].b});
       out_.streamTetOf[pairs_[n].tet] = pm_.tetCount() + n;
     }
+    putMoved(js);
 
     const float* pi = &mesh_.positions[3 * size_t(i)];
     const float* pj = &pm_.mesh.positions[3 * size_t(js)];
@@ -256,6 +249,26 @@ class Encoder {
     const uint32_t firstNew = pm_.tetCount();
     applySplit(pm_, SplitOp{js, moved_, newTets_, pi, fields_.data(), s_.valuesField >= 0 ? &jValue : nullptr}, changed_);
     if (metered_) meter_.afterSplit(i, js, moved_, firstNew, jValueChanged);
+  }
+
+  // T_moved: the marker 0 when the reader finds it from T_new (moved_tets.h), else 1 and a bit
+  // per tet around p_j (star_), in ascending order.
+  void putMoved(uint32_t js) {
+    std::vector<uint8_t>& out = column(SplitColumn::Moved);
+    movedFinder_.find(pm_.mesh, js, star_, candidates_, newTets_, implied_);
+    if (implied_ == moved_) {
+      out.push_back(0);
+      return;
+    }
+    out.push_back(1);
+    ++out_.movedMasks;
+    const size_t maskAt = out.size();
+    out.resize(maskAt + (star_.size() + 7) / 8, 0);
+    for (size_t k = 0, x = 0; k < star_.size() && x < moved_.size(); ++k)
+      if (star_[k] == moved_[x]) {
+        out[maskAt + (k >> 3)] |= uint8_t(1u << (k & 7));
+        ++x;
+      }
   }
 
   // Closes the current chunk and compresses it on another thread while encoding goes on. The
@@ -310,7 +323,7 @@ class Encoder {
     const uint32_t index = uint32_t(jobs_.size());
     beginChunk(job.raw, ChunkKind::Splits, index);
     putU32(job.raw, inChunk_);
-    putU32(job.raw, kSplitFlagColumns | (q_.lossless ? kSplitFlagLossless : 0) | (s_.valuesField >= 0 ? kSplitFlagKeptIsoValue : 0));
+    putU32(job.raw, kSplitFlagColumns | kSplitFlagImpliedMoved | (q_.lossless ? kSplitFlagLossless : 0) | (s_.valuesField >= 0 ? kSplitFlagKeptIsoValue : 0));
     for (const std::vector<uint8_t>& c : columns_) putU32(job.raw, uint32_t(c.size()));
     for (const std::vector<uint8_t>& c : columns_) job.raw.insert(job.raw.end(), c.begin(), c.end());
     job.info.kind = ChunkKind::Splits;
@@ -376,7 +389,9 @@ class Encoder {
   std::vector<uint8_t> columns_[kSplitColumns];  // the current chunk's records, column by column
   std::vector<Pair> pairs_, chain_;
   std::deque<Job> jobs_;  // chunks being compressed, in order (stable addresses)
-  std::vector<uint32_t> star_, moved_, candidates_, newTets_, changed_;
+  std::vector<uint32_t> star_, moved_, candidates_, newTets_, changed_, implied_;
+  MovedTetsFinder movedFinder_;
+
   uint32_t prevJ_ = 0, inChunk_ = 0;
   uint64_t target_ = 0;
   uint64_t flushedRaw_ = 0;  // record bytes of the chunks before the current one

@@ -39,6 +39,7 @@ namespace {
 
 std::string tempDir(const std::string& name) { return test::suiteDir("progressive", name); }
 TetMesh harmonic(uint32_t n) { return test::harmonicMesh(n); }
+uint32_t gridVertex(uint32_t n, uint32_t i, uint32_t j, uint32_t k) { return i + n * (j + n * k); }
 
 // Harmonic n³ without the tets whose centroid `drop` selects, and without the vertices no
 // tet uses any more.
@@ -718,8 +719,9 @@ TEST(Progressive, KeptValueFlagsAreReadAsDocumented) {
     EXPECT_EQ(ZSTD_decompress(raw.data(), raw.size(), file.data(), file.size()), raw.size());
     uint32_t old;
     std::memcpy(&old, &raw[kChunkHeaderBytes + 4], 4);
-    EXPECT_EQ(old, kSplitFlagKeptIsoValue | kSplitFlagColumns);
-    flags |= kSplitFlagColumns;
+    const uint32_t layout = kSplitFlagColumns | kSplitFlagImpliedMoved;  // how the records are stored
+    EXPECT_EQ(old, kSplitFlagKeptIsoValue | layout);
+    flags |= layout;
     std::memcpy(&raw[kChunkHeaderBytes + 4], &flags, 4);
     ChunkInfo& entry = ds.manifest.chunks[1];
     EXPECT_TRUE(finishChunk(raw, 3, file, entry));
@@ -739,10 +741,11 @@ TEST(Progressive, KeptValueFlagsAreReadAsDocumented) {
 
 static void readRowsAndColumns(bool lossless);
 
-// The packer writes split records in columns (flag bit 3); packs written before that hold them
-// one record after the other, and readers still read those. Rewriting every chunk of a pack
-// back into rows, record by record, gives the same mesh at every chunk.
-TEST(Progressive, SplitRecordsReadTheSameInRowsAsInColumns) {
+// The packer writes split records in columns (flag bit 3), most without a mask of T_moved (bit
+// 4); packs written before that hold them one record after the other, each with its mask, and
+// readers still read those. Rewriting every chunk of a pack that way, record by record (the
+// mask made from the tets that moved), gives the same mesh at every chunk.
+TEST(Progressive, SplitRecordsReadTheSameInRowsWithMasks) {
   for (bool lossless : {false, true}) {
     SCOPED_TRACE(lossless ? "lossless" : "quantized");
     readRowsAndColumns(lossless);
@@ -783,15 +786,36 @@ static void readRowsAndColumns(bool lossless) {
     ASSERT_EQ(at, raw.size());
     // Each record's bytes in each column, from where the reader was before and after it.
     std::vector<uint8_t> row(raw.begin(), raw.begin() + kChunkHeaderBytes + 8);
-    flags &= ~kSplitFlagColumns;
+    ASSERT_TRUE(flags & kSplitFlagImpliedMoved);
+    flags &= ~(kSplitFlagColumns | kSplitFlagImpliedMoved);
     std::memcpy(&row[kChunkHeaderBytes + 4], &flags, 4);
     ASSERT_TRUE(receiveChunk(cols, c, file));
     const uint32_t first = cols.splitsApplied();
     for (uint32_t g = first; g < first + info.splits; ++g) {
-      std::vector<uint32_t> changed;
+      std::vector<uint32_t> changed, starAfter;
       bool reached;
       ASSERT_TRUE(stepTowards(cols, g + 1, 1, changed, &reached));
+      // The tets around p_j before the split: those still around it but new, and the moved
+      // ones, which now hold p_i instead.
+      const ProgressiveMesh& pm = cols.pm;
+      const uint32_t i = pm.vertexCount() - 1, j = pm.splitJ[g], before = pm.splitTetsBefore[g];
+      std::vector<uint32_t> star, moved;
+      starOf(pm, j, starAfter);
+      for (uint32_t t : starAfter)
+        if (t < before) star.push_back(t);
+      starOf(pm, i, starAfter);
+      for (uint32_t t : starAfter)
+        if (t < before) moved.push_back(t);
+      star.insert(star.end(), moved.begin(), moved.end());
+      std::sort(star.begin(), star.end());
+      std::vector<uint8_t> mask((star.size() + 7) / 8, 0);
+      for (size_t k = 0; k < star.size(); ++k)
+        if (std::binary_search(moved.begin(), moved.end(), star[k])) mask[k >> 3] |= uint8_t(1u << (k & 7));
       for (uint32_t k = 0; k < kSplitColumns; ++k) {
+        if (SplitColumn(k) == SplitColumn::Moved) {
+          row.insert(row.end(), mask.begin(), mask.end());
+          continue;
+        }
         const uint32_t from = g == first ? 0 : cols.recordStart[kSplitColumns * g + k];
         const uint32_t to = cols.recordStart[kSplitColumns * (g + 1) + k];
         row.insert(row.end(), raw.begin() + long(columnAt[k] + from), raw.begin() + long(columnAt[k] + to));
@@ -835,6 +859,46 @@ TEST(Progressive, SplitColumnsThatDoNotFillThePayloadAreRefused) {
   }
 }
 
+// T_moved follows from T_new (moved_tets.h) for all but a few splits of real packs: on a
+// cube, on a mesh with a non-convex boundary and creases, and with flat input tets.
+TEST(Progressive, MovedTetsFollowFromNewTetsOnAlmostEverySplit) {
+  TetMesh flat = harmonic(12);  // one vertex pushed onto the layer below: flat tets around it
+  flat.positions[3 * gridVertex(12, 5, 5, 5) + 2] = flat.positions[3 * gridVertex(12, 5, 5, 4) + 2];
+  PackOptions o;
+  for (const auto& [name, mesh] : {std::pair{"moved-cube", harmonic(12)}, std::pair{"moved-l", lShape(12)},
+                                   std::pair{"moved-flat", flat}}) {
+    PackSummary s;
+    pack(name, mesh, o, &s);
+    EXPECT_GT(s.splits, 500u) << name;
+    EXPECT_LE(s.movedMasks, s.splits / 100) << name;
+  }
+}
+
+// The moved marker is 0 or 1; anything else is refused, and the chunk leaves the level as it was.
+TEST(Progressive, AMovedMarkerOtherThanZeroOrOneIsRefused) {
+  PackOptions o;
+  o.chunkKb = 2;
+  const std::string dir = pack("moved-marker", harmonic(8), o);
+  Dataset ds;
+  ASSERT_TRUE(loadPackedDir(dir, ds, 1));
+  const ChunkInfo info = ds.manifest.chunks[1];
+  std::vector<uint8_t> file = test::loadBytes(dir + "/" + info.file), raw(info.rawBytes);
+  ASSERT_EQ(ZSTD_decompress(raw.data(), raw.size(), file.data(), file.size()), raw.size());
+  uint32_t length[kSplitColumns];
+  std::memcpy(length, &raw[kChunkHeaderBytes + 8], sizeof length);
+  size_t at = kChunkHeaderBytes + 8 + sizeof length;  // the Moved column follows the KeptVertex one
+  at += length[uint32_t(SplitColumn::KeptVertex)];
+  ASSERT_EQ(raw[at], 0) << "the first record's T_moved follows from T_new";
+  raw[at] = 2;
+  ASSERT_TRUE(finishChunk(raw, 3, file, ds.manifest.chunks[1]));
+  const uint32_t v = ds.pm.vertexCount(), t = ds.pm.tetCount();
+  Result r = applyChunk(ds, 1, file);
+  EXPECT_EQ(r.status, Status::Corrupt) << r.message;
+  EXPECT_NE(r.message.find("marker"), std::string::npos) << r.message;
+  EXPECT_EQ(ds.pm.vertexCount(), v);
+  EXPECT_EQ(ds.pm.tetCount(), t);
+}
+
 // The undo log holds one value a split, the isoField's, however many fields there are (none
 // with --samples); a chunk whose records carry another kind of kept values than the splits
 // before it is refused and leaves the level as it was.
@@ -853,7 +917,7 @@ TEST(Progressive, UndoLogKeepsOnlyTheFittedFieldsValue) {
   const ChunkInfo info = ds.manifest.chunks[3];
   std::vector<uint8_t> file = test::loadBytes(dir + "/" + info.file), raw(info.rawBytes);
   ASSERT_EQ(ZSTD_decompress(raw.data(), raw.size(), file.data(), file.size()), raw.size());
-  const uint32_t none = kSplitFlagColumns;
+  const uint32_t none = kSplitFlagColumns | kSplitFlagImpliedMoved;
   std::memcpy(&raw[kChunkHeaderBytes + 4], &none, 4);
   ASSERT_TRUE(finishChunk(raw, 3, file, ds.manifest.chunks[3]));
   const uint32_t v = ds.pm.vertexCount();
@@ -873,9 +937,6 @@ TEST(Progressive, UndoLogKeepsOnlyTheFittedFieldsValue) {
 
 // ------------------------------------------------------------------ legality on tiny meshes
 
-namespace {
-uint32_t gridVertex(uint32_t n, uint32_t i, uint32_t j, uint32_t k) { return i + n * (j + n * k); }
-}  // namespace
 
 TEST(Legality, BoundaryVertexMayNotBePulledInward) {
   TetMesh m = harmonic(3);
