@@ -31,8 +31,10 @@ Result beginSplits(SplitReader& r, std::span<const uint8_t> payload, const Chunk
   if (!header.u32(count) || !header.u32(flags)) return fail(Status::Truncated, "split chunk: payload shorter than its header");
   if (count != info.splits)
     return corrupt(std::to_string(count) + " splits where the manifest says " + std::to_string(info.splits));
-  if (flags & ~(kSplitFlagLossless | kSplitFlagKeptValues | kSplitFlagKeptIsoValue | kSplitFlagColumns | kSplitFlagImpliedMoved))
+  if (flags & ~(kSplitFlagLossless | kSplitFlagKeptValues | kSplitFlagKeptIsoValue | kSplitFlagColumns |
+                kSplitFlagImpliedMoved | kSplitFlagRingWalk))
     return fail(Status::Unsupported, "split chunk: unknown flags");
+  r.ringWalk = flags & kSplitFlagRingWalk;
   r.columns = flags & kSplitFlagColumns;
   r.impliedMoved = flags & kSplitFlagImpliedMoved;
   for (ByteReader& c : r.in) c = ByteReader{};
@@ -100,6 +102,7 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
   // T_new: (i, j, a, b), vertices named by index into j's sorted neighbours, or past the end
   // for an explicit vertex id; listed as pairs or as the chain of the edge's link.
   neighboursOf(pm, j, r.candidates);
+  if (r.impliedMoved || r.ringWalk) r.link.build(pm.mesh, j, r.star, r.candidates);
   uint32_t header;
   if (!r.column(SplitColumn::NewTetCount).varint(header)) return fail(Status::Truncated, "split chunk: record ends early");
   const uint32_t m = header >> 2, mode = header & 3;
@@ -127,9 +130,23 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
     if (cycle && m < 3) return corrupt("a link cycle of fewer than three vertices");
     const uint32_t count = cycle ? m : m + 1;
     r.ring.resize(count);
+    // With flag bit 5, each vertex after the first is named among the link neighbours of the one
+    // before that are not on the ring yet (vertex_link.h), or past them as above.
+    uint64_t used = 0;
+    uint32_t from = VertexLink::kNone;
     for (uint32_t& v : r.ring) {
-      if (!read(v)) return fail(Status::Truncated, "split chunk: record ends early");
+      uint32_t x;
+      if (!tetsIn.varint(x)) return fail(Status::Truncated, "split chunk: record ends early");
+      const uint32_t near = from != VertexLink::kNone ? r.link.choices(from, used) : 0;
+      if (x < near) {
+        v = r.link.choice(from, used, x);
+      } else {
+        x -= near;
+        v = x < nc ? r.candidates[x] : x - nc;
+      }
       if (!valid(v)) return fail(Status::OutOfRange, "split chunk: a new tet has an invalid vertex");
+      from = r.ringWalk ? r.link.localOf(v) : VertexLink::kNone;
+      if (from != VertexLink::kNone) used |= uint64_t(1) << from;
     }
     for (uint32_t n = 0; n < m; ++n) {
       const uint32_t a = r.ring[n], b = r.ring[(n + 1) % count];
@@ -138,7 +155,7 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
     }
   }
 
-  if (marker == 0) r.movedFinder.find(pm.mesh, j, r.star, r.candidates, r.newTets, r.moved);
+  if (marker == 0) r.link.moved(r.newTets, r.moved);
 
   // Position and field values of p_i: raw floats, or grid steps relative to p_j.
   float position[3];

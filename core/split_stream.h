@@ -7,11 +7,11 @@
 #include <vector>
 
 #include "manifest.h"
-#include "moved_tets.h"
 #include "progressive.h"
 #include "quantize.h"
 #include "status.h"
 #include "varint.h"
+#include "vertex_link.h"
 
 namespace tetstream {
 
@@ -25,10 +25,13 @@ inline constexpr uint32_t kSplitFlagKeptIsoValue = 4;
 // all moved masks, and so on. zstd's entropy stage codes each block with one table, so a column
 // of one kind of number compresses far better than records that interleave six kinds.
 inline constexpr uint32_t kSplitFlagColumns = 8;
-// Each record's moved field starts with a byte: 0, T_moved follows from T_new (moved_tets.h) and
-// no mask is stored; 1, the mask follows. Most records then need one byte (which zstd all but
-// removes) instead of a mask.
+// Each record's moved field starts with a byte: 0, T_moved follows from T_new (vertex_link.h)
+// and no mask is stored; 1, the mask follows. Most records then need one byte (which zstd all
+// but removes) instead of a mask.
 inline constexpr uint32_t kSplitFlagImpliedMoved = 16;
+// A cycle's or path's vertices after the first are named among the link neighbours of the one
+// before (vertex_link.h): a handful of choices instead of every neighbour of p_j.
+inline constexpr uint32_t kSplitFlagRingWalk = 32;
 
 // The fields of a split record, in record order; with kSplitFlagColumns each is a column.
 enum class SplitColumn : uint32_t { KeptVertex, Moved, NewTetCount, NewTets, Position, Values };
@@ -47,6 +50,7 @@ struct SplitReader {
   ByteReader in[kSplitColumns];
   bool columns = false;
   bool impliedMoved = false;  // kSplitFlagImpliedMoved
+  bool ringWalk = false;      // kSplitFlagRingWalk
   uint32_t remaining = 0;  // records left in the chunk
   uint32_t prevJ = 0;
   bool lossless = false;
@@ -55,7 +59,7 @@ struct SplitReader {
   // scratch, reused across records
   std::vector<uint32_t> star, candidates, moved, newTets, ring;
   std::vector<float> fields, jFields;  // jFields: keptCount values
-  MovedTetsFinder movedFinder;
+  VertexLink link;  // of j, for ring walks and T_moved
 
   ByteReader& column(SplitColumn c) { return in[columns ? uint32_t(c) : 0]; }
   // Where the next record starts (one offset per column), and going back there.

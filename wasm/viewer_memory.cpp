@@ -8,7 +8,7 @@ namespace tetstream::viewer {
 namespace {
 
 // Per-element costs in bytes (see the header for where they come from).
-constexpr double kPerVertex = 12 + 9 + 4 + 1;  // position; star block (start, size, class); the de-duplication stamp (seen); link numbering (moved_tets.h)
+constexpr double kPerVertex = 12 + 9 + 4 + 1;  // position; star block (start, size, class); the de-duplication stamp (seen); link numbering (vertex_link.h)
 constexpr double kPerFieldValue = 4;
 constexpr double kPerTet = 16 + 23;         // vertex ids; 4 corners in the star pool at 1.4 slots each
 constexpr double kPerSplit = 4 + 4 + 24;    // undo log (splitJ, splitTetsBefore); record offsets (one per column)

@@ -196,6 +196,7 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   stream.chunkBytes = std::max<uint32_t>(opt.chunkKb, 1) << 10;
   stream.firstChunkBytes = std::min<uint32_t>(stream.chunkBytes, 16u << 10);
   stream.zstdLevel = opt.zstdLevel;
+  stream.ringWalk = opt.ringWalk;
   stream.progress = [&](uint32_t done, uint32_t planned) { progress("encode", done, planned); };
   EncodedStream enc;
   if (Result r = encodeStream(mesh, simplified, m, stream, enc); !r) return r;

@@ -194,6 +194,7 @@ class Encoder {
     // edge of a consistently oriented mesh the pairs (a, b) chain into the edge's link: a cycle
     // (interior edge) or a path (boundary edge), written as its vertices; otherwise as pairs.
     neighboursOf(pm_, js, candidates_);
+    link_.build(pm_.mesh, js, star_, candidates_);
     const uint32_t first = log.removedBegin[c], count = log.removedBegin[c + 1] - first;
     pairs_.clear();
     for (uint32_t n = 0; n < count; ++n) {
@@ -216,15 +217,17 @@ class Encoder {
         putVarint(list, candidateIndex(p.b));
       }
     } else {
-      for (const Pair& p : pairs_) putVarint(list, candidateIndex(p.a));
-      if (mode == RingMode::Path) putVarint(list, candidateIndex(pairs_.back().b));
+      ring_.clear();
+      for (const Pair& p : pairs_) ring_.push_back(p.a);
+      if (mode == RingMode::Path) ring_.push_back(pairs_.back().b);
+      putRing(list);
     }
     newTets_.clear();
     for (uint32_t n = 0; n < count; ++n) {
       newTets_.insert(newTets_.end(), {is, js, pairs_[n].a, pairs_[n].b});
       out_.streamTetOf[pairs_[n].tet] = pm_.tetCount() + n;
     }
-    putMoved(js);
+    putMoved();
 
     const float* pi = &mesh_.positions[3 * size_t(i)];
     const float* pj = &pm_.mesh.positions[3 * size_t(js)];
@@ -251,11 +254,26 @@ class Encoder {
     if (metered_) meter_.afterSplit(i, js, moved_, firstNew, jValueChanged);
   }
 
-  // T_moved: the marker 0 when the reader finds it from T_new (moved_tets.h), else 1 and a bit
+  // A cycle's or path's vertices (ring_) as a walk in p_j's link (FORMAT.md §4, flag bit 5):
+  // after the first, each by its rank among the link neighbours of the one before that are not
+  // on the ring yet, or past those by its index among all of p_j's neighbours.
+  void putRing(std::vector<uint8_t>& out) {
+    uint64_t used = 0;
+    uint32_t from = VertexLink::kNone;
+    for (uint32_t v : ring_) {
+      const uint32_t near = from != VertexLink::kNone ? link_.choices(from, used) : 0;
+      const uint32_t rank = from != VertexLink::kNone ? link_.rankOf(from, used, v) : VertexLink::kNone;
+      putVarint(out, rank != VertexLink::kNone ? rank : near + candidateIndex(v));
+      from = opt_.ringWalk ? link_.localOf(v) : VertexLink::kNone;
+      if (from != VertexLink::kNone) used |= uint64_t(1) << from;
+    }
+  }
+
+  // T_moved: the marker 0 when the reader finds it from T_new (vertex_link.h), else 1 and a bit
   // per tet around p_j (star_), in ascending order.
-  void putMoved(uint32_t js) {
+  void putMoved() {
     std::vector<uint8_t>& out = column(SplitColumn::Moved);
-    movedFinder_.find(pm_.mesh, js, star_, candidates_, newTets_, implied_);
+    link_.moved(newTets_, implied_);
     if (implied_ == moved_) {
       out.push_back(0);
       return;
@@ -323,7 +341,7 @@ class Encoder {
     const uint32_t index = uint32_t(jobs_.size());
     beginChunk(job.raw, ChunkKind::Splits, index);
     putU32(job.raw, inChunk_);
-    putU32(job.raw, kSplitFlagColumns | kSplitFlagImpliedMoved | (q_.lossless ? kSplitFlagLossless : 0) | (s_.valuesField >= 0 ? kSplitFlagKeptIsoValue : 0));
+    putU32(job.raw, kSplitFlagColumns | kSplitFlagImpliedMoved | (opt_.ringWalk ? kSplitFlagRingWalk : 0) | (q_.lossless ? kSplitFlagLossless : 0) | (s_.valuesField >= 0 ? kSplitFlagKeptIsoValue : 0));
     for (const std::vector<uint8_t>& c : columns_) putU32(job.raw, uint32_t(c.size()));
     for (const std::vector<uint8_t>& c : columns_) job.raw.insert(job.raw.end(), c.begin(), c.end());
     job.info.kind = ChunkKind::Splits;
@@ -390,7 +408,8 @@ class Encoder {
   std::vector<Pair> pairs_, chain_;
   std::deque<Job> jobs_;  // chunks being compressed, in order (stable addresses)
   std::vector<uint32_t> star_, moved_, candidates_, newTets_, changed_, implied_;
-  MovedTetsFinder movedFinder_;
+  VertexLink link_;  // of p_j, as the reader sees it
+  std::vector<uint32_t> ring_;
 
   uint32_t prevJ_ = 0, inChunk_ = 0;
   uint64_t target_ = 0;

@@ -18,6 +18,9 @@ struct StreamOptions {
   uint32_t firstChunkBytes = 16u << 10;  // compressed size aimed at by the first split chunk
   uint32_t chunkBytes = 256u << 10;      // later chunks double up to this size
   int zstdLevel = 18;
+  // Rings as walks in p_j's link (split flag bit 5). Off: every ring vertex by its place among
+  // p_j's neighbours, as packs before that flag (for tests of readers).
+  bool ringWalk = true;
   std::function<void(uint32_t done, uint32_t planned)> progress;  // splits encoded so far
 };
 
@@ -30,7 +33,7 @@ struct EncodedStream {
   std::vector<uint32_t> streamVertexOf;      // original vertex id -> id in the stream
   std::vector<uint32_t> streamTetOf;         // original tet id -> id in the stream
   double baseFieldError = 0;                 // estimated field error of the base mesh
-  uint32_t movedMasks = 0;                   // splits whose T_moved does not follow from T_new (moved_tets.h)
+  uint32_t movedMasks = 0;                   // splits whose T_moved does not follow from T_new (vertex_link.h)
 };
 
 // `mesh` is the simplifier's input (values on the quantization grid of `m` unless lossless);

@@ -55,7 +55,7 @@ before(async () => {
   checkBuilds();
   await precompressDir(webDir); // nginx's gzip_static must not send an older build's .gz
   tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'tetstream-network-'));
-  ({ dir: pack } = makePack(tmp, 'h24', { n: 24, packArgs: ['--chunk-kb', '16', '--name', NAME] }));
+  ({ dir: pack } = makePack(tmp, 'h24', { n: 24, packArgs: ['--chunk-kb', '12', '--name', NAME] }));
   manifest = readManifest(pack);
   assert.ok(manifest.chunks.length >= 8, `a stream of several chunks (${manifest.chunks.length})`);
 
@@ -202,7 +202,7 @@ test('over a slow link the chunks come one after another at the full rate, not a
   // Chunks sharing a link end together, and the viewer then gets all their splits at once: it is
   // still applying them long after the last byte. 64 KB chunks over 150 KB/s, 30 ms before each
   // response: a chunk alone takes ~0.4 s, and the next request should start only near its end.
-  const { dir } = makePack(tmp, 'h32', { n: 32, packArgs: ['--chunk-kb', '64'] });
+  const { dir } = makePack(tmp, 'h40', { n: 40, packArgs: ['--chunk-kb', '64'] });
   const chunks = readManifest(dir).chunks.length;
   const slow = createServer({ mounts: [{ prefix: '/data', dir }, { prefix: '/', dir: webDir }], throttleBytesPerSec: 150e3, latencyMs: 30 });
   const slowUrl = await listen(slow);

@@ -719,7 +719,7 @@ TEST(Progressive, KeptValueFlagsAreReadAsDocumented) {
     EXPECT_EQ(ZSTD_decompress(raw.data(), raw.size(), file.data(), file.size()), raw.size());
     uint32_t old;
     std::memcpy(&old, &raw[kChunkHeaderBytes + 4], 4);
-    const uint32_t layout = kSplitFlagColumns | kSplitFlagImpliedMoved;  // how the records are stored
+    const uint32_t layout = kSplitFlagColumns | kSplitFlagImpliedMoved | kSplitFlagRingWalk;  // how records are stored
     EXPECT_EQ(old, kSplitFlagKeptIsoValue | layout);
     flags |= layout;
     std::memcpy(&raw[kChunkHeaderBytes + 4], &flags, 4);
@@ -859,7 +859,7 @@ TEST(Progressive, SplitColumnsThatDoNotFillThePayloadAreRefused) {
   }
 }
 
-// T_moved follows from T_new (moved_tets.h) for all but a few splits of real packs: on a
+// T_moved follows from T_new (vertex_link.h) for all but a few splits of real packs: on a
 // cube, on a mesh with a non-convex boundary and creases, and with flat input tets.
 TEST(Progressive, MovedTetsFollowFromNewTetsOnAlmostEverySplit) {
   TetMesh flat = harmonic(12);  // one vertex pushed onto the layer below: flat tets around it
@@ -872,6 +872,25 @@ TEST(Progressive, MovedTetsFollowFromNewTetsOnAlmostEverySplit) {
     EXPECT_GT(s.splits, 500u) << name;
     EXPECT_LE(s.movedMasks, s.splits / 100) << name;
   }
+}
+
+// Rings as walks in p_j's link (flag bit 5) and as places among all of p_j's neighbours (packs
+// before that flag) decode to the same mesh; the walks take fewer bytes.
+TEST(Progressive, RingWalksDecodeLikePlainRingsInFewerBytes) {
+  const TetMesh m = lShape(12);
+  PackOptions o;
+  o.lossless = true;
+  PackSummary walk, plain;
+  const std::string a = pack("ring-walk", m, o, &walk);
+  o.ringWalk = false;
+  const std::string b = pack("ring-plain", m, o, &plain);
+  Dataset da, db;
+  ASSERT_TRUE(loadPackedDir(a, da));
+  ASSERT_TRUE(loadPackedDir(b, db));
+  EXPECT_EQ(da.pm.mesh.tets, db.pm.mesh.tets);
+  EXPECT_EQ(da.pm.mesh.positions, db.pm.mesh.positions);
+  EXPECT_EQ(da.pm.vertexCount(), m.vertexCount());
+  EXPECT_LT(walk.manifest.totalBytes(), plain.manifest.totalBytes() * 0.97);
 }
 
 // The moved marker is 0 or 1; anything else is refused, and the chunk leaves the level as it was.
@@ -917,7 +936,7 @@ TEST(Progressive, UndoLogKeepsOnlyTheFittedFieldsValue) {
   const ChunkInfo info = ds.manifest.chunks[3];
   std::vector<uint8_t> file = test::loadBytes(dir + "/" + info.file), raw(info.rawBytes);
   ASSERT_EQ(ZSTD_decompress(raw.data(), raw.size(), file.data(), file.size()), raw.size());
-  const uint32_t none = kSplitFlagColumns | kSplitFlagImpliedMoved;
+  const uint32_t none = kSplitFlagColumns | kSplitFlagImpliedMoved | kSplitFlagRingWalk;
   std::memcpy(&raw[kChunkHeaderBytes + 4], &none, 4);
   ASSERT_TRUE(finishChunk(raw, 3, file, ds.manifest.chunks[3]));
   const uint32_t v = ds.pm.vertexCount();
