@@ -6,28 +6,12 @@
 namespace tetstream {
 namespace {
 
-// Whether the stored tet v, read as (j, a, b, x), is an odd permutation of its stored order:
-// stored tets are positive, so (j, a, b, x) is then negative.
-bool oddAs(const uint32_t* v, uint32_t j, uint32_t a, uint32_t b) {
-  int pos[4] = {0, 0, 0, 0}, n = 0;
-  for (uint32_t want : {j, a, b})
-    for (int k = 0; k < 4; ++k)
-      if (v[k] == want && n < 3) pos[n++] = k;
-  pos[3] = 6 - pos[0] - pos[1] - pos[2];  // (the caller's tets hold j, a and b)
-  int inversions = 0;
-  for (int x = 0; x < 4; ++x)
-    for (int y = x + 1; y < 4; ++y) inversions += pos[x] > pos[y];
-  return inversions & 1;
-}
-
 uint64_t bit(uint32_t x) { return uint64_t(1) << x; }
 
 }  // namespace
 
 void VertexLink::build(const TetMesh& mesh, uint32_t j, std::span<const uint32_t> star,
                        std::span<const uint32_t> neighbours) {
-  mesh_ = &mesh;
-  j_ = j;
   star_ = star;
   neighbours_ = neighbours;
   const uint32_t L = uint32_t(neighbours.size());
@@ -39,12 +23,15 @@ void VertexLink::build(const TetMesh& mesh, uint32_t j, std::span<const uint32_t
   // these branches go either way at random, and mispredicting them cost more than the rest.)
   const size_t n = star.size();
   triangle_.resize(n);
+  corners_.resize(n);
   std::fill(adjacent_, adjacent_ + L, 0);
   for (size_t s = 0; s < n; ++s) {
     const uint32_t* v = &mesh.tets[4 * size_t(star[s])];
     const int at = (v[1] == j) + 2 * (v[2] == j) + 3 * (v[3] == j);  // j's slot
     // (Every vertex of a tet around j is a neighbour: its local_ entry is from this call.)
     const uint32_t p = local_[v[at == 0 ? 1 : 0]], q = local_[v[at <= 1 ? 2 : 1]], r = local_[v[at <= 2 ? 3 : 2]];
+    // (j, p, q, r) takes `at` swaps from the stored order: odd `at`, it is negative.
+    corners_[s] = p | q << 8 | r << 16 | uint32_t(at & 1) << 24;
     triangle_[s] = bit(p) | bit(q) | bit(r);
     adjacent_[p] |= bit(q) | bit(r);
     adjacent_[q] |= bit(p) | bit(r);
@@ -90,22 +77,20 @@ void VertexLink::moved(std::span<const uint32_t> newTets, std::vector<uint32_t>&
     ringVertices |= bit(a) | bit(b);
   }
   // The seeds: a tet with a ring edge (a, b) came from p_i exactly when (j, a, b, x) is negative.
+  // With (j, p, q, r) the tet in stored order (its sign from corners_), (j, a, b, x) has the same
+  // sign when (a, b) runs along p → q → r → p, the other sign when against it.
   uint64_t sideI = 0, sideJ = 0;  // link vertices off the ring known to be on either side
-  side_.assign(n, 0);
+  side_.resize(n);
   for (size_t s = 0; s < n; ++s) {
-    const uint64_t tri = triangle_[s];
-    if (!(tri & ringVertices)) continue;
-    bool fromI = false, fromJ = false;
-    for (uint64_t as = tri; as; as &= as - 1) {
-      const uint32_t a = uint32_t(std::countr_zero(as));
-      for (uint64_t bs = ringOut_[a] & tri; bs; bs &= bs - 1) {
-        const uint32_t b = uint32_t(std::countr_zero(bs));
-        (oddAs(&mesh_->tets[4 * size_t(star_[s])], j_, neighbours_[a], neighbours_[b]) ? fromI : fromJ) = true;
-      }
-    }
-    side_[s] = fromI;
-    if (fromI) sideI |= tri & ~ringVertices;
-    if (fromJ) sideJ |= tri & ~ringVertices;
+    const uint32_t c = corners_[s], p = c & 0xff, q = c >> 8 & 0xff, r = c >> 16 & 0xff;
+    const uint64_t along = (ringOut_[p] >> q | ringOut_[q] >> r | ringOut_[r] >> p) & 1;
+    const uint64_t against = (ringOut_[q] >> p | ringOut_[r] >> q | ringOut_[p] >> r) & 1;
+    const uint64_t negative = c >> 24;  // (j, p, q, r) is negative
+    const uint64_t fromI = negative ? along : against, fromJ = negative ? against : along;
+    side_[s] = uint8_t(fromI);
+    const uint64_t off = triangle_[s] & ~ringVertices;
+    sideI |= off & (0 - fromI);
+    sideJ |= off & (0 - fromJ);
   }
   // p_i's side: every link vertex off the ring that a path off the ring joins to a seed's.
   for (uint64_t frontier = sideI; frontier;) {
