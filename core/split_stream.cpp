@@ -111,10 +111,12 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
   r.newTets.clear();
   const uint32_t nc = uint32_t(r.candidates.size());
   ByteReader& tetsIn = r.column(SplitColumn::NewTets);
+  // A vertex by its place among j's neighbours, or past them its id.
+  auto named = [&](uint32_t x) { return x < nc ? r.candidates[x] : x - nc; };
   auto read = [&](uint32_t& v) {
     uint32_t x;
     if (!tetsIn.varint(x)) return false;
-    v = x < nc ? r.candidates[x] : x - nc;
+    v = named(x);
     return true;
   };
   auto valid = [&](uint32_t v) { return v < V && v != j; };
@@ -138,12 +140,7 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
       uint32_t x;
       if (!tetsIn.varint(x)) return fail(Status::Truncated, "split chunk: record ends early");
       const uint32_t near = from != VertexLink::kNone ? r.link.choices(from, used) : 0;
-      if (x < near) {
-        v = r.link.choice(from, used, x);
-      } else {
-        x -= near;
-        v = x < nc ? r.candidates[x] : x - nc;
-      }
+      v = x < near ? r.link.choice(from, used, x) : named(x - near);
       if (!valid(v)) return fail(Status::OutOfRange, "split chunk: a new tet has an invalid vertex");
       from = r.ringWalk ? r.link.localOf(v) : VertexLink::kNone;
       if (from != VertexLink::kNone) used |= uint64_t(1) << from;

@@ -35,10 +35,8 @@ class VertexLink {
   // star: the tets around j, ascending ids; neighbours: the distinct vertices of those tets
   // other than j, ascending (their places are the link's local vertex numbers).
   void build(const TetMesh& mesh, uint32_t j, std::span<const uint32_t> star, std::span<const uint32_t> neighbours);
-  // Whether the link is small enough for bit masks (kMaxLink); without, walks and T_moved are
-  // not available (every ring vertex is coded on its own, T_moved found empty).
-  bool usable() const { return usable_; }
-  // The local number of mesh vertex v, or kNone when v is no neighbour of j.
+  // The local number of mesh vertex v, or kNone when v is no neighbour of j. A link of more than
+  // kMaxLink vertices has none: no walks (every ring vertex is named on its own) and no T_moved.
   uint32_t localOf(uint32_t v) const;
 
   // Ring walks. `used`: the local numbers of the ring vertices so far, as bits. The next vertex's
@@ -51,7 +49,7 @@ class VertexLink {
 
   // T_moved for the new tets (i, j, a, b) (each vertex < the mesh's vertex count, or i), ascending
   // tet ids. May leave out tets it cannot place (a link triangle with all three vertices on the
-  // ring and no ring edge; none without usable()), which the packer's check then finds.
+  // ring and no ring edge; none beyond kMaxLink), which the packer's check then finds.
   void moved(std::span<const uint32_t> newTets, std::vector<uint32_t>& out);
 
  private:

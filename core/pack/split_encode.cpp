@@ -184,7 +184,7 @@ class Encoder {
     putVarint(column(SplitColumn::KeptVertex), zigzag(int32_t(js) - int32_t(prevJ_)));
     prevJ_ = js;
 
-    // Moved tets as a bit mask over star(j), ascending.
+    // T_moved in stream tet ids, ascending (written by putMoved() once T_new is known).
     moved_.clear();
     for (uint32_t k = log.movedBegin[c]; k < log.movedBegin[c + 1]; ++k) moved_.push_back(out_.streamTetOf[log.moved[k]]);
     std::sort(moved_.begin(), moved_.end());
@@ -341,7 +341,8 @@ class Encoder {
     const uint32_t index = uint32_t(jobs_.size());
     beginChunk(job.raw, ChunkKind::Splits, index);
     putU32(job.raw, inChunk_);
-    putU32(job.raw, kSplitFlagColumns | kSplitFlagImpliedMoved | (opt_.ringWalk ? kSplitFlagRingWalk : 0) | (q_.lossless ? kSplitFlagLossless : 0) | (s_.valuesField >= 0 ? kSplitFlagKeptIsoValue : 0));
+    putU32(job.raw, kSplitFlagColumns | kSplitFlagImpliedMoved | (opt_.ringWalk ? kSplitFlagRingWalk : 0) |
+                        (q_.lossless ? kSplitFlagLossless : 0) | (s_.valuesField >= 0 ? kSplitFlagKeptIsoValue : 0));
     for (const std::vector<uint8_t>& c : columns_) putU32(job.raw, uint32_t(c.size()));
     for (const std::vector<uint8_t>& c : columns_) job.raw.insert(job.raw.end(), c.begin(), c.end());
     job.info.kind = ChunkKind::Splits;
@@ -410,7 +411,6 @@ class Encoder {
   std::vector<uint32_t> star_, moved_, candidates_, newTets_, changed_, implied_;
   VertexLink link_;  // of p_j, as the reader sees it
   std::vector<uint32_t> ring_;
-
   uint32_t prevJ_ = 0, inChunk_ = 0;
   uint64_t target_ = 0;
   uint64_t flushedRaw_ = 0;  // record bytes of the chunks before the current one

@@ -41,6 +41,14 @@ std::string tempDir(const std::string& name) { return test::suiteDir("progressiv
 TetMesh harmonic(uint32_t n) { return test::harmonicMesh(n); }
 uint32_t gridVertex(uint32_t n, uint32_t i, uint32_t j, uint32_t k) { return i + n * (j + n * k); }
 
+// Chunk `info` of the pack in `dir`, decompressed (empty when that fails).
+std::vector<uint8_t> rawChunk(const std::string& dir, const ChunkInfo& info) {
+  const std::vector<uint8_t> file = test::loadBytes(dir + "/" + info.file);
+  std::vector<uint8_t> raw(info.rawBytes);
+  if (ZSTD_decompress(raw.data(), raw.size(), file.data(), file.size()) != raw.size()) raw.clear();
+  return raw;
+}
+
 // Harmonic n³ without the tets whose centroid `drop` selects, and without the vertices no
 // tet uses any more.
 template <typename Drop>
@@ -715,8 +723,8 @@ TEST(Progressive, KeptValueFlagsAreReadAsDocumented) {
   // Chunk 1 with its flags word replaced, re-compressed, and the manifest entry to match.
   auto withFlags = [&](Dataset& ds, uint32_t flags) {
     const ChunkInfo info = ds.manifest.chunks[1];
-    std::vector<uint8_t> file = test::loadBytes(dir + "/" + info.file), raw(info.rawBytes);
-    EXPECT_EQ(ZSTD_decompress(raw.data(), raw.size(), file.data(), file.size()), raw.size());
+    std::vector<uint8_t> file, raw = rawChunk(dir, info);
+    EXPECT_EQ(raw.size(), info.rawBytes);
     uint32_t old;
     std::memcpy(&old, &raw[kChunkHeaderBytes + 4], 4);
     const uint32_t layout = kSplitFlagColumns | kSplitFlagImpliedMoved | kSplitFlagRingWalk;  // how records are stored
@@ -771,9 +779,8 @@ static void readRowsAndColumns(bool lossless) {
   ASSERT_GE(cols.manifest.chunks.size(), 4u);
   for (uint32_t c = 1; c < cols.manifest.chunks.size(); ++c) {
     const ChunkInfo info = cols.manifest.chunks[c];
-    const std::vector<uint8_t> file = test::loadBytes(dir + "/" + info.file);
-    std::vector<uint8_t> raw(info.rawBytes);
-    ASSERT_EQ(ZSTD_decompress(raw.data(), raw.size(), file.data(), file.size()), raw.size());
+    const std::vector<uint8_t> file = test::loadBytes(dir + "/" + info.file), raw = rawChunk(dir, info);
+    ASSERT_EQ(raw.size(), info.rawBytes);
     uint32_t flags, length[kSplitColumns];
     std::memcpy(&flags, &raw[kChunkHeaderBytes + 4], 4);
     ASSERT_TRUE(flags & kSplitFlagColumns);
@@ -842,8 +849,8 @@ TEST(Progressive, SplitColumnsThatDoNotFillThePayloadAreRefused) {
     Dataset ds;
     ASSERT_TRUE(loadPackedDir(dir, ds, 1));
     const ChunkInfo info = ds.manifest.chunks[1];
-    std::vector<uint8_t> file = test::loadBytes(dir + "/" + info.file), raw(info.rawBytes);
-    ASSERT_EQ(ZSTD_decompress(raw.data(), raw.size(), file.data(), file.size()), raw.size());
+    std::vector<uint8_t> file, raw = rawChunk(dir, info);
+    ASSERT_EQ(raw.size(), info.rawBytes);
     uint32_t length;
     const size_t at = kChunkHeaderBytes + 8 + 4 * uint32_t(SplitColumn::NewTets);
     std::memcpy(&length, &raw[at], 4);
@@ -901,8 +908,8 @@ TEST(Progressive, AMovedMarkerOtherThanZeroOrOneIsRefused) {
   Dataset ds;
   ASSERT_TRUE(loadPackedDir(dir, ds, 1));
   const ChunkInfo info = ds.manifest.chunks[1];
-  std::vector<uint8_t> file = test::loadBytes(dir + "/" + info.file), raw(info.rawBytes);
-  ASSERT_EQ(ZSTD_decompress(raw.data(), raw.size(), file.data(), file.size()), raw.size());
+  std::vector<uint8_t> file, raw = rawChunk(dir, info);
+  ASSERT_EQ(raw.size(), info.rawBytes);
   uint32_t length[kSplitColumns];
   std::memcpy(length, &raw[kChunkHeaderBytes + 8], sizeof length);
   size_t at = kChunkHeaderBytes + 8 + sizeof length;  // the Moved column follows the KeptVertex one
@@ -934,8 +941,8 @@ TEST(Progressive, UndoLogKeepsOnlyTheFittedFieldsValue) {
   EXPECT_EQ(ds.pm.keptFirst, uint32_t(ds.manifest.findField(ds.manifest.isoField)));
   // Chunk 3 written without kept values (as --samples would), after two chunks with them.
   const ChunkInfo info = ds.manifest.chunks[3];
-  std::vector<uint8_t> file = test::loadBytes(dir + "/" + info.file), raw(info.rawBytes);
-  ASSERT_EQ(ZSTD_decompress(raw.data(), raw.size(), file.data(), file.size()), raw.size());
+  std::vector<uint8_t> file, raw = rawChunk(dir, info);
+  ASSERT_EQ(raw.size(), info.rawBytes);
   const uint32_t none = kSplitFlagColumns | kSplitFlagImpliedMoved | kSplitFlagRingWalk;
   std::memcpy(&raw[kChunkHeaderBytes + 4], &none, 4);
   ASSERT_TRUE(finishChunk(raw, 3, file, ds.manifest.chunks[3]));
