@@ -31,6 +31,7 @@ struct PackOptions {
   double maxMemoryBytes = 0;              // refuse meshes that need more (0: 90% of physical memory)
   int threads = 2;                        // threads that evaluate collapse costs (1 or 2; same output)
   uint32_t partitionMinVertices = 50000;  // simplify in slabs at once from this size (SimplifyOptions)
+  uint32_t renumberMinTets = 50000;       // renumber scattered meshes from this size (pack/renumber.h)
   // Progress for displays: phase ("validate", "simplify", "encode", "write"), items done and
   // planned in that phase (collapses, splits; 0 planned when not countable).
   std::function<void(const char* phase, uint64_t done, uint64_t planned)> progress;
