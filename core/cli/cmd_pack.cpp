@@ -1,5 +1,5 @@
 // tetstream pack INPUT -o OUTDIR [--field NAME] [--weights G,F,S] [--base-fraction F |
-//   --base-vertices N | --max-error E] [--lossless] [--chunk-kb K] [--json]
+//   --base-vertices N | --max-error E] [--lossless] [--compact] [--chunk-kb K] [--json]
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -74,7 +74,7 @@ Runner addPack(CLI::App& app) {
     double baseFraction = 0.01, maxError = -1, maxMemoryGb = 0;
     uint32_t baseVertices = 0, baseTets = 0, chunkKb = 256;
     int level = 18, threads = 2;
-    bool lossless = false, json = false, samples = false;
+    bool lossless = false, json = false, samples = false, compact = false;
     ReadOptions read;
   };
   auto o = std::make_shared<Opts>();
@@ -101,6 +101,9 @@ Runner addPack(CLI::App& app) {
   sub->add_flag("--samples", o->samples,
                 "coarse levels keep the input's values at their vertices (default: values fitted to the region "
                 "each vertex stands for, which lowers the field error; the full level is the input either way)");
+  sub->add_flag("--compact", o->compact,
+                "a smaller stream (1-14% on the test datasets) for a longer pack (3-6%) and ~20% more memory: "
+                "inside each chunk the splits go by kept vertex, not by cost");
   sub->add_option("--chunk-kb", o->chunkKb, "largest split chunk in KB; the first chunks are smaller")
       ->check(CLI::Range(1u, 65536u))->capture_default_str();
   sub->add_option("--zstd-level", o->level, "zstd compression level")->check(CLI::Range(1, 22))->capture_default_str();
@@ -138,6 +141,7 @@ Runner addPack(CLI::App& app) {
       opt.baseFraction = 0;  // as far as the error bound allows
     }
     opt.lossless = o->lossless;
+    opt.orderSplits = o->compact;
     opt.chunkKb = o->chunkKb;
     opt.maxMemoryBytes = o->maxMemoryGb * 1e9;
     opt.progress = [&bar](const char* phase, uint64_t done, uint64_t planned) { bar.update(phase, done, planned); };

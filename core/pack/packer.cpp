@@ -178,6 +178,7 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   so.partitionMinVertices = opt.partitionMinVertices;
   so.fitValues = opt.fitValues;
   so.field = iso;
+  so.recordReadSets = opt.orderSplits;
   so.maxError = opt.maxError;
   so.targetTets = opt.baseTets;
   so.targetVertices = opt.baseVertices ? opt.baseVertices
@@ -207,6 +208,7 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   stream.firstChunkBytes = std::min<uint32_t>(stream.chunkBytes, 16u << 10);
   stream.zstdLevel = opt.zstdLevel;
   stream.ringWalk = opt.ringWalk;
+  stream.orderSplits = opt.orderSplits;
   stream.progress = [&](uint32_t done, uint32_t planned) { progress("encode", done, planned); };
   EncodedStream enc;
   if (Result r = encodeStream(mesh, simplified, m, stream, enc); !r) return r;

@@ -206,6 +206,7 @@ class Simplifier {
     }
     out_.log.movedBegin.push_back(uint32_t(out_.log.moved.size()));
     out_.log.removedBegin.push_back(uint32_t(out_.log.removed.size()));
+    if (opt_.recordReadSets) out_.log.starBegin.push_back(uint32_t(out_.log.star.size()));
     if (fitOn_ && opt_.refitValues) refitValues();
     if (fitOn_) {
       out_.values = fit_;
@@ -984,6 +985,7 @@ class Simplifier {
     out_.log.moved.reserve(size_t(expected * movedEach));
     out_.log.removed.reserve(size_t(expected * removedEach));
     out_.log.removedVertices.reserve(size_t(4 * expected * removedEach));
+    if (opt_.recordReadSets) out_.log.star.reserve(size_t(expected * 4.0 * tetsAlive_ / std::max<uint32_t>(alive_, 1)));
 
     const double budgetV = kPartShare * planned;
     const double budgetT = opt_.targetTets > 0 ? kPartShare * (double(tetsAlive_) - opt_.targetTets) : kInf;
@@ -1112,6 +1114,7 @@ class Simplifier {
   static void forEachArray(F f, Logs&... logs) {
     f(logs.i...), f(logs.j...), f(logs.fieldError...), f(logs.iValue...), f(logs.jValue...);
     f(logs.movedBegin...), f(logs.moved...), f(logs.removedBegin...), f(logs.removed...), f(logs.removedVertices...);
+    f(logs.starBegin...), f(logs.star...);
   }
 
   // Appends collapse c of `src` (whose begin arrays have no closing entry yet) to `dst`.
@@ -1129,6 +1132,10 @@ class Simplifier {
     dst.removed.insert(dst.removed.end(), src.removed.begin() + r0, src.removed.begin() + r1);
     dst.removedVertices.insert(dst.removedVertices.end(), src.removedVertices.begin() + 4 * size_t(r0),
                                src.removedVertices.begin() + 4 * size_t(r1));
+    if (src.starBegin.empty()) return;  // (no read sets recorded)
+    const uint32_t s0 = src.starBegin[c], s1 = c + 1 < src.size() ? src.starBegin[c + 1] : uint32_t(src.star.size());
+    dst.starBegin.push_back(uint32_t(dst.star.size()));
+    dst.star.insert(dst.star.end(), src.star.begin() + s0, src.star.begin() + s1);
   }
 
   // ------------------------------------------------------------------ link condition
@@ -1580,6 +1587,10 @@ class Simplifier {
       float before = kappa_[t];
       kappa_[t] = tetKappa(t);
       for (int k = 0; k < 4; ++k) qualitySum_[v[k]] += 3.0 / kappa_[t] - (v[k] == j ? 0.0 : 3.0 / before);
+    }
+    if (opt_.recordReadSets) {
+      log.starBegin.push_back(uint32_t(log.star.size()));
+      log.star.insert(log.star.end(), star_[j].begin(), star_[j].end());
     }
     star_[i].clear();
     star_[i].shrink_to_fit();

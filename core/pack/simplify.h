@@ -78,6 +78,8 @@ struct SimplifyOptions {
   // all together, to the input field at every input vertex (least squares; simplify.cpp).
   bool refitValues = true;
   std::function<void(uint32_t done, uint32_t planned)> progress;  // called now and then
+  // Keep in the log what each split reads (CollapseLog::star), for StreamOptions::orderSplits.
+  bool recordReadSets = false;
   bool verifyLinkCondition = false;  // tests: also run the slow reference link check, count mismatches
   // Threads (1 or 2; the result is the same either way): the slabs run on one each, and the
   // one queue evaluates its next entries on both for meshes of at least parallelMinVertices
@@ -99,6 +101,8 @@ struct CollapseLog {
   std::vector<uint32_t> removedBegin;    // likewise for removed tets
   std::vector<uint32_t> removed;         // tet ids removed by the collapse
   std::vector<uint32_t> removedVertices; // 4 per removed tet: its vertices just before the collapse
+  std::vector<uint32_t> starBegin;       // likewise for star: the tets around j just after the collapse,
+  std::vector<uint32_t> star;            // what its split reads (only with recordReadSets; split_order.h)
 
   uint32_t size() const { return uint32_t(i.size()); }
 };

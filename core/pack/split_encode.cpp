@@ -1,12 +1,14 @@
 #include "pack/split_encode.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cassert>
 #include <deque>
 #include <future>
 
 #include "pack/chunk_encode.h"
 #include "pack/level_error.h"
+#include "pack/split_order.h"
 #include "progressive.h"
 #include "quantize.h"
 #include "split_stream.h"
@@ -61,9 +63,11 @@ class Encoder {
   }
 
  private:
+  // In cost order: each split encoded and applied, a chunk flushed once it holds its share.
   Result encodeSplits(uint32_t C) {
     target_ = opt_.firstChunkBytes;
     startChunk();
+    if (opt_.orderSplits && !s_.log.starBegin.empty()) return encodeOrderedSplits(C);
     for (uint32_t c = C; c-- > 0;) {
       encodeSplit(c);
       ++inChunk_;
@@ -76,6 +80,53 @@ class Encoder {
     }
     return collect();
   }
+
+  // Towards the end chunks halve again (a chunk ends once it holds about as many bytes as the
+  // splits still to come would take, at the mean size so far), down to the first chunk's size:
+  // a viewer that keeps pace with the link then has a small last chunk to apply when the last
+  // byte arrives, instead of a whole large one. A rest smaller than that stays in the chunk.
+  bool tapers(uint32_t done, uint32_t left) const {
+    const double least = opt_.firstChunkBytes * ratio_;
+    const double rest = double(left) * double(flushedRaw_ + recordBytes()) / double(done);
+    return double(recordBytes()) >= std::max(least, rest) && rest >= least;
+  }
+
+  // StreamOptions::orderSplits: chunk by chunk, how many splits it takes (plannedSplits), their
+  // order (split_order.h), then each split encoded and applied in that order. Split s undoes
+  // collapse C − 1 − s.
+  Result encodeOrderedSplits(uint32_t C) {
+    SplitOrder order(mesh_.tetCount());
+    const CollapseLog& log = s_.log;
+    for (uint32_t done = 0; done < C;) {
+      const uint32_t count = plannedSplits(done, C);
+      order.plan(log, done, count);
+      order.run([&](uint32_t s) { return out_.streamVertexOf[log.j[C - 1 - s]]; },
+                [&](uint32_t s) {
+                  encodeSplit(C - 1 - s);
+                  ++inChunk_;
+                  if (opt_.progress && (inChunk_ & 4095) == 0) opt_.progress(done + inChunk_, C);
+                });
+      done += count;
+      if (Result r = flushChunk(done); !r) {
+        collect();
+        return r;
+      }
+    }
+    return collect();
+  }
+
+  // The splits the next ordered chunk takes, planned before it is encoded: from the record bytes
+  // per split so far (a guess for the first chunk), about target_ bytes once compressed at the
+  // ratio seen, halving towards the end like tapers().
+  uint32_t plannedSplits(uint32_t done, uint32_t C) const {
+    const double perSplit = done ? double(flushedRaw_) / done : kFirstGuessBytesPerSplit;
+    const uint32_t left = C - done;
+    const double least = opt_.firstChunkBytes * ratio_ / perSplit;  // in splits
+    double count = std::ceil(double(target_) * ratio_ / perSplit);
+    if (2 * count >= left && left - std::ceil(left / 2.0) >= least) count = std::ceil(left / 2.0);
+    return uint32_t(std::clamp(count, 1.0, double(left)));
+  }
+  static constexpr double kFirstGuessBytesPerSplit = 12;  // Harmonic 64³: 11.5, carotid 14
 
   // Each level's field error, measured at the input's vertices (level_error.h) for the field
   // that steered the simplification: the base at every input vertex on another thread (it reads
@@ -129,16 +180,6 @@ class Encoder {
       pm_.keptCount = 1;
       pm_.keptFixed = true;
     }
-  }
-
-  // Towards the end chunks halve again (a chunk ends once it holds about as many bytes as the
-  // splits still to come would take, at the mean size so far), down to the first chunk's size:
-  // a viewer that keeps pace with the link then has a small last chunk to apply when the last
-  // byte arrives, instead of a whole large one. A rest smaller than that stays in the chunk.
-  bool tapers(uint32_t done, uint32_t left) const {
-    const double least = opt_.firstChunkBytes * ratio_;
-    const double rest = double(left) * double(flushedRaw_ + recordBytes()) / double(done);
-    return double(recordBytes()) >= std::max(least, rest) && rest >= least;
   }
 
   // The current chunk's records so far, in bytes (all columns).

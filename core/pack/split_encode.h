@@ -21,6 +21,9 @@ struct StreamOptions {
   // Rings as walks in p_j's link (split flag bit 5). Off: every ring vertex by its place among
   // p_j's neighbours, as packs before that flag (for tests of readers).
   bool ringWalk = true;
+  // Inside each chunk, splits in waves by kept vertex instead of in cost order (split_order.h):
+  // a smaller kept-vertex column. Needs the simplifier's read sets (recordReadSets).
+  bool orderSplits = false;
   std::function<void(uint32_t done, uint32_t planned)> progress;  // splits encoded so far
 };
 

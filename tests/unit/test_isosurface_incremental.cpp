@@ -495,14 +495,16 @@ TEST(IncrementalIso, BenchmarkHarmonic64) {
 
 // The same property on the real stream: pack Harmonic, then walk the level up and down through
 // every received split (applySplit / undoSplit via the dataset), updating locally after every
-// few splits, and compare with a from-scratch extraction each time.
-TEST(IncrementalIso, RealVertexSplitsEqualFromScratch) {
-  test::ScratchDir dir("incremental-real");
+// few splits, and compare with a from-scratch extraction each time. With orderSplits the splits
+// of each chunk come by kept vertex (pack --compact).
+void expectRealSplitsEqualFromScratch(bool orderSplits) {
+  test::ScratchDir dir(orderSplits ? "incremental-real-ordered" : "incremental-real");
   TetMesh m = makeGridMesh(10);
   addHarmonicField(m);
   PackOptions o;
   o.chunkKb = 1;
   o.zstdLevel = 3;
+  o.orderSplits = orderSplits;
   PackSummary s;
   ASSERT_TRUE(packMesh(m, dir.path, o, s));
   Dataset ds;
@@ -530,3 +532,6 @@ TEST(IncrementalIso, RealVertexSplitsEqualFromScratch) {
     EXPECT_EQ(ds.pm.vertexCount(), m.vertexCount());
   }
 }
+
+TEST(IncrementalIso, RealVertexSplitsEqualFromScratch) { expectRealSplitsEqualFromScratch(false); }
+TEST(IncrementalIso, RealVertexSplitsInKeptVertexOrderEqualFromScratch) { expectRealSplitsEqualFromScratch(true); }
