@@ -154,6 +154,10 @@ def bench_mesh(name, mesh, field, iso, tmp, with_vtk, quick, repeat, light=False
     res["size"] = {"bytes": p["bytes"], "bitsPerTet": p["bitsPerTet"], "bytesPerSplit": p["bytesPerSplit"],
                    "baseBytes": p["baseBytes"], "baseVertices": p["baseVertices"], "chunks": p["chunks"],
                    "zstd19RawBitsPerTet": 8 * zstd19_bytes(mesh, tmp) / tets, "packMs": p["ms"]}
+    # pack --compact: the same levels, splits by kept vertex inside each chunk (one run).
+    c = run_json([CLI, "pack", mesh, "-o", os.path.join(tmp, "compact"), "--field", field, "--compact", "--json"])
+    res["size"]["compact"] = {"bytes": c["bytes"], "bitsPerTet": c["bitsPerTet"], "packMs": c["ms"],
+                              "peakMemoryMB": c["peakMemoryMB"], "defaultPeakMemoryMB": p["peakMemoryMB"]}
     # Isosurface on the full mesh: ours (in-process extraction time of `tetstream iso`) and VTK.
     ours_iso = [run_json([CLI, "iso", mesh, "--field", field, "--value", str(iso), "--json"]) for _ in range(repeat)]
     res["iso"] = {"isovalue": iso, "triangles": ours_iso[0]["triangles"], "ms": median([r["ms"] for r in ours_iso])}
@@ -196,10 +200,14 @@ def markdown(results, machine):
             lines.append(f"| {r['name']} | {e['fraction']:.0%}{star} ({o['tets']:,}) | {o['rmsRelative']:.5f} / {o['maxRelative']:.4f} | {vtxt} | "
                          f"{o['volumeRatio']:.5f} | {vvol} | {o['meanQuality']:.3f} / {vq} |")
     results = [r for r in results if "size" in r]  # (the --large case stops after the errors)
-    lines += ["", "| dataset | packed bits/tet | bytes/split | zstd -19 raw bits/tet | base | chunks |", "|---|---|---|---|---|---|"]
+    lines += ["", "Default pack (one run; `--compact`: splits by kept vertex inside each chunk):", "",
+              "| dataset | packed bits/tet | bytes/split | zstd -19 raw bits/tet | base | chunks | --compact bits/tet (bytes) | pack ms / --compact | peak MB / --compact |",
+              "|---|---|---|---|---|---|---|---|---|"]
     for r in results:
         s = r["size"]
-        lines.append(f"| {r['name']} | {s['bitsPerTet']:.1f} | {s['bytesPerSplit']:.1f} | {s['zstd19RawBitsPerTet']:.1f} | {s['baseVertices']:,} vertices, {s['baseBytes'] / 1024:.0f} KB | {s['chunks']} |")
+        c = s["compact"]
+        lines.append(f"| {r['name']} | {s['bitsPerTet']:.1f} | {s['bytesPerSplit']:.1f} | {s['zstd19RawBitsPerTet']:.1f} | {s['baseVertices']:,} vertices, {s['baseBytes'] / 1024:.0f} KB | {s['chunks']} | "
+                     f"{c['bitsPerTet']:.1f} ({100 * (c['bytes'] / s['bytes'] - 1):+.1f}%) | {s['packMs']:.0f} / {c['packMs']:.0f} | {c['defaultPeakMemoryMB']:.0f} / {c['peakMemoryMB']:.0f} |")
     lines += ["", "| dataset | isosurface on the full mesh: triangles | tetstream (ms) | VTK vtkContourFilter (ms) | ratio |", "|---|---|---|---|---|"]
     for r in results:
         i = r["iso"]
