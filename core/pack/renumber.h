@@ -1,8 +1,8 @@
 // Numbering for memory locality. The simplifier and the encoder walk from a vertex to the tets
 // around it and on to their vertices; with a numbering that keeps neighbours close in memory
 // those walks stay in the caches. Meshes from grids and most solvers are numbered that way, but
-// some are not (Delaunay meshers number points as they insert them; a mesh unpacked from a
-// stream comes in stream order): ironProt.vtk packed 1.4× slower in stream order.
+// some are not (meshers that number points as they insert them; kiefer_dataset.vtu; a mesh
+// unpacked from a stream comes in stream order): ironProt.vtk packed 1.4× slower in stream order.
 #pragma once
 #include <cstdint>
 
