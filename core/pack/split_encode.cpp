@@ -69,6 +69,10 @@ class Encoder {
     startChunk();
     if (opt_.orderSplits && !s_.log.starBegin.empty()) return encodeOrderedSplits(C);
     for (uint32_t c = C; c-- > 0;) {
+      if (!splitFits(c)) {
+        collect();
+        return misfit();
+      }
       encodeSplit(c);
       ++inChunk_;
       if (opt_.progress && (c & 4095) == 0) opt_.progress(C - c, C);
@@ -100,14 +104,18 @@ class Encoder {
     for (uint32_t done = 0; done < C;) {
       const uint32_t count = plannedSplits(done, C);
       order.plan(log, done, count);
+      bool misfits = false;
       order.run([&](uint32_t s) { return out_.streamVertexOf[log.j[C - 1 - s]]; },
                 [&](uint32_t s) {
+                  misfits = misfits || !splitFits(C - 1 - s);
+                  if (misfits) return;
                   encodeSplit(C - 1 - s);
                   ++inChunk_;
                   if (opt_.progress && (inChunk_ & 4095) == 0) opt_.progress(done + inChunk_, C);
                 });
       done += count;
-      if (Result r = flushChunk(done); !r) {
+      Result r = misfits ? misfit() : flushChunk(done);
+      if (!r) {
         collect();
         return r;
       }
@@ -215,6 +223,25 @@ class Encoder {
     if (q_.lossless) putF32(out, value);
     else putVarint(out, zigzag(int32_t(axis.quantize(value)) - int32_t(axis.quantize(predictor))));
   }
+
+  // Whether the split that undoes collapse c meets the mesh its log describes: p_j there and p_i
+  // not yet, T_moved's tets around p_j, T_new's other vertices there. Always so in cost order and
+  // in split_order.h's order; checked anyway (a few lookups a split), as applySplit trusts it.
+  bool splitFits(uint32_t c) const {
+    const CollapseLog& log = s_.log;
+    const uint32_t js = out_.streamVertexOf[log.j[c]];
+    if (js == kNone || out_.streamVertexOf[log.i[c]] != kNone) return false;
+    for (uint32_t k = log.movedBegin[c]; k < log.movedBegin[c + 1]; ++k) {
+      const uint32_t t = out_.streamTetOf[log.moved[k]];
+      if (t >= pm_.tetCount()) return false;
+      const uint32_t* v = &pm_.mesh.tets[4 * size_t(t)];
+      if (v[0] != js && v[1] != js && v[2] != js && v[3] != js) return false;
+    }
+    for (uint32_t k = 4 * log.removedBegin[c]; k < 4 * log.removedBegin[c + 1]; ++k)
+      if (log.removedVertices[k] != log.i[c] && out_.streamVertexOf[log.removedVertices[k]] == kNone) return false;
+    return true;
+  }
+  static Result misfit() { return fail(Status::Corrupt, "encoder: a split does not fit the mesh it undoes (internal error)"); }
 
   void encodeSplit(uint32_t c) {
     const CollapseLog& log = s_.log;
