@@ -129,7 +129,7 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
     summary.notes.push_back("re-oriented " + std::to_string(summary.flippedTets) + " negatively oriented tetrahedra");
   // A numbering that scatters neighbours costs the simplifier and the encoder cache misses at
   // every step (renumber.h): such meshes are renumbered first (the stream has its own numbering).
-  if (const double spread = numberingSpread(mesh); mesh.tetCount() >= opt.renumberMinTets && spread > kScatteredNumbering) {
+  if (const double spread = mesh.tetCount() >= opt.renumberMinTets ? numberingSpread(mesh) : 0.0; spread > kScatteredNumbering) {
     renumberForLocality(mesh, adjacency);
     char note[160];
     std::snprintf(note, sizeof note, "renumbered vertices and tetrahedra for speed: the file's numbering scatters "

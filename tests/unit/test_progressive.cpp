@@ -187,6 +187,13 @@ void expectSameMesh(const TetMesh& in, const TetMesh& out, const Quantizer& q, b
   }
 }
 
+// Two packed folders hold the same bytes: manifest and every chunk file.
+void expectSamePack(const std::string& a, const std::string& b) {
+  EXPECT_EQ(test::loadFile(a + "/manifest.json"), test::loadFile(b + "/manifest.json"));
+  for (auto& e : std::filesystem::directory_iterator(a + "/chunks"))
+    EXPECT_EQ(test::loadFile(e.path().string()), test::loadFile(b + "/chunks/" + e.path().filename().string()));
+}
+
 void roundTrip(const std::string& name, const TetMesh& m, PackOptions o) {
   o.chunkKb = 2;  // many small chunks: many prefixes to check
   o.minBaseVertices = 0;  // these meshes are small: simplify all the way to 1%
@@ -238,9 +245,7 @@ TEST(Progressive, PackingIsDeterministic) {
   PackOptions o;
   o.chunkKb = 2;
   std::string a = pack("det-a", m, o), b = pack("det-b", m, o);
-  EXPECT_EQ(test::loadFile(a + "/manifest.json"), test::loadFile(b + "/manifest.json"));
-  for (auto& e : std::filesystem::directory_iterator(a + "/chunks"))
-    EXPECT_EQ(test::loadFile(e.path().string()), test::loadFile(b + "/chunks/" + e.path().filename().string()));
+  expectSamePack(a, b);
 }
 
 // pack --compact: inside each chunk the splits go by kept vertex (split_order.h). Every level
@@ -256,9 +261,7 @@ TEST(Progressive, SplitsInKeptVertexOrderRoundTripExactly) {
   o.chunkKb = 2;
   const TetMesh m = harmonic(10);
   std::string a = pack("ordered-a", m, o), b = pack("ordered-b", m, o);
-  EXPECT_EQ(test::loadFile(a + "/manifest.json"), test::loadFile(b + "/manifest.json"));
-  for (auto& e : std::filesystem::directory_iterator(a + "/chunks"))
-    EXPECT_EQ(test::loadFile(e.path().string()), test::loadFile(b + "/chunks/" + e.path().filename().string()));
+  expectSamePack(a, b);
   Dataset ds;
   ASSERT_TRUE(loadPackedDir(a, ds, 1));
   ASSERT_GE(ds.manifest.chunks.size(), 4u);
@@ -283,9 +286,7 @@ TEST(Progressive, FlippedInputTetsPackAsTheOriginal) {
   PackSummary a, b;
   std::string da = pack("flip-a", m, o, &a), db = pack("flip-b", flipped, o, &b);
   EXPECT_EQ(b.flippedTets, (m.tetCount() + 2) / 3);
-  EXPECT_EQ(test::loadFile(da + "/manifest.json"), test::loadFile(db + "/manifest.json"));
-  for (auto& e : std::filesystem::directory_iterator(da + "/chunks"))
-    EXPECT_EQ(test::loadFile(e.path().string()), test::loadFile(db + "/chunks/" + e.path().filename().string()));
+  expectSamePack(da, db);
 }
 
 // The mesh with its vertices and tets in a shuffled order (each tet keeps its slot order).
