@@ -122,6 +122,19 @@ void initProgressive(ProgressiveMesh& pm, TetMesh base) {
   pm.baseTets = pm.mesh.tetCount();
 }
 
+void reserveProgressive(ProgressiveMesh& pm, uint32_t vertices, uint32_t tets) {
+  TetMesh& m = pm.mesh;
+  m.positions.reserve(3 * size_t(vertices));
+  for (ScalarField& f : m.fields) f.values.reserve(vertices);
+  m.tets.reserve(4 * size_t(tets));
+  pm.stars.reserve(vertices, 4 * size_t(tets));
+  pm.seen.reserve(vertices);
+  const size_t splits = vertices > m.vertexCount() ? vertices - m.vertexCount() : 0;
+  pm.splitJ.reserve(splits);
+  pm.splitTetsBefore.reserve(splits);
+  pm.splitJValues.reserve(splits * pm.keptCount);
+}
+
 void starOf(const ProgressiveMesh& pm, uint32_t v, std::vector<uint32_t>& tets) {
   tets.clear();
   for (uint32_t c : pm.stars.corners(v)) tets.push_back(c >> 2);

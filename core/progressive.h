@@ -98,6 +98,11 @@ struct ProgressiveMesh {
 // Takes ownership of the base mesh and builds the incidence lists.
 void initProgressive(ProgressiveMesh& pm, TetMesh base);
 
+// Sets aside room for a mesh of `vertices` and `tets` (the full level), so that applying
+// splits never moves the arrays (the packer's encoder: growing them by doubling copied and
+// first-touched ~40 MB on Harmonic 64³).
+void reserveProgressive(ProgressiveMesh& pm, uint32_t vertices, uint32_t tets);
+
 // Tets around v, ascending ids (the canonical order of FORMAT.md §4).
 void starOf(const ProgressiveMesh& pm, uint32_t v, std::vector<uint32_t>& tets);
 

@@ -12,6 +12,9 @@ namespace tetstream {
 // Starts a chunk's raw bytes with the 16-byte chunk header.
 void beginChunk(std::vector<uint8_t>& raw, ChunkKind kind, uint32_t index);
 
+// The packer's default level, at which finishChunk() tunes zstd's parameters (see there).
+inline constexpr int kTunedZstdLevel = 18;
+
 // Compresses the raw chunk with zstd at `level` into `file` and fills the size and hash fields
 // of `info` (kind, counts and file name are the caller's).
 Result finishChunk(const std::vector<uint8_t>& raw, int level, std::vector<uint8_t>& file, ChunkInfo& info);

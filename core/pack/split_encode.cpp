@@ -188,6 +188,7 @@ class Encoder {
       pm_.keptCount = 1;
       pm_.keptFixed = true;
     }
+    reserveProgressive(pm_, V, T);
   }
 
   // The current chunk's records so far, in bytes (all columns).
