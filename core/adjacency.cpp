@@ -2,43 +2,50 @@
 
 #include <algorithm>
 #include <cassert>
+#if !defined(__EMSCRIPTEN__)
+#include <thread>
+#endif
 
 #include "tet_tables.h"
 
 namespace tetstream {
 
-void buildFaceAdjacency(std::span<const uint32_t> tets, uint32_t vertexCount, FaceAdjacency& out) {
-  const size_t halfFaces = tets.size();
-  out.opposite.assign(halfFaces, kNoNeighbor);
-  out.nonManifoldFaces = 0;
+constexpr size_t kParallelHalfFaces = 400000;  // 100,000 tets
 
-  // Bucket half-faces by their smallest vertex (counting sort), then match inside each bucket
-  // by the other two vertices. Buckets are small (the faces around one vertex).
-  std::vector<uint32_t> start(size_t(vertexCount) + 1, 0);
-  auto sortedFace = [&](size_t h, uint32_t s[3]) {
-    const uint32_t* v = &tets[h & ~size_t(3)];
-    const uint8_t* f = kTetFaces[h & 3];
-    s[0] = v[f[0]]; s[1] = v[f[1]]; s[2] = v[f[2]];
-    if (s[0] > s[1]) std::swap(s[0], s[1]);
-    if (s[1] > s[2]) std::swap(s[1], s[2]);
-    if (s[0] > s[1]) std::swap(s[0], s[1]);
-  };
+namespace {
+
+// The faces of a tet's slots f (kTetFaces) as sorted vertex triples.
+void sortedFace(std::span<const uint32_t> tets, size_t h, uint32_t s[3]) {
+  const uint32_t* v = &tets[h & ~size_t(3)];
+  const uint8_t* f = kTetFaces[h & 3];
+  s[0] = v[f[0]]; s[1] = v[f[1]]; s[2] = v[f[2]];
+  if (s[0] > s[1]) std::swap(s[0], s[1]);
+  if (s[1] > s[2]) std::swap(s[1], s[2]);
+  if (s[0] > s[1]) std::swap(s[0], s[1]);
+}
+
+// Pairs the half-faces whose smallest vertex lies in [lo, hi): bucketed by that vertex (a
+// counting sort), matched inside each bucket by the other two. Buckets are small (the faces
+// around one vertex). Writes only those half-faces' entries; returns the non-manifold faces.
+uint64_t pairFaces(std::span<const uint32_t> tets, uint32_t lo, uint32_t hi, std::vector<uint32_t>& opposite) {
+  const size_t halfFaces = tets.size();
+  std::vector<uint32_t> start(size_t(hi - lo) + 1, 0);
   for (size_t h = 0; h < halfFaces; ++h) {
     uint32_t s[3];
-    sortedFace(h, s);
-    assert(s[2] < vertexCount);
-    ++start[s[0] + 1];
+    sortedFace(tets, h, s);
+    if (s[0] >= lo && s[0] < hi) ++start[s[0] - lo + 1];
   }
-  for (size_t v = 0; v < vertexCount; ++v) start[v + 1] += start[v];
+  for (size_t v = 0; v < hi - lo; ++v) start[v + 1] += start[v];
   struct Entry { uint64_t key; uint32_t halfFace; };
-  std::vector<Entry> entries(halfFaces);
+  std::vector<Entry> entries(start.back());
   std::vector<uint32_t> fill(start.begin(), start.end() - 1);
   for (size_t h = 0; h < halfFaces; ++h) {
     uint32_t s[3];
-    sortedFace(h, s);
-    entries[fill[s[0]]++] = {uint64_t(s[1]) << 32 | s[2], uint32_t(h)};
+    sortedFace(tets, h, s);
+    if (s[0] >= lo && s[0] < hi) entries[fill[s[0] - lo]++] = {uint64_t(s[1]) << 32 | s[2], uint32_t(h)};
   }
-  for (size_t v = 0; v < vertexCount; ++v) {
+  uint64_t nonManifold = 0;
+  for (size_t v = 0; v < hi - lo; ++v) {
     Entry* b = entries.data() + start[v];
     Entry* e = entries.data() + start[v + 1];
     std::sort(b, e, [](const Entry& x, const Entry& y) { return x.key < y.key || (x.key == y.key && x.halfFace < y.halfFace); });
@@ -46,14 +53,36 @@ void buildFaceAdjacency(std::span<const uint32_t> tets, uint32_t vertexCount, Fa
       Entry* end = run + 1;
       while (end < e && end->key == run->key) ++end;
       if (end - run == 2) {
-        out.opposite[run[0].halfFace] = run[1].halfFace;
-        out.opposite[run[1].halfFace] = run[0].halfFace;
+        opposite[run[0].halfFace] = run[1].halfFace;
+        opposite[run[1].halfFace] = run[0].halfFace;
       } else if (end - run > 2) {
-        ++out.nonManifoldFaces;
+        ++nonManifold;
       }
       run = end;
     }
   }
+  return nonManifold;
+}
+
+}  // namespace
+
+void buildFaceAdjacency(std::span<const uint32_t> tets, uint32_t vertexCount, FaceAdjacency& out) {
+  out.opposite.assign(tets.size(), kNoNeighbor);
+  for ([[maybe_unused]] uint32_t v : tets) assert(v < vertexCount);
+#if !defined(__EMSCRIPTEN__)
+  // Natively, a large mesh's vertices in two halves on two threads (each scans every face and
+  // pairs those of its half: the pairs never cross, so the writes don't either). Harmonic 64³:
+  // 124 → ~70 ms.
+  if (tets.size() >= kParallelHalfFaces) {
+    uint64_t upper = 0;
+    std::jthread other([&] { upper = pairFaces(tets, vertexCount / 2, vertexCount, out.opposite); });
+    const uint64_t lower = pairFaces(tets, 0, vertexCount / 2, out.opposite);
+    other.join();
+    out.nonManifoldFaces = lower + upper;
+    return;
+  }
+#endif
+  out.nonManifoldFaces = pairFaces(tets, 0, vertexCount, out.opposite);
 }
 
 void extractBoundary(std::span<const uint32_t> tets, const FaceAdjacency& adj, std::vector<uint32_t>& triangles) {

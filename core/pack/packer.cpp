@@ -38,22 +38,31 @@ double msSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// Snaps positions and fields to the quantization grid of `m` (FORMAT.md §4). Returns the number
-// of tets that the snapping flattened or turned over (0 means this grid is safe).
-uint64_t snapToGrid(TetMesh& mesh, const Manifest& m) {
-  Quantizer q = makeQuantizer(m);
-  std::vector<double> before(mesh.tetCount());
-  for (uint32_t t = 0; t < mesh.tetCount(); ++t) before[t] = tetVolume(mesh, t);
-  for (uint32_t v = 0; v < mesh.vertexCount(); ++v)
-    for (int k = 0; k < 3; ++k) {
-      float& x = mesh.positions[3 * size_t(v) + k];
-      x = q.position[k].dequantize(q.position[k].quantize(x));
-    }
+// The positions snapped to the quantization grid of `m` (FORMAT.md §4), into `snapped`. Returns
+// the number of tets that the snapping flattens or turns over (0 means this grid is safe).
+// (Into a copy of the positions only: copying the whole mesh and keeping every tet's volume took
+// 38 ms on Harmonic 64³.)
+uint64_t snapPositions(const TetMesh& mesh, const Manifest& m, std::vector<float>& snapped) {
+  const Quantizer q = makeQuantizer(m);
+  snapped.resize(mesh.positions.size());
+  for (size_t k = 0; k < snapped.size(); ++k)
+    snapped[k] = q.position[k % 3].dequantize(q.position[k % 3].quantize(mesh.positions[k]));
+  uint64_t broken = 0;
+  for (uint32_t t = 0; t < mesh.tetCount(); ++t) {
+    const uint32_t* v = &mesh.tets[4 * size_t(t)];
+    auto volume = [v](const std::vector<float>& p) {
+      return tetVolume(&p[3 * size_t(v[0])], &p[3 * size_t(v[1])], &p[3 * size_t(v[2])], &p[3 * size_t(v[3])]);
+    };
+    broken += volume(mesh.positions) > 0 && !(volume(snapped) > 0);
+  }
+  return broken;
+}
+
+// Snaps the fields to the grid of `m`.
+void snapFields(TetMesh& mesh, const Manifest& m) {
+  const Quantizer q = makeQuantizer(m);
   for (size_t f = 0; f < mesh.fields.size(); ++f)
     for (float& x : mesh.fields[f].values) x = q.field[f].dequantize(q.field[f].quantize(x));
-  uint64_t broken = 0;
-  for (uint32_t t = 0; t < mesh.tetCount(); ++t) broken += before[t] > 0 && !(tetVolume(mesh, t) > 0);
-  return broken;
 }
 
 }  // namespace
@@ -152,17 +161,19 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   if (report.nonFiniteFieldValues && !opt.lossless)
     summary.notes.push_back("fields contain NaN or infinite values: stored lossless (float32)");
   if (!m.lossless) {
-    TetMesh snapped;
+    std::vector<float> snapped;
     for (int bits : {16, 20, 24}) {
       m.positionBits = bits;
-      snapped = mesh;
-      uint64_t broken = snapToGrid(snapped, m);
+      uint64_t broken = snapPositions(mesh, m, snapped);
       if (broken == 0) break;
       summary.notes.push_back(std::to_string(broken) + " tetrahedra are too small for a " + std::to_string(bits) +
                               "-bit position grid" + (bits < 24 ? ": trying more bits" : ": storing lossless"));
       if (bits == 24) m.lossless = true;
     }
-    if (!m.lossless) mesh = std::move(snapped);
+    if (!m.lossless) {
+      mesh.positions = std::move(snapped);
+      snapFields(mesh, m);
+    }
     m.positionBits = m.lossless ? 16 : m.positionBits;
   }
 

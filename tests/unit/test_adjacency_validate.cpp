@@ -1,11 +1,14 @@
 // Face adjacency, boundary extraction and validation findings on tiny hand-made meshes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
 #include "adjacency.h"
 #include "pack/generators.h"
+#include "tet_tables.h"
 #include "test_helpers.h"
 #include "validate.h"
 
@@ -49,6 +52,39 @@ TEST(Adjacency, GridBoundaryIsClosedAndOutward) {
     float nx = u[1] * v[2] - u[2] * v[1], ny = u[2] * v[0] - u[0] * v[2], nz = u[0] * v[1] - u[1] * v[0];
     EXPECT_GT(nx * c[0] + ny * c[1] + nz * c[2], 0);
   }
+}
+
+// Above 100,000 tets the faces are paired on two threads, each for half of the vertices.
+TEST(Adjacency, LargeMeshPairsEveryFaceOnce) {
+  const uint32_t n = 32;  // 178,746 tets
+  TetMesh m = makeGridMesh(n);
+  FaceAdjacency adj;
+  buildFaceAdjacency(m.tets, m.vertexCount(), adj);
+  EXPECT_EQ(adj.nonManifoldFaces, 0u);
+  size_t boundary = 0;
+  auto faceOf = [&](uint32_t h) {
+    std::array<uint32_t, 3> f;
+    for (int k = 0; k < 3; ++k) f[size_t(k)] = m.tets[4 * (h / 4) + kTetFaces[h % 4][k]];
+    std::sort(f.begin(), f.end());
+    return f;
+  };
+  for (uint32_t h = 0; h < adj.opposite.size(); ++h) {
+    const uint32_t o = adj.opposite[h];
+    if (o == kNoNeighbor) { ++boundary; continue; }
+    ASSERT_EQ(adj.opposite[o], h);
+    ASSERT_EQ(faceOf(o), faceOf(h));
+  }
+  EXPECT_EQ(boundary, size_t(12 * (n - 1) * (n - 1)));
+  // A copy of an interior tet from each half of the numbering: four faces with three tets each.
+  std::vector<uint32_t> interior;
+  for (uint32_t t = 0; t < m.tetCount(); ++t)
+    if (adj.opposite[4 * t] != kNoNeighbor && adj.opposite[4 * t + 1] != kNoNeighbor &&
+        adj.opposite[4 * t + 2] != kNoNeighbor && adj.opposite[4 * t + 3] != kNoNeighbor)
+      interior.push_back(t);
+  for (uint32_t t : {interior[interior.size() / 8], interior[interior.size() * 7 / 8]})
+    m.tets.insert(m.tets.end(), m.tets.begin() + 4 * t, m.tets.begin() + 4 * t + 4);
+  buildFaceAdjacency(m.tets, m.vertexCount(), adj);
+  EXPECT_EQ(adj.nonManifoldFaces, 8u);
 }
 
 TEST(Adjacency, ThreeTetsOnOneFaceAreNonManifold) {

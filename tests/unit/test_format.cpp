@@ -69,6 +69,33 @@ TEST(Format, PackOrientsTetsPositively) {
   for (uint32_t t = 0; t < ds.pm.mesh.tetCount(); ++t) EXPECT_GT(tetVolume(ds.pm.mesh, t), 0);
 }
 
+TEST(Format, PackRaisesThePositionGridForTetsTooSmallForIt) {
+  // A unit tet and one 4e-6 across: the 16-bit grid (steps of 1.5e-5) would flatten the small
+  // one, the 20-bit grid (9.5e-7) keeps it.
+  TetMesh m;
+  const float corner[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  for (float scale : {1.0f, 4e-6f})
+    for (const auto& c : corner)
+      for (int k = 0; k < 3; ++k) m.positions.push_back((scale < 1 ? 0.5f : 0.0f) + scale * c[k]);
+  m.tets = {0, 1, 2, 3, 4, 5, 6, 7};
+  m.fields.push_back({"f", {0, 1, 2, 3, 4, 5, 6, 7}});
+  PackOptions o = wholeMesh();
+  o.lossless = false;
+  PackSummary s;
+  const std::string dir = tempDir("grid");
+  ASSERT_TRUE(packMesh(m, dir, o, s));
+  EXPECT_EQ(s.manifest.positionBits, 20);
+  EXPECT_FALSE(s.manifest.lossless);
+  bool noted = false;
+  for (const std::string& n : s.notes) noted |= n.find("too small for a 16-bit position grid") != std::string::npos;
+  EXPECT_TRUE(noted);
+  Dataset ds;
+  ASSERT_TRUE(loadPackedDir(dir, ds));
+  ASSERT_EQ(ds.pm.mesh.tetCount(), 2u);
+  for (uint32_t t = 0; t < 2; ++t) EXPECT_GT(tetVolume(ds.pm.mesh, t), 0);
+  for (size_t k = 0; k < m.positions.size(); ++k) EXPECT_NEAR(ds.pm.mesh.positions[k], m.positions[k], 1e-6);
+}
+
 TEST(Format, PackIsDeterministic) {
   TetMesh m = harmonic(7);
   std::string a = packed("det-a", m), b = packed("det-b", m);
