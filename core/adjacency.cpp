@@ -14,7 +14,7 @@ constexpr size_t kParallelHalfFaces = 400000;  // 100,000 tets
 
 namespace {
 
-// The faces of a tet's slots f (kTetFaces) as sorted vertex triples.
+// The vertices of half-face h (face h % 4 of tet h / 4, kTetFaces), ascending.
 void sortedFace(std::span<const uint32_t> tets, size_t h, uint32_t s[3]) {
   const uint32_t* v = &tets[h & ~size_t(3)];
   const uint8_t* f = kTetFaces[h & 3];
