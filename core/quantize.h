@@ -22,6 +22,8 @@ struct QuantAxis {
     return q >= 0 ? (q > maxQ ? maxQ : uint32_t(q)) : 0;  // NaN lands on 0 too
   }
   float dequantize(uint32_t q) const { return min + float(q) * step; }
+  // x as a reader decodes it: the nearest grid value.
+  float snap(float x) const { return dequantize(quantize(x)); }
 };
 
 inline QuantAxis makeAxis(float lo, float hi, int bits) {

@@ -46,7 +46,7 @@ uint64_t snapPositions(const TetMesh& mesh, const Manifest& m, std::vector<float
   const Quantizer q = makeQuantizer(m);
   snapped.resize(mesh.positions.size());
   for (size_t k = 0; k < snapped.size(); ++k)
-    snapped[k] = q.position[k % 3].dequantize(q.position[k % 3].quantize(mesh.positions[k]));
+    snapped[k] = q.position[k % 3].snap(mesh.positions[k]);
   uint64_t broken = 0;
   for (uint32_t t = 0; t < mesh.tetCount(); ++t) {
     const uint32_t* v = &mesh.tets[4 * size_t(t)];
@@ -62,7 +62,7 @@ uint64_t snapPositions(const TetMesh& mesh, const Manifest& m, std::vector<float
 void snapFields(TetMesh& mesh, const Manifest& m) {
   const Quantizer q = makeQuantizer(m);
   for (size_t f = 0; f < mesh.fields.size(); ++f)
-    for (float& x : mesh.fields[f].values) x = q.field[f].dequantize(q.field[f].quantize(x));
+    for (float& x : mesh.fields[f].values) x = q.field[f].snap(x);
 }
 
 }  // namespace

@@ -207,7 +207,7 @@ class Encoder {
   }
 
   // A value as the decoder will see it: on the field's quantization grid unless lossless.
-  float snapped(size_t f, float x) const { return q_.lossless ? x : q_.field[f].dequantize(q_.field[f].quantize(x)); }
+  float snapped(size_t f, float x) const { return q_.lossless ? x : q_.field[f].snap(x); }
   // Field f at original vertex v at the base level: the simplifier's fitted value for the
   // field it steered by, the sample for the others.
   float valueAt(size_t f, uint32_t v) const {
