@@ -437,6 +437,7 @@ class Simplifier {
   // Scratch for evaluating one vertex's out-edges; one per thread.
   struct Lane {
     std::vector<StarTet> star;
+    uint32_t center = 0;  // the vertex of star
     double flatBound = 0;  // see prepareStar
     double qualityFloor = 0;  // the least 3/κ a changed tet may have (see prepareStar)
     uint64_t boundaryEdges = 0;  // bitOf() the neighbours joined to the vertex by a boundary edge
@@ -522,9 +523,11 @@ class Simplifier {
   };
 
 
+  // (After neighbours(L, i, L.nbr).)
   void prepareStar(Lane& L, uint32_t i) {
     const std::vector<uint32_t>& star = star_[i];
     L.star.resize(star.size());
+    L.center = i;
     const double* pi = p(i);
     // Every edge of a tet after the collapse lies in the star's bounding box, so the flatness
     // threshold of the longest possible edge bounds every tet's own threshold from above.
@@ -552,11 +555,7 @@ class Simplifier {
         st.other[m] = v[k];
         st.mask |= bitOf(L.place[v[k]]);
         st.f[m] = fit_[v[k]];
-        for (int a = 0; a < 3; ++a) {
-          st.x[m][a] = q[a];
-          lo[a] = std::min(lo[a], q[a]);
-          hi[a] = std::max(hi[a], q[a]);
-        }
+        for (int a = 0; a < 3; ++a) st.x[m][a] = q[a];
         ++m;
       }
       // Moving the vertex at slot si to the front takes si adjacent swaps. With u, w the edges
@@ -570,10 +569,17 @@ class Simplifier {
       }
       cross(u, w, st.g);
       for (double& x : st.g) x *= -st.sign;
-      st.detOld = newDet(st, pi);
+      st.detOld = st.g[0] * (pi[0] - st.x[0][0]) + st.g[1] * (pi[1] - st.x[0][1]) + st.g[2] * (pi[2] - st.x[0][2]);
       // κ's terms without p_i: the face of the others (|u × w|²) and its edges.
       st.fixedFace = dot(st.g, st.g);
       st.fixedEdges = dot(u, u) + dot(w, w) + dist2(st.x[1], st.x[2]);
+    }
+    for (uint32_t w : L.nbr) {  // (neighbours() listed the star's vertices but i)
+      const double* q = p(w);
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min(lo[a], q[a]);
+        hi[a] = std::max(hi[a], q[a]);
+      }
     }
     const double diam2 = (hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]);
     L.flatBound = kFlat * diam2 * std::sqrt(diam2);
@@ -609,9 +615,12 @@ class Simplifier {
       e[k] = st.x[2][k] - P[k];
     }
   }
-  // The determinant of st's tet with P in the slot of i (positive: properly oriented).
-  static double newDet(const StarTet& st, const double* P) {
-    return st.g[0] * (P[0] - st.x[0][0]) + st.g[1] * (P[1] - st.x[0][1]) + st.g[2] * (P[2] - st.x[0][2]);
+  // The determinant of st's tet with P in the slot of i (positive: properly oriented), from the
+  // move m = P − p_i: g·(P − x0) = detOld + g·m, three products a tet instead of six operations
+  // (legal() runs this for every tet around i and every neighbour of i).
+  static double newDet(const StarTet& st, const double* m) { return st.detOld + dot(st.g, m); }
+  static void moveTo(const double* P, const double* pi, double* m) {
+    for (int k = 0; k < 3; ++k) m[k] = P[k] - pi[k];
   }
   static void cross(const double* u, const double* v, double* n) {
     n[0] = u[1] * v[2] - u[2] * v[1];
@@ -630,6 +639,8 @@ class Simplifier {
     if (boundary_[i] && !(bit ? (L.boundaryEdges & bit) != 0 : isBoundaryEdge(i, j)))
       return *verdict = CollapseVerdict::BoundaryRule, false;
     const double* P = p(j);
+    double m[3];
+    moveTo(P, p(i), m);
     L.removedQuality = 0;  // Σ 3/κ of the tets the collapse removes, and their count
     L.removed = 0;
     for (const StarTet& st : L.star) {
@@ -638,7 +649,7 @@ class Simplifier {
         ++L.removed;
         continue;
       }
-      const double det = newDet(st, P);
+      const double det = newDet(st, m);
       if (det <= 0) return *verdict = CollapseVerdict::Inverted, false;
       if (det <= L.flatBound && isFlat(st, P, det)) return *verdict = CollapseVerdict::Flat, false;
     }
@@ -715,7 +726,7 @@ class Simplifier {
       cross(b, d, bd);
       const double num[4] = {st.detOld, st.sign * dot(d, be), st.sign * dot(a, de), st.sign * dot(a, bd)};
       const double lo = std::min({num[0], num[1], num[2], num[3]});
-      const double det = newDet(st, P);
+      const double det = st.detOld - dot(st.g, d);  // newDet() with the move −d
       if (lo < 0 && lo / det <= bestInside) continue;
       bestInside = lo / det;
       interp = (num[0] / det) * c.sj + ((num[1] / det) * st.f[0] + (num[2] / det) * st.f[1] + (num[3] / det) * st.f[2]);
@@ -728,6 +739,8 @@ class Simplifier {
   bool finishCost(Lane& L, Candidate& c, CollapseVerdict* verdict) {
     const uint32_t j = c.j;
     const double* P = p(j);
+    double m[3];
+    moveTo(P, p(L.center), m);
     double qualitySum = qualitySum_[j];
     int64_t count = int64_t(star_[j].size());
     for (const StarTet& st : L.star) {
@@ -736,7 +749,7 @@ class Simplifier {
         --count;
         continue;
       }
-      const double det = newDet(st, P);
+      const double det = newDet(st, m);
       // The edges and faces at P.
       double a[3], b[3], e[3], ab[3], be[3], ae[3];
       edgesFrom(P, st, a, b, e);
