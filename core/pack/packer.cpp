@@ -203,7 +203,7 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   }
   so.progress = [&](uint32_t done, uint32_t planned) { progress("simplify", done, planned); };
   progress("simplify", 0, 0);  // (its set-up, 15-20% of its time on carotid and Harmonic 64³, reports no collapses yet)
-  if (Result r = simplifyMesh(mesh, so, simplified, &adjacency); !r) return r;
+  if (Result r = simplifyMesh(mesh, so, simplified, &adjacency, &mesh.tets); !r) return r;  // (mesh.tets taken over)
   summary.simplifyMs = msSince(t0);
   summary.stopReason = simplified.stopReason;
   summary.flatTetsRemoved = simplified.flatTetsRemoved;

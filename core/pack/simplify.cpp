@@ -118,8 +118,9 @@ uint64_t makeEdge(uint32_t a, uint32_t b) { return a < b ? uint64_t(a) << 32 | b
 
 class Simplifier {
  public:
-  Simplifier(const TetMesh& m, const SimplifyOptions& o, SimplifyResult& r, FaceAdjacency* adjacency = nullptr)
-      : mesh_(m), opt_(o), out_(r), adjacency_(adjacency) {}
+  Simplifier(const TetMesh& m, const SimplifyOptions& o, SimplifyResult& r, FaceAdjacency* adjacency = nullptr,
+             std::vector<uint32_t>* takeTets = nullptr)
+      : mesh_(m), opt_(o), out_(r), adjacency_(adjacency), takeTets_(takeTets) {}
 
   CollapseVerdict check(uint32_t i, uint32_t j) {
     init();
@@ -232,7 +233,8 @@ class Simplifier {
     diag_ = computeBounds(mesh_.positions).diagonal();
     if (!(diag_ > 0)) diag_ = 1;
 
-    out_.tets = mesh_.tets;
+    if (takeTets_ && takeTets_ == &mesh_.tets) out_.tets = std::move(*takeTets_);
+    else out_.tets = mesh_.tets;  // (mesh_.tets is not read again: T_ counts them)
     out_.tetAlive.assign(T_, 1);
     out_.vertexAlive.assign(V_, 0);
     star_.assign(V_, {});
@@ -255,7 +257,10 @@ class Simplifier {
       opp_ = std::move(adj.opposite);
     }
     boundary_.assign(V_, 0);
-    quadric_.assign(V_, {});
+    // Only boundary vertices have a quadric (a tenth of a grid's vertices, fewer in a real mesh):
+    // 88 bytes each, stored for those alone.
+    quadricOf_.assign(V_, kNoQuadric);
+    quadrics_.clear();
     for (uint32_t h = 0; h < 4 * T_; ++h) {
       if (opp_[h] != kNoNeighbor) continue;
       const uint32_t* v = &out_.tets[h & ~3u];
@@ -264,12 +269,18 @@ class Simplifier {
       double u[3] = {pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]}, w[3] = {pc[0] - pa[0], pc[1] - pa[1], pc[2] - pa[2]};
       double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
       double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-      for (uint32_t x : {a, b, c}) boundary_[x] = 1;
+      for (uint32_t x : {a, b, c}) {
+        boundary_[x] = 1;
+        if (quadricOf_[x] == kNoQuadric) {
+          quadricOf_[x] = uint32_t(quadrics_.size());
+          quadrics_.emplace_back();
+        }
+      }
       if (len == 0) continue;
       for (double& x : n) x /= len;
       double d = -(n[0] * pa[0] + n[1] * pa[1] + n[2] * pa[2]);
       const double plane[4] = {n[0], n[1], n[2], d};
-      for (uint32_t x : {a, b, c}) quadric_[x].addSquare(plane, 0.5 * len);
+      for (uint32_t x : {a, b, c}) quadrics_[quadricOf_[x]].addSquare(plane, 0.5 * len);
     }
     kappa_.resize(T_);
     qualitySum_.assign(V_, 0.0);
@@ -673,8 +684,8 @@ class Simplifier {
     c.region = fq.weight > 0 ? std::sqrt(std::max(0.0, fq.eval(x5)) / fq.weight) / range_ : 0.0;
     c.eg = 0;
     if (boundary_[i]) {
-      Quadric q = quadric_[i];
-      q.add(quadric_[j]);
+      Quadric q = quadrics_[quadricOf_[i]];
+      q.add(boundaryQuadric(j));  // (j is on the boundary too: legal() checked the boundary rule)
       const double x4[4] = {P[0], P[1], P[2], 1.0};
       if (q.weight > 0) c.eg = std::sqrt(std::max(0.0, q.eval(x4)) / q.weight) / diag_;
     }
@@ -997,7 +1008,7 @@ class Simplifier {
     forEachArray([&](auto& v) { v.reserve(size_t(expected)); }, out_.log);
     out_.log.moved.reserve(size_t(expected * movedEach));
     out_.log.removed.reserve(size_t(expected * removedEach));
-    out_.log.removedVertices.reserve(size_t(4 * expected * removedEach));
+    out_.log.removedOthers.reserve(size_t(2 * expected * removedEach));
     if (opt_.recordReadSets) out_.log.star.reserve(size_t(expected * 4.0 * tetsAlive_ / std::max<uint32_t>(alive_, 1)));
 
     const double budgetV = kPartShare * planned;
@@ -1126,7 +1137,7 @@ class Simplifier {
   template <class F, class... Logs>
   static void forEachArray(F f, Logs&... logs) {
     f(logs.i...), f(logs.j...), f(logs.fieldError...), f(logs.iValue...), f(logs.jValue...);
-    f(logs.movedBegin...), f(logs.moved...), f(logs.removedBegin...), f(logs.removed...), f(logs.removedVertices...);
+    f(logs.movedBegin...), f(logs.moved...), f(logs.removedBegin...), f(logs.removed...), f(logs.removedOthers...);
     f(logs.starBegin...), f(logs.star...);
   }
 
@@ -1143,8 +1154,8 @@ class Simplifier {
     dst.removedBegin.push_back(uint32_t(dst.removed.size()));
     dst.moved.insert(dst.moved.end(), src.moved.begin() + m0, src.moved.begin() + m1);
     dst.removed.insert(dst.removed.end(), src.removed.begin() + r0, src.removed.begin() + r1);
-    dst.removedVertices.insert(dst.removedVertices.end(), src.removedVertices.begin() + 4 * size_t(r0),
-                               src.removedVertices.begin() + 4 * size_t(r1));
+    dst.removedOthers.insert(dst.removedOthers.end(), src.removedOthers.begin() + 2 * size_t(r0),
+                             src.removedOthers.begin() + 2 * size_t(r1));
     if (src.starBegin.empty()) return;  // (no read sets recorded)
     const uint32_t s0 = src.starBegin[c], s1 = c + 1 < src.size() ? src.starBegin[c + 1] : uint32_t(src.star.size());
     dst.starBegin.push_back(uint32_t(dst.star.size()));
@@ -1555,6 +1566,21 @@ class Simplifier {
     v.pop_back();
   }
 
+  // The two vertices of tet v besides those in slots si and sj, in the order that makes
+  // (v[si], v[sj], a, b) an even permutation of v: a split that recreates the tet as (i, j, a, b)
+  // gives it the same orientation.
+  static void orientedOthers(const uint32_t* v, int si, int sj, uint32_t* out) {
+    int slot[4] = {si, sj, 0, 0}, n = 2;
+    for (int k = 0; k < 4; ++k)
+      if (k != si && k != sj) slot[n++] = k;
+    int inversions = 0;
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) inversions += slot[a] > slot[b];
+    if (inversions & 1) std::swap(slot[2], slot[3]);
+    out[0] = v[slot[2]];
+    out[1] = v[slot[3]];
+  }
+
   void collapse(Worker& W, uint32_t i, uint32_t j, float fieldErr, float key) {
     CollapseLog& log = *W.log;
     if (W.part >= 0) W.keys.push_back(key);
@@ -1573,12 +1599,14 @@ class Simplifier {
       if (!tetHas(t, j)) continue;
       // Removed tet (i, j, k, l): glue its neighbours across (j, k, l) and (i, k, l).
       log.removed.push_back(t);
-      log.removedVertices.insert(log.removedVertices.end(), v, v + 4);
       int si = 0, sj = 0;
       for (int k = 0; k < 4; ++k) {
         if (v[k] == i) si = k;
         if (v[k] == j) sj = k;
       }
+      uint32_t others[2];
+      orientedOthers(v, si, sj, others);
+      log.removedOthers.insert(log.removedOthers.end(), others, others + 2);
       uint32_t hA = opp_[4 * t + si], hB = opp_[4 * t + sj];
       if (hA != kNoNeighbor) opp_[hA] = hB;
       if (hB != kNoNeighbor) opp_[hB] = hA;
@@ -1609,8 +1637,11 @@ class Simplifier {
     star_[i].shrink_to_fit();
     out_.vertexAlive[i] = 0;
     ++W.collapsed;
-    boundary_[j] |= boundary_[i];
-    quadric_[j].add(quadric_[i]);
+    if (boundary_[i]) {  // (then j is on the boundary too, and has a quadric: see legal())
+      boundary_[j] = 1;
+      assert(quadricOf_[j] != kNoQuadric);
+      if (quadricOf_[j] != kNoQuadric) quadrics_[quadricOf_[j]].add(quadrics_[quadricOf_[i]]);
+    }
     fieldQuadric_[j].add(fieldQuadric_[i]);
     // j now stands for the region of both: its value becomes the one that fits the original
     // field there best (least squares over the region's original tets, at p_j); the split gives
@@ -1649,6 +1680,7 @@ class Simplifier {
   const SimplifyOptions& opt_;
   SimplifyResult& out_;
   FaceAdjacency* adjacency_;  // the caller's, taken over by init() (or none)
+  std::vector<uint32_t>* takeTets_;  // mesh_.tets, taken over by init() (or none: copied)
   uint32_t V_ = 0, T_ = 0, alive_ = 0, tetsAlive_ = 0, flatInput_ = 0;
   std::vector<double> pos_;
   const float* field_ = nullptr;
@@ -1660,7 +1692,14 @@ class Simplifier {
   std::vector<std::vector<uint32_t>> star_;
   std::vector<uint32_t> opp_;
   std::vector<uint8_t> boundary_;
-  std::vector<Quadric> quadric_;
+  static constexpr uint32_t kNoQuadric = ~0u;
+  std::vector<uint32_t> quadricOf_;  // per vertex: its boundary quadric in quadrics_, or kNoQuadric (interior)
+  std::vector<Quadric> quadrics_;
+  // The boundary quadric of v: zero for an interior vertex, whose collapse does not move the boundary.
+  const Quadric& boundaryQuadric(uint32_t v) const {
+    static const Quadric zero;
+    return quadricOf_[v] == kNoQuadric ? zero : quadrics_[quadricOf_[v]];
+  }
   std::vector<float> kappa_, lastCost_;
   std::vector<FieldQuadric> fieldQuadric_;
   std::vector<double> qualitySum_;  // per vertex: Σ 3/κ over its star
@@ -1698,10 +1737,11 @@ CollapseVerdict checkCollapse(const TetMesh& mesh, uint32_t i, uint32_t j, const
   return s.check(i, j);
 }
 
-Result simplifyMesh(const TetMesh& mesh, const SimplifyOptions& options, SimplifyResult& out, FaceAdjacency* adjacency) {
+Result simplifyMesh(const TetMesh& mesh, const SimplifyOptions& options, SimplifyResult& out, FaceAdjacency* adjacency,
+                    std::vector<uint32_t>* takeTets) {
   assert(options.field >= 0 && size_t(options.field) < mesh.fields.size());
   out = SimplifyResult{};
-  Simplifier s(mesh, options, out, adjacency);
+  Simplifier s(mesh, options, out, adjacency, takeTets);
   return s.run();
 }
 

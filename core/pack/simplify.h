@@ -100,7 +100,8 @@ struct CollapseLog {
   std::vector<uint32_t> moved;           // tets whose i slot became j
   std::vector<uint32_t> removedBegin;    // likewise for removed tets
   std::vector<uint32_t> removed;         // tet ids removed by the collapse
-  std::vector<uint32_t> removedVertices; // 4 per removed tet: its vertices just before the collapse
+  std::vector<uint32_t> removedOthers;   // 2 per removed tet: its vertices besides i and j, ordered so
+                                         // that (i, j, a, b) has the tet's orientation
   std::vector<uint32_t> starBegin;       // likewise for star: the tets around j just after the collapse,
   std::vector<uint32_t> star;            // what its split reads (only with recordReadSets; split_order.h)
 
@@ -134,7 +135,9 @@ CollapseVerdict checkCollapse(const TetMesh& mesh, uint32_t i, uint32_t j, const
 // Simplifies `mesh` (positions already on the packer's quantization grid; tets positively
 // oriented or flat). Fails only on a mesh the caller should have validated (asserted).
 // `adjacency`, when given, is the face adjacency of `mesh` (buildFaceAdjacency), saving its rebuild.
+// `takeTets`, when given, is mesh.tets itself, taken over instead of copied (it is left empty:
+// the packer needs them no longer, and a copy is 16 bytes a tet of the peak memory).
 Result simplifyMesh(const TetMesh& mesh, const SimplifyOptions& options, SimplifyResult& out,
-                    FaceAdjacency* adjacency = nullptr);
+                    FaceAdjacency* adjacency = nullptr, std::vector<uint32_t>* takeTets = nullptr);
 
 }  // namespace tetstream

@@ -19,19 +19,11 @@ namespace {
 
 constexpr uint32_t kNone = ~uint32_t(0);
 
-// Parity of the permutation that takes slots (0, 1, 2, 3) to `p`.
-bool oddPermutation(const int p[4]) {
-  int inversions = 0;
-  for (int a = 0; a < 4; ++a)
-    for (int b = a + 1; b < 4; ++b) inversions += p[a] > p[b];
-  return inversions & 1;
-}
-
 void putU32(std::vector<uint8_t>& b, uint32_t x) { for (int i = 0; i < 4; ++i) b.push_back(uint8_t(x >> (8 * i))); }
 
 class Encoder {
  public:
-  Encoder(const TetMesh& mesh, const SimplifyResult& s, const Manifest& m, const StreamOptions& o, EncodedStream& out)
+  Encoder(const TetMesh& mesh, SimplifyResult& s, const Manifest& m, const StreamOptions& o, EncodedStream& out)
       : mesh_(mesh), s_(s), m_(m), opt_(o), out_(out), q_(makeQuantizer(m)) {}
 
   Result run() {
@@ -99,7 +91,7 @@ class Encoder {
   // order (split_order.h), then each split encoded and applied in that order. Split s undoes
   // collapse C − 1 − s.
   Result encodeOrderedSplits(uint32_t C) {
-    SplitOrder order(mesh_.tetCount());
+    SplitOrder order(uint32_t(s_.tetAlive.size()));
     const CollapseLog& log = s_.log;
     for (uint32_t done = 0; done < C;) {
       const uint32_t count = plannedSplits(done, C);
@@ -163,7 +155,7 @@ class Encoder {
   }
 
   void buildBase() {
-    const uint32_t V = mesh_.vertexCount(), T = mesh_.tetCount();
+    const uint32_t V = mesh_.vertexCount(), T = uint32_t(s_.tetAlive.size());  // (mesh_.tets may be gone: simplify.h)
     out_.streamVertexOf.assign(V, kNone);
     out_.streamTetOf.assign(T, kNone);
     TetMesh& b = out_.base;
@@ -182,6 +174,7 @@ class Encoder {
       out_.streamTetOf[t] = b.tetCount();
       for (int k = 0; k < 4; ++k) b.tets.push_back(out_.streamVertexOf[s_.tets[4 * size_t(t) + k]]);
     }
+    std::vector<uint32_t>().swap(s_.tets);  // read no more: its memory is the splits' (split_encode.h)
     initProgressive(pm_, b);
     if (s_.valuesField >= 0) {  // splits give j back its value of the fitted field only
       pm_.keptFirst = uint32_t(s_.valuesField);
@@ -238,8 +231,8 @@ class Encoder {
       const uint32_t* v = &pm_.mesh.tets[4 * size_t(t)];
       if (v[0] != js && v[1] != js && v[2] != js && v[3] != js) return false;
     }
-    for (uint32_t k = 4 * log.removedBegin[c]; k < 4 * log.removedBegin[c + 1]; ++k)
-      if (log.removedVertices[k] != log.i[c] && out_.streamVertexOf[log.removedVertices[k]] == kNone) return false;
+    for (uint32_t k = 2 * log.removedBegin[c]; k < 2 * log.removedBegin[c + 1]; ++k)
+      if (out_.streamVertexOf[log.removedOthers[k]] == kNone) return false;
     return true;
   }
   static Result misfit() { return fail(Status::Corrupt, "encoder: a split does not fit the mesh it undoes (internal error)"); }
@@ -267,15 +260,8 @@ class Encoder {
     const uint32_t first = log.removedBegin[c], count = log.removedBegin[c + 1] - first;
     pairs_.clear();
     for (uint32_t n = 0; n < count; ++n) {
-      const uint32_t* v = &log.removedVertices[4 * size_t(first + n)];
-      int slot[4], others = 2;
-      for (int k = 0; k < 4; ++k) {
-        if (v[k] == i) slot[0] = k;
-        else if (v[k] == j) slot[1] = k;
-        else slot[others++] = k;
-      }
-      if (oddPermutation(slot)) std::swap(slot[2], slot[3]);
-      pairs_.push_back({out_.streamVertexOf[v[slot[2]]], out_.streamVertexOf[v[slot[3]]], log.removed[first + n]});
+      const uint32_t* ab = &log.removedOthers[2 * size_t(first + n)];  // (i, j, a, b) has the tet's orientation
+      pairs_.push_back({out_.streamVertexOf[ab[0]], out_.streamVertexOf[ab[1]], log.removed[first + n]});
     }
     const RingMode mode = chainPairs();
     putVarint(column(SplitColumn::NewTetCount), count << 2 | uint32_t(mode));
@@ -463,7 +449,7 @@ class Encoder {
   }
 
   const TetMesh& mesh_;
-  const SimplifyResult& s_;
+  SimplifyResult& s_;
   const Manifest& m_;
   const StreamOptions& opt_;
   EncodedStream& out_;
@@ -488,7 +474,7 @@ class Encoder {
 
 }  // namespace
 
-Result encodeStream(const TetMesh& mesh, const SimplifyResult& s, const Manifest& m, const StreamOptions& opt,
+Result encodeStream(const TetMesh& mesh, SimplifyResult& s, const Manifest& m, const StreamOptions& opt,
                     EncodedStream& out) {
   out = EncodedStream{};
   // Kept values are written for the manifest's isoField only (split flag bit 2).

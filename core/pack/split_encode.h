@@ -39,10 +39,12 @@ struct EncodedStream {
   uint32_t movedMasks = 0;                   // splits whose T_moved does not follow from T_new (vertex_link.h)
 };
 
-// `mesh` is the simplifier's input (values on the quantization grid of `m` unless lossless);
+// `mesh` is the simplifier's input (values on the quantization grid of `m` unless lossless; its
+// positions and fields are read, not its tets, which simplifyMesh may have taken over);
 // `m` supplies bounds, fields and quantization. The base mesh is compressed as chunk 0 while the
-// splits are encoded, and the split chunks follow from index 1.
-Result encodeStream(const TetMesh& mesh, const SimplifyResult& s, const Manifest& m, const StreamOptions& opt,
+// splits are encoded, and the split chunks follow from index 1. s.tets is released once the base
+// mesh is built (the peak memory of a pack is the simplifier's or the encoder's).
+Result encodeStream(const TetMesh& mesh, SimplifyResult& s, const Manifest& m, const StreamOptions& opt,
                     EncodedStream& out);
 
 }  // namespace tetstream
