@@ -233,8 +233,9 @@ class Simplifier {
     diag_ = computeBounds(mesh_.positions).diagonal();
     if (!(diag_ > 0)) diag_ = 1;
 
-    if (takeTets_ && takeTets_ == &mesh_.tets) out_.tets = std::move(*takeTets_);
-    else out_.tets = mesh_.tets;  // (mesh_.tets is not read again: T_ counts them)
+    assert(!takeTets_ || takeTets_ == &mesh_.tets);
+    if (takeTets_) out_.tets = std::move(*takeTets_);  // (mesh_.tets is not read again: T_ counts them)
+    else out_.tets = mesh_.tets;
     out_.tetAlive.assign(T_, 1);
     out_.vertexAlive.assign(V_, 0);
     star_.assign(V_, {});
