@@ -205,9 +205,7 @@ class Simplifier {
       out_.tetCount += out_.tetAlive[t];
       if (out_.tetAlive[t] && kappa_[t] >= kKappaCap) ++out_.flatTetsLeft;
     }
-    out_.log.movedBegin.push_back(uint32_t(out_.log.moved.size()));
-    out_.log.removedBegin.push_back(uint32_t(out_.log.removed.size()));
-    if (opt_.recordReadSets) out_.log.starBegin.push_back(uint32_t(out_.log.star.size()));
+    out_.log.close(opt_.recordReadSets);
     if (fitOn_ && opt_.refitValues) refitValues();
     if (fitOn_) {
       out_.values = fit_;
@@ -529,6 +527,7 @@ class Simplifier {
     uint64_t pops = 0, requeued = 0, rejectedByLink = 0, flatTetsRemoved = 0, linkMismatches = 0;
     bool errorBound = false;
     std::vector<uint32_t> touched, around;
+    CollapseTets record;    // the tets of the collapse being made
     std::vector<uint64_t> linkEdges, edgeLink;
     EdgeTable edgeTable;
     uint32_t edgeTableStamp = 0;
@@ -1007,9 +1006,8 @@ class Simplifier {
     const double movedEach = std::max(0.0, 4.0 * tetsAlive_ / std::max<uint32_t>(alive_, 1) - removedEach);
     const double expected = planned + 1.0;
     forEachArray([&](auto& v) { v.reserve(size_t(expected)); }, out_.log);
-    out_.log.moved.reserve(size_t(expected * movedEach));
-    out_.log.removed.reserve(size_t(expected * removedEach));
-    out_.log.removedOthers.reserve(size_t(2 * expected * removedEach));
+    out_.log.tetBytes.reserve(size_t(expected * (CollapseLog::kHeaderBytes + CollapseLog::kMovedBytes * movedEach +
+                                                 CollapseLog::kRemovedBytes * removedEach)));
     if (opt_.recordReadSets) out_.log.star.reserve(size_t(expected * 4.0 * tetsAlive_ / std::max<uint32_t>(alive_, 1)));
 
     const double budgetV = kPartShare * planned;
@@ -1138,8 +1136,7 @@ class Simplifier {
   template <class F, class... Logs>
   static void forEachArray(F f, Logs&... logs) {
     f(logs.i...), f(logs.j...), f(logs.fieldError...), f(logs.iValue...), f(logs.jValue...);
-    f(logs.movedBegin...), f(logs.moved...), f(logs.removedBegin...), f(logs.removed...), f(logs.removedOthers...);
-    f(logs.starBegin...), f(logs.star...);
+    f(logs.tetsBegin...), f(logs.tetBytes...), f(logs.starBegin...), f(logs.star...);
   }
 
   // Appends collapse c of `src` (whose begin arrays have no closing entry yet) to `dst`.
@@ -1149,14 +1146,7 @@ class Simplifier {
     dst.fieldError.push_back(src.fieldError[c]);
     dst.iValue.push_back(src.iValue[c]);
     dst.jValue.push_back(src.jValue[c]);
-    const uint32_t m0 = src.movedBegin[c], m1 = c + 1 < src.size() ? src.movedBegin[c + 1] : uint32_t(src.moved.size());
-    const uint32_t r0 = src.removedBegin[c], r1 = c + 1 < src.size() ? src.removedBegin[c + 1] : uint32_t(src.removed.size());
-    dst.movedBegin.push_back(uint32_t(dst.moved.size()));
-    dst.removedBegin.push_back(uint32_t(dst.removed.size()));
-    dst.moved.insert(dst.moved.end(), src.moved.begin() + m0, src.moved.begin() + m1);
-    dst.removed.insert(dst.removed.end(), src.removed.begin() + r0, src.removed.begin() + r1);
-    dst.removedOthers.insert(dst.removedOthers.end(), src.removedOthers.begin() + 2 * size_t(r0),
-                             src.removedOthers.begin() + 2 * size_t(r1));
+    dst.appendTetsOf(src, c);
     if (src.starBegin.empty()) return;  // (no read sets recorded)
     const uint32_t s0 = src.starBegin[c], s1 = c + 1 < src.size() ? src.starBegin[c + 1] : uint32_t(src.star.size());
     dst.starBegin.push_back(uint32_t(dst.star.size()));
@@ -1590,8 +1580,8 @@ class Simplifier {
     log.iValue.push_back(fit_[i]);
     log.jValue.push_back(fit_[j]);
     log.fieldError.push_back(float(fieldErr * range_));
-    log.movedBegin.push_back(uint32_t(log.moved.size()));
-    log.removedBegin.push_back(uint32_t(log.removed.size()));
+    CollapseTets& record = W.record;
+    record.clear();
 
     W.around.assign(star_[i].begin(), star_[i].end());  // star_ lists change below
     const std::vector<uint32_t>& around = W.around;
@@ -1599,7 +1589,7 @@ class Simplifier {
       uint32_t* v = &out_.tets[4 * size_t(t)];
       if (!tetHas(t, j)) continue;
       // Removed tet (i, j, k, l): glue its neighbours across (j, k, l) and (i, k, l).
-      log.removed.push_back(t);
+      record.removed.push_back(t);
       int si = 0, sj = 0;
       for (int k = 0; k < 4; ++k) {
         if (v[k] == i) si = k;
@@ -1607,7 +1597,7 @@ class Simplifier {
       }
       uint32_t others[2];
       orientedOthers(v, si, sj, others);
-      log.removedOthers.insert(log.removedOthers.end(), others, others + 2);
+      record.others.insert(record.others.end(), others, others + 2);
       uint32_t hA = opp_[4 * t + si], hB = opp_[4 * t + sj];
       if (hA != kNoNeighbor) opp_[hA] = hB;
       if (hB != kNoNeighbor) opp_[hB] = hA;
@@ -1624,12 +1614,13 @@ class Simplifier {
       uint32_t* v = &out_.tets[4 * size_t(t)];
       for (int k = 0; k < 4; ++k)
         if (v[k] == i) v[k] = j;
-      log.moved.push_back(t);
+      record.moved.push_back(t);
       star_[j].push_back(t);
       float before = kappa_[t];
       kappa_[t] = tetKappa(t);
       for (int k = 0; k < 4; ++k) qualitySum_[v[k]] += 3.0 / kappa_[t] - (v[k] == j ? 0.0 : 3.0 / before);
     }
+    log.appendTets(record, j);
     if (opt_.recordReadSets) {
       log.starBegin.push_back(uint32_t(log.star.size()));
       log.star.insert(log.star.end(), star_[j].begin(), star_[j].end());

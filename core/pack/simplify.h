@@ -56,6 +56,7 @@
 
 #include "adjacency.h"
 #include "mesh.h"
+#include "pack/collapse_log.h"
 #include "status.h"
 
 namespace tetstream {
@@ -89,23 +90,6 @@ struct SimplifyOptions {
   // Meshes of at least this many vertices are simplified in slabs at once for most of the
   // way (simplify.cpp, runParts); the result depends on this, not on `threads`.
   uint32_t partitionMinVertices = 50000;
-};
-
-// One collapse as it happened, in original vertex and tet ids.
-struct CollapseLog {
-  std::vector<uint32_t> i, j;            // removed vertex, kept vertex
-  std::vector<float> fieldError;         // E_f of the collapse (field units), for the manifest
-  std::vector<float> iValue, jValue;     // the steering field at i and j just before the collapse
-  std::vector<uint32_t> movedBegin;      // collapse c moved tets moved[movedBegin[c] .. movedBegin[c+1])
-  std::vector<uint32_t> moved;           // tets whose i slot became j
-  std::vector<uint32_t> removedBegin;    // likewise for removed tets
-  std::vector<uint32_t> removed;         // tet ids removed by the collapse
-  std::vector<uint32_t> removedOthers;   // 2 per removed tet: its vertices besides i and j, ordered so
-                                         // that (i, j, a, b) has the tet's orientation
-  std::vector<uint32_t> starBegin;       // likewise for star: the tets around j just after the collapse,
-  std::vector<uint32_t> star;            // what its split reads (only with recordReadSets; split_order.h)
-
-  uint32_t size() const { return uint32_t(i.size()); }
 };
 
 struct SimplifyResult {

@@ -221,19 +221,26 @@ class Encoder {
   // Whether the split that undoes collapse c meets the mesh its log describes: p_j there and p_i
   // not yet, T_moved's tets around p_j, T_new's other vertices there. Always so in cost order and
   // in split_order.h's order; checked anyway (a few lookups a split), as applySplit trusts it.
-  bool splitFits(uint32_t c) const {
+  bool splitFits(uint32_t c) {
     const CollapseLog& log = s_.log;
     const uint32_t js = out_.streamVertexOf[log.j[c]];
     if (js == kNone || out_.streamVertexOf[log.i[c]] != kNone) return false;
-    for (uint32_t k = log.movedBegin[c]; k < log.movedBegin[c + 1]; ++k) {
-      const uint32_t t = out_.streamTetOf[log.moved[k]];
+    const CollapseTets& tets = tetsOf(c);
+    for (uint32_t m : tets.moved) {
+      const uint32_t t = out_.streamTetOf[m];
       if (t >= pm_.tetCount()) return false;
       const uint32_t* v = &pm_.mesh.tets[4 * size_t(t)];
       if (v[0] != js && v[1] != js && v[2] != js && v[3] != js) return false;
     }
-    for (uint32_t k = 2 * log.removedBegin[c]; k < 2 * log.removedBegin[c + 1]; ++k)
-      if (out_.streamVertexOf[log.removedOthers[k]] == kNone) return false;
+    for (uint32_t v : tets.others)
+      if (out_.streamVertexOf[v] == kNone) return false;
     return true;
+  }
+  // Collapse c's tets, read from the log once for splitFits and encodeSplit.
+  const CollapseTets& tetsOf(uint32_t c) {
+    if (tetsRead_ != c) s_.log.readTets(c, tets_);
+    tetsRead_ = c;
+    return tets_;
   }
   static Result misfit() { return fail(Status::Corrupt, "encoder: a split does not fit the mesh it undoes (internal error)"); }
 
@@ -247,8 +254,9 @@ class Encoder {
     prevJ_ = js;
 
     // T_moved in stream tet ids, ascending (written by putMoved() once T_new is known).
+    const CollapseTets& tets = tetsOf(c);
     moved_.clear();
-    for (uint32_t k = log.movedBegin[c]; k < log.movedBegin[c + 1]; ++k) moved_.push_back(out_.streamTetOf[log.moved[k]]);
+    for (uint32_t m : tets.moved) moved_.push_back(out_.streamTetOf[m]);
     std::sort(moved_.begin(), moved_.end());
     starOf(pm_, js, star_);
 
@@ -257,11 +265,11 @@ class Encoder {
     // (interior edge) or a path (boundary edge), written as its vertices; otherwise as pairs.
     neighboursOf(pm_, js, candidates_);
     link_.build(pm_.mesh, js, star_, candidates_);
-    const uint32_t first = log.removedBegin[c], count = log.removedBegin[c + 1] - first;
+    const uint32_t count = uint32_t(tets.removed.size());
     pairs_.clear();
     for (uint32_t n = 0; n < count; ++n) {
-      const uint32_t* ab = &log.removedOthers[2 * size_t(first + n)];  // (i, j, a, b) has the tet's orientation
-      pairs_.push_back({out_.streamVertexOf[ab[0]], out_.streamVertexOf[ab[1]], log.removed[first + n]});
+      const uint32_t* ab = &tets.others[2 * size_t(n)];  // (i, j, a, b) has the tet's orientation
+      pairs_.push_back({out_.streamVertexOf[ab[0]], out_.streamVertexOf[ab[1]], tets.removed[n]});
     }
     const RingMode mode = chainPairs();
     putVarint(column(SplitColumn::NewTetCount), count << 2 | uint32_t(mode));
@@ -462,6 +470,8 @@ class Encoder {
   std::vector<float> prefixMax_, fields_;
   std::vector<uint8_t> columns_[kSplitColumns];  // the current chunk's records, column by column
   std::vector<Pair> pairs_, chain_;
+  CollapseTets tets_;                     // collapse tetsRead_'s (tetsOf)
+  uint32_t tetsRead_ = kNone;
   std::deque<Job> jobs_;  // chunks being compressed, in order (stable addresses)
   std::vector<uint32_t> star_, moved_, candidates_, newTets_, changed_, implied_;
   VertexLink link_;  // of p_j, as the reader sees it

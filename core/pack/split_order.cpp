@@ -17,8 +17,7 @@ void SplitOrder::plan(const CollapseLog& log, uint32_t first, uint32_t count) {
   };
   for (uint32_t k = 0; k < count; ++k) {
     const uint32_t c = C - 1 - (first + k);
-    const uint32_t m0 = log.movedBegin[c], m1 = log.movedBegin[c + 1];
-    const uint32_t r0 = log.removedBegin[c], r1 = log.removedBegin[c + 1];
+    log.readTets(c, tets_);
     const uint32_t s0 = log.starBegin[c], s1 = log.starBegin[c + 1];
     // After the last writer of every tet it reads, after every writer and reader of a tet it writes.
     uint32_t after = 0;
@@ -27,12 +26,12 @@ void SplitOrder::plan(const CollapseLog& log, uint32_t first, uint32_t count) {
       const TetState& s = at(t);
       after = std::max({after, s.written, s.read});
     };
-    for (uint32_t e = m0; e < m1; ++e) writes(log.moved[e]);
-    for (uint32_t e = r0; e < r1; ++e) writes(log.removed[e]);
+    for (uint32_t t : tets_.moved) writes(t);
+    for (uint32_t t : tets_.removed) writes(t);
     const uint32_t wave = after + 1;
     for (uint32_t e = s0; e < s1; ++e) state_[log.star[e]].read = std::max(state_[log.star[e]].read, wave);
-    for (uint32_t e = m0; e < m1; ++e) state_[log.moved[e]].written = wave;
-    for (uint32_t e = r0; e < r1; ++e) state_[log.removed[e]].written = wave;
+    for (uint32_t t : tets_.moved) state_[t].written = wave;
+    for (uint32_t t : tets_.removed) state_[t].written = wave;
     waveOf_[k] = wave;
     waves = std::max(waves, wave);
   }

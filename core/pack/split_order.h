@@ -52,6 +52,7 @@ class SplitOrder {
     uint32_t read = 0;       // the latest wave that read it
   };
   std::vector<TetState> state_;
+  CollapseTets tets_;  // of the collapse being planned
   std::vector<uint32_t> waveOf_, waveStart_, byWave_, next_;  // per split; splits grouped by wave
   std::vector<uint64_t> wave_;
   uint32_t first_ = 0, stamp_ = 0;
