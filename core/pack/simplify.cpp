@@ -124,6 +124,7 @@ class Simplifier {
 
   CollapseVerdict check(uint32_t i, uint32_t j) {
     init();
+    readyLanes();
     Lane& L = *main_.lane;
     neighbours(L, i, L.nbr);
     const size_t slot = size_t(std::find(L.nbr.begin(), L.nbr.end(), j) - L.nbr.begin());
@@ -151,6 +152,7 @@ class Simplifier {
     if (V_ >= opt_.partitionMinVertices) runParts(planned);
     for (uint32_t v = 0; v < V_; ++v)  // (after the parts: what they left queued)
       if (out_.vertexAlive[v] && queued_[v]) W.heap.push({queueKey(v), v});
+    readyLanes();
     const bool parallel = opt_.threads > 1 && V_ >= opt_.parallelMinVertices;
     const uint32_t roundSize = parallel ? kRoundSize : 1;
     WorkPool pool(parallel ? 1 : 0);
@@ -316,10 +318,9 @@ class Simplifier {
     lastCost_.assign(V_, float(kInf));
     // Every vertex's first cost, on two threads (each with its own scratch lane; the mesh is
     // only read), then queued in vertex order so the result does not depend on the threads.
-    mainLane_.reset(V_);
     main_.lane = &mainLane_;
     lanes_.resize(kRoundSize);
-    for (Lane& L : lanes_) L.reset(V_);
+    for (size_t k = 0; k < 2; ++k) lanes_[k].reset(V_);  // (the rest: readyLanes())
     auto work = [this](Lane& L, uint32_t begin, uint32_t end) {
       for (uint32_t v = begin; v < end; ++v)
         if (out_.vertexAlive[v]) lastCost_[v] = bestCost(L, v);
@@ -1704,6 +1705,13 @@ class Simplifier {
   std::vector<uint8_t> queued_;  // per vertex: has an entry in the queue (or in the current round)
   Lane mainLane_;
   std::vector<Lane> lanes_;  // one per entry of a round (and per thread in init() and runParts())
+  // The one queue's lanes (all but the two of the first costs and the slabs) get their
+  // per-vertex arrays only now, after the slabs, when less memory is in use (peak memory).
+  void readyLanes() {
+    if (mainLane_.seen.size() != V_) mainLane_.reset(V_);
+    for (Lane& L : lanes_)
+      if (L.seen.size() != V_) L.reset(V_);
+  }
   static constexpr uint32_t kRoundSize = 4;
   std::vector<Entry> round_;
   std::vector<uint32_t> changed_;  // per vertex: roundStamp_ of the last round that touched it
