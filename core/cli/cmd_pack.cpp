@@ -39,8 +39,10 @@ class ProgressLine {
     const double secs = std::chrono::duration<double>(now - phaseStart_).count();
     const double fraction = planned ? double(done) / double(planned) : 0.0;
     char rate[48] = "", eta[32] = "";
+    // A rate only where the phase counts items (reading counts itself as 0 then 1 of 1).
+    const char* unit = phase_ == "simplify" ? "collapses" : phase_ == "encode" ? "splits" : nullptr;
     if (planned && secs > 0.2) {
-      std::snprintf(rate, sizeof rate, ", %.0fk %s/s", done / secs / 1000, phase_ == "simplify" ? "collapses" : "splits");
+      if (unit) std::snprintf(rate, sizeof rate, ", %.0fk %s/s", done / secs / 1000, unit);
       if (fraction > 0.02 && fraction < 1) std::snprintf(eta, sizeof eta, ", %.0f s left", secs * (1 - fraction) / fraction);
     }
     const int filled = int(fraction * 30 + 0.5);

@@ -67,10 +67,10 @@ void snapFields(TetMesh& mesh, const Manifest& m) {
 
 }  // namespace
 
-// Packing needs about kPackBytesPerTet per input tet at its peak (measured in session 18: 147 B
-// on Harmonic 64³, 150 B on Harmonic 128³, 154 B on the carotid data, 180 B on Blunt Fin, README),
-// with a margin. A mesh that would need more than the limit is refused up front with the figure,
-// rather than failing an allocation halfway through a long run.
+// Packing needs about kPackBytesPerTet per input tet at its peak (measured in session 20: 133 B
+// on Harmonic 64³ and ironProt.vtk, 129 B on Harmonic 128³, 140 B on the carotid data, 165 B on
+// Blunt Fin, README), with a margin. A mesh that would need more than the limit is refused up
+// front with the figure, rather than failing an allocation halfway through a long run.
 constexpr double kPackBytesPerTet = 200;
 
 Result checkMemoryFor(const TetMesh& mesh, const PackOptions& opt) {

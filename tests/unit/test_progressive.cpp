@@ -363,8 +363,6 @@ void expectSameOnOneThreadAndTwo(const TetMesh& m, SimplifyOptions o, SimplifyRe
   EXPECT_EQ(one.queuePops, two.queuePops);
 }
 
-// The two-thread loop evaluates queue entries speculatively and must give exactly the collapses
-// of the one-thread loop (every round size and interleaving, down to the last vertex).
 // The collapse log keeps each collapse's tets as varints (collapse_log.h): read back, they must
 // be what was written (moved tets as a set), for ids anywhere in uint32, empty lists included,
 // and a record copied into another log must read the same there.
@@ -410,6 +408,8 @@ TEST(CollapseLog, TetsReadBackAsWrittenAndCopied) {
   }
 }
 
+// The two-thread loop evaluates queue entries speculatively and must give exactly the collapses
+// of the one-thread loop (every round size and interleaving, down to the last vertex).
 TEST(Progressive, TwoThreadsCollapseExactlyAsOne) {
   SimplifyResult one, two;
   SimplifyOptions o;
