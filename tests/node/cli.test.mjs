@@ -3,7 +3,8 @@ import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import path from 'node:path';
-import { cli, root, tempDir, packedHarmonic } from './helpers.mjs';
+import { spawnSync } from 'node:child_process';
+import { cli, cliPath, root, tempDir, packedHarmonic } from './helpers.mjs';
 
 test('--help on the tool and every subcommand', () => {
   const top = cli('--help');
@@ -126,4 +127,26 @@ test('the other input formats: notes on stdout, --q names the PLOT3D solution', 
   assert.equal(gmsh.status, 0, gmsh.stderr);
   assert.match(gmsh.stdout, /note {6}split 2 hexahedra, 4 wedges, 12 pyramids into 48 tetrahedra/);
   assert.match(gmsh.stdout, /valid {5}no problems found/);
+});
+
+// The commands that read an input start the program again with glibc's huge pages on
+// (core/cli/huge_pages.h): the pack must be the same byte for byte with them, without them
+// (TETSTREAM_HUGE_PAGES=0) and with a user's own GLIBC_TUNABLES kept, and the restart must happen
+// once, not again and again (a loop would hit the timeout).
+test('huge pages on, off or with the user\'s own glibc tunables: the same pack', () => {
+  const dir = tempDir('huge-pages');
+  const vtu = path.join(dir, 'h.vtu');
+  assert.equal(cli('gen', 'harmonic', '--n', '10', '-o', vtu).status, 0);
+  const manifests = [];
+  for (const [name, env] of [['default', {}], ['off', { TETSTREAM_HUGE_PAGES: '0' }],
+    ['own tunables', { GLIBC_TUNABLES: 'glibc.malloc.check=0' }]]) {
+    const out = path.join(dir, name.replace(/ /g, '-'));
+    const r = spawnSync(cliPath, ['pack', vtu, '-o', out, '--json'],
+      { encoding: 'utf8', timeout: 60000, env: { ...process.env, ...env } });
+    assert.equal(r.status, 0, `${name}: ${r.stderr}`);
+    assert.equal(JSON.parse(r.stdout).tets, 9 ** 3 * 6, name);
+    manifests.push(fs.readFileSync(path.join(out, 'manifest.json'), 'utf8'));
+  }
+  assert.equal(manifests[1], manifests[0], 'without huge pages');
+  assert.equal(manifests[2], manifests[0], 'with the user\'s tunables');
 });
