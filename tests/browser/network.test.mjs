@@ -239,12 +239,16 @@ test('a chunk that fails twice with 503 is retried with backoff and the stream c
   own.setFaults([{ match: `/data/${chunkFile(3)}`, kind: 'status', status: 503, times: 2 }]);
   const { page, problems } = await openViewer(browser, `${ownUrl}/index.html?data=/data/manifest.json`,
     { allow: NETWORK_ERRORS, recordNotices: true });
-  // The retry message while it waits: a screenshot to look at.
-  await page.waitForFunction(() => /retrying part 4 of \d+ in/.test(window.tetstream.stats().notice), null, { timeout: 20000 });
+  // The retry message while it waits, as the status line shows it at that moment (read in the
+  // page: on a slow machine the backoff can run out before a round trip from here), then a
+  // screenshot to look at.
+  const shown = await (await page.waitForFunction(() => {
+    const text = document.querySelector('#status-text')?.textContent ?? '';
+    return /retrying part 4 of \d+ in/.test(window.tetstream.stats().notice) && /retrying part 4/.test(text) && text;
+  }, null, { timeout: 20000 })).jsonValue();
   await frames(page, 3);
   await page.screenshot({ path: path.join(outDir, 'network-retry.png') });
-  // The status line is read after the screenshot: the backoff may have run out by then.
-  assert.match(await page.textContent('#status-text'),
+  assert.match(shown,
     new RegExp(`^The server answered HTTP 503 \\(Service Unavailable\\): retrying part 4 of ${parts()} (in (\\d+ s|a moment)|now \\(attempt 2\\))\\.$`));
   const s = await waitForState(page, ['complete', 'error']);
   assertCompleteAndRight(s, '503 twice');
@@ -301,7 +305,10 @@ test('a dropped connection mid-chunk is retried and the stream completes', async
 
 test('a slow chunk is waited for (no retry), and frames keep coming meanwhile', async (t) => {
   const since = Date.now();
-  own.setFaults([{ match: `/data/${chunkFile(3)}`, kind: 'slow', delayMs: 3000, times: 1 }]);
+  // Held for 7 s (the stall timer is 10 s): the viewer asks for part 4 early, and a slow machine
+  // can take 3 s or more to receive the three parts before it, which left a 3 s hold run out
+  // before the second of frames below began.
+  own.setFaults([{ match: `/data/${chunkFile(3)}`, kind: 'slow', delayMs: 7000, times: 1 }]);
   const { page, problems } = await openViewer(browser, `${ownUrl}/index.html?data=/data/manifest.json`,
     { allow: NETWORK_ERRORS, recordNotices: true });
   // While part 4 is held back: the page keeps drawing (animation frames for one second).

@@ -70,11 +70,12 @@ before(async () => {
       { prefix: '/', dir: webDir },
     ],
   });
-  // /slow/... serves /data/... with every chunk 300 ms late (a slow link, for pause/resume),
-  // and every chunk request is logged.
+  // /slow/... serves /data/... with every chunk 600 ms late (a slow link, for pause/resume: the
+  // stream must still be going when the pause button has been found and clicked, which takes a
+  // slow machine with a software GL a few seconds), and every chunk request is logged.
   ({ server, baseUrl } = await listenWithSlowRoute(files, {
     slowTo: '/data',
-    delayMs: 300,
+    delayMs: 600,
     onRequest: (req) => { if (/\.tsc$/.test(req.url)) chunkRequests.push([Date.now(), req.url]); },
   }));
   browser = await launchBrowser();
@@ -276,7 +277,10 @@ test('pause stops fetching, resume completes the stream', async (t) => {
   await page.mouse.down();
   await frames(page, 2);
   await page.mouse.up();
-  await page.waitForFunction(() => window.tetstream.stats().paused, null, { timeout: 5000 });
+  await page.waitForFunction(() => window.tetstream.stats().paused, null, { timeout: 5000 }).catch(async (e) => {
+    const st = await page.evaluate(() => window.tetstream.stats());
+    throw new Error(`not paused after the click (${st.state}, ${st.chunksReceived} chunks in): ${e.message}`);
+  });
   const pausedAt = Date.now();
   const p = await page.evaluate(() => window.tetstream.stats());
   assert.equal(p.paused, true);
