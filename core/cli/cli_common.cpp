@@ -5,7 +5,6 @@
 #include <filesystem>
 
 #include "dataset.h"
-#include "huge_pages.h"
 #include "pack/mesh_io.h"
 
 namespace tetstream::cli {
@@ -25,7 +24,6 @@ void addReadOptions(CLI::App* sub, ReadOptions& read) {
 }
 
 Result loadInput(const std::string& path, Input& in, const LevelOption& level, const ReadOptions& read) {
-  useHugePages();  // (may start the program again, with huge pages: huge_pages.h)
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) {
     if (!isPackedDir(path)) return fail(Status::IoError, path + ": a folder without manifest.json is not a packed dataset");

@@ -16,8 +16,6 @@
 namespace tetstream::cli {
 namespace {
 
-char** commandLine = nullptr;
-
 #if defined(__linux__) && defined(__GLIBC__)
 // What a first touch of a fresh 4 KB page costs here, in microseconds: 64 pages of a new mapping
 // written once each (about 0.3–1 µs on a machine of its own, 8–30 µs on this project's virtual
@@ -36,8 +34,6 @@ double microsecondsPerFreshPage() {
 
 }  // namespace
 
-void rememberCommandLine(char** argv) { commandLine = argv; }
-
 // Why: packing touches about 2.5 times its peak memory afresh (arrays freed and allocated again
 // phase after phase: the file, the face pairing, the simplifier's and the encoder's arrays), and
 // on virtual machines such as this project's a first touch is expensive: 128,000 page faults cost
@@ -48,16 +44,15 @@ void rememberCommandLine(char** argv) { commandLine = argv; }
 // 0.40 s, checks 0.37 -> 0.17 s), carotid 4.5 -> 3.7 s, Harmonic 24³ 491 -> 432 ms, peak memory
 // +3%; the output is the same. The second start costs ~6 ms here (post.vtk, 8,750 tets, gains about
 // as much); a file's size does not tell a small mesh from a large one (ironProt.vtk's 314 KB hold
-// 1.8M tets), so every command that reads an input does it. Not done when the kernel gives huge
+// 1.8M tets), so every command that reads an input does it (all but gen). Not done when the kernel gives huge
 // pages to every program anyway ("always") or to none ("never"), when the tunable is set already,
 // under valgrind (its tools would lose the program) or with TETSTREAM_HUGE_PAGES=0. Nor where a
 // first touch is cheap (under 2 µs a page), as there fewer faults can gain little, and huge pages
 // have been seen to cost: on session 16's machine the simplifier was no faster with them and
 // reading 2.3× slower.
-void useHugePages() {
+void useHugePages(char** argv) {
 #if defined(__linux__) && defined(__GLIBC__)
   constexpr double kCheapPageMicroseconds = 2.0;
-  if (!commandLine) return;
   const char* optOut = std::getenv("TETSTREAM_HUGE_PAGES");
   if (optOut && std::strcmp(optOut, "0") == 0) return;
   if (std::getenv("TETSTREAM_RESTARTED")) return;  // (never twice, whatever glibc does with the tunable)
@@ -73,7 +68,9 @@ void useHugePages() {
       tunables && *tunables ? std::string(tunables) + ":glibc.malloc.hugetlb=1" : "glibc.malloc.hugetlb=1";
   if (setenv("GLIBC_TUNABLES", value.c_str(), 1) != 0 || setenv("TETSTREAM_RESTARTED", "1", 1) != 0) return;
   std::fflush(nullptr);
-  execv("/proc/self/exe", commandLine);  // returns only if it failed: go on with small pages
+  execv("/proc/self/exe", argv);  // returns only if it failed: go on with small pages
+#else
+  (void)argv;
 #endif
 }
 

@@ -1,14 +1,12 @@
 // Transparent huge pages for the commands that read a mesh or a packed dataset (why and what it
-// gains: huge_pages.cpp). Linux with glibc only; elsewhere these do nothing.
+// gains: huge_pages.cpp). Linux with glibc only; elsewhere it does nothing.
 #pragma once
 
 namespace tetstream::cli {
 
-// main() hands over its argv first: the program may start itself again with it.
-void rememberCommandLine(char** argv);
-
-// Called before a command reads its input: the program starts itself again with glibc's huge pages
-// on and runs the same command line from the start. Returns where it does not (see the .cpp).
-void useHugePages();
+// Called once, after the command line is parsed and before the command reads its input: the
+// program starts itself again with argv and glibc's huge pages on. Returns where it does not (see
+// the .cpp), and in the restarted program.
+void useHugePages(char** argv);
 
 }  // namespace tetstream::cli

@@ -10,7 +10,6 @@
 #include "manifest.h"
 
 int main(int argc, char** argv) {
-  tetstream::cli::rememberCommandLine(argv);
 #if defined(__GLIBC__)
   // One malloc arena for all threads: the packer's two simplifier threads grow and free star
   // lists that other threads allocated, and separate arenas kept 24 MB more at the peak
@@ -32,7 +31,12 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
-  for (auto& [sub, run] : runners)
-    if (sub->parsed()) return run();
+  for (auto& [sub, run] : runners) {
+    if (!sub->parsed()) continue;
+    // Every command but gen reads a mesh or a packed dataset: decided once, before any work
+    // (the program may start again here, with huge pages: huge_pages.h).
+    if (sub->get_name() != "gen") useHugePages(argv);
+    return run();
+  }
   return 2;
 }

@@ -67,9 +67,9 @@ void snapFields(TetMesh& mesh, const Manifest& m) {
 
 }  // namespace
 
-// Packing needs about kPackBytesPerTet per input tet at its peak (measured in session 20: 133 B
-// on Harmonic 64³ and ironProt.vtk, 129 B on Harmonic 128³, 140 B on the carotid data, 165 B on
-// Blunt Fin, README), with a margin. A mesh that would need more than the limit is refused up
+// Packing needs about kPackBytesPerTet per input tet at its peak (measured in session 20 with
+// huge pages, which add 2-4%: 138 B on Harmonic 64³, 136 B on ironProt.vtk, 130 B on Harmonic
+// 128³, 145 B on the carotid data, 178 B on Blunt Fin, README), with a margin. A mesh that would need more than the limit is refused up
 // front with the figure, rather than failing an allocation halfway through a long run.
 constexpr double kPackBytesPerTet = 200;
 
