@@ -155,6 +155,8 @@ class Simplifier {
     readyLanes();
     const bool parallel = opt_.threads > 1 && V_ >= opt_.parallelMinVertices;
     const uint32_t roundSize = parallel ? kRoundSize : 1;
+    trackChanges_ = roundSize > 1;  // (changedThisRound reads changed_ only then)
+    if (trackChanges_) changed_.assign(V_, 0);
     WorkPool pool(parallel ? 1 : 0);
     auto evaluateTask = [this](uint32_t k) { evaluateVertex(lanes_[k], round_[k].vertex); };
     auto goOn = [&] { return alive_ - W.collapsed > target && tetsAlive_ - W.tetsRemoved > opt_.targetTets && !W.errorBound; };
@@ -311,7 +313,6 @@ class Simplifier {
     onBoth([&](int part) { sums(part, part ? V_ / 2 : 0, part ? V_ : V_ / 2); });
     flatInput_ += flat[0] + flat[1];
     queued_.assign(V_, 0);
-    changed_.assign(V_, 0);
     represented_.assign(V_, 1);
     lastCost_.assign(V_, float(kInf));
     // Every vertex's first cost, on two threads (each with its own scratch lane; the mesh is
@@ -1684,9 +1685,11 @@ class Simplifier {
           W.touched.push_back(w);
         }
       }
-    changed_[i] = roundStamp_;
+    if (trackChanges_) {  // (random writes the slabs and a one-thread queue would make for nothing)
+      changed_[i] = roundStamp_;
+      for (uint32_t v : W.touched) changed_[v] = roundStamp_;
+    }
     for (uint32_t v : W.touched) {
-      changed_[v] = roundStamp_;
       if (queued_[v]) continue;  // its entry stays: it is evaluated afresh when popped
       queued_[v] = 1;
       if (W.part >= 0 && !inner_[v]) continue;  // left to the whole mesh's queue
@@ -1734,6 +1737,7 @@ class Simplifier {
   static constexpr uint32_t kRoundSize = 4;
   std::vector<Entry> round_;
   std::vector<uint32_t> changed_;  // per vertex: roundStamp_ of the last round that touched it
+  bool trackChanges_ = false;      // collapses keep changed_ (the one queue's rounds of several)
   uint32_t roundStamp_ = 0;
   Worker main_;     // the one queue of the whole mesh (its log is out_.log)
   Worker parts_[kMaxSlabs];  // the slabs of the parallel phase
