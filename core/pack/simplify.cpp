@@ -212,7 +212,8 @@ class Simplifier {
     out_.log.close(opt_.recordReadSets);
     if (fitOn_ && opt_.refitValues) refitValues();
     if (fitOn_) {
-      out_.values = fit_;
+      out_.values.resize(V_);
+      for (uint32_t v = 0; v < V_; ++v) out_.values[v] = vert_[v].fit;
       out_.valuesField = opt_.field;
     }
     return Result::success();
@@ -224,7 +225,11 @@ class Simplifier {
     V_ = mesh_.vertexCount();
     T_ = mesh_.tetCount();
     field_ = mesh_.fields[size_t(opt_.field)].values.data();
-    fit_ = mesh_.fields[size_t(opt_.field)].values;
+    vert_.resize(V_);
+    for (uint32_t v = 0; v < V_; ++v) {
+      const float* q = &mesh_.positions[3 * size_t(v)];
+      vert_[v] = {{q[0], q[1], q[2]}, field_[v]};
+    }
     fitOn_ = opt_.fitValues;
     Range r = computeRange(mesh_.fields[size_t(opt_.field)].values);
     range_ = r.max > r.min ? double(r.max) - r.min : 1.0;
@@ -360,14 +365,14 @@ class Simplifier {
 
   static constexpr uint8_t kFaces[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
 
-  // Vertex v's position, read from the mesh's floats (exact in double): no copy of the
-  // positions in double, which took 24 bytes a vertex of memory and of the caches.
+  // Vertex v's position, from the floats of vert_ (exact in double; a copy in double took 24
+  // bytes a vertex of memory and of the caches).
   struct Point {
     double x[3];
     operator const double*() const { return x; }
   };
   Point p(uint32_t v) const {
-    const float* q = &mesh_.positions[3 * size_t(v)];
+    const float* q = vert_[v].x;
     return {{q[0], q[1], q[2]}};
   }
 
@@ -580,7 +585,7 @@ class Simplifier {
         const Point q = p(v[k]);
         st.other[m] = v[k];
         st.mask |= bitOf(L.place[v[k]]);
-        st.f[m] = fit_[v[k]];
+        st.f[m] = vert_[v[k]].fit;
         for (int a = 0; a < 3; ++a) st.x[m][a] = q[a];
         ++m;
       }
@@ -692,7 +697,7 @@ class Simplifier {
     FieldQuadric fq = fieldQuadric_[i];
     fq.add(fieldQuadric_[j]);
     const uint32_t count = represented_[i] + represented_[j];
-    c.sj = fitsRegion(count) ? fitted(fq, P, fit_[j]) : fit_[j];
+    c.sj = fitsRegion(count) ? fitted(fq, P, vert_[j].fit) : vert_[j].fit;
     // The field quadric over everything i and j stand for (our stand-in for eq. 5's sum over
     // the region).
     const double x5[5] = {P[0], P[1], P[2], c.sj, 1.0};
@@ -860,8 +865,7 @@ class Simplifier {
           L.seen[w] = L.stamp;
           L.place[w] = uint8_t(std::min<size_t>(out.size(), 255));
           out.push_back(w);
-          __builtin_prefetch(&mesh_.positions[3 * size_t(w)]);  // prepareStar and legal() read it next
-          __builtin_prefetch(&fit_[w]);
+          __builtin_prefetch(&vert_[w]);  // prepareStar and legal() read it next
         }
       }
     }
@@ -1457,7 +1461,7 @@ class Simplifier {
           continue;  // (a vertex of no tet stands nowhere)
         }
         l.usable = std::isfinite(field_[v]);  // a NaN or infinite sample (or neighbour value) fits nothing
-        for (int x = 0; x < 4; ++x) l.usable = l.usable && (l.w[x] == 0 || std::isfinite(fit_[l.t4[x]]));
+        for (int x = 0; x < 4; ++x) l.usable = l.usable && (l.w[x] == 0 || std::isfinite(vert_[l.t4[x]].fit));
       }
     });
     onBoth([&](int part) {
@@ -1472,7 +1476,7 @@ class Simplifier {
           rhs[r] += l.w[x] * f;
           for (int y = 0; y < 4; ++y) {
             if (l.w[y] == 0) continue;
-            if (col[l.t4[y]] == none) rhs[r] -= l.w[x] * l.w[y] * fit_[l.t4[y]];  // a fixed value
+            if (col[l.t4[y]] == none) rhs[r] -= l.w[x] * l.w[y] * vert_[l.t4[y]].fit;  // a fixed value
             else at(r, col[l.t4[y]]) += l.w[x] * l.w[y];
           }
         }
@@ -1484,7 +1488,7 @@ class Simplifier {
     std::vector<double> x(n), res(n), z(n), d(n), q(n), inverse(n);
     std::vector<uint8_t> held(n, 0);
     for (uint32_t r = 0; r < n; ++r) {
-      x[r] = std::isfinite(fit_[free[r]]) ? fit_[free[r]] : 0.0;
+      x[r] = std::isfinite(vert_[free[r]].fit) ? vert_[free[r]].fit : 0.0;
       const double diagonal = at(r, r);
       inverse[r] = diagonal > 0 ? 1 / diagonal : 0.0;
       if (!(diagonal > 0)) held[r] = 2;  // no usable sample around it: it keeps its value
@@ -1533,7 +1537,7 @@ class Simplifier {
       if (!crossed) break;
     }
     for (uint32_t r = 0; r < n; ++r)
-      if (held[r] != 2 && std::isfinite(x[r])) fit_[free[r]] = float(std::clamp(x[r], fieldMin_, fieldMax_));
+      if (held[r] != 2 && std::isfinite(x[r])) vert_[free[r]].fit = float(std::clamp(x[r], fieldMin_, fieldMax_));
   }
   static constexpr int kRefitRounds = 4;
   static constexpr int kRefitIterations = 200;
@@ -1599,8 +1603,8 @@ class Simplifier {
     if (W.part >= 0) W.keys.push_back(key);
     log.i.push_back(i);
     log.j.push_back(j);
-    log.iValue.push_back(fit_[i]);
-    log.jValue.push_back(fit_[j]);
+    log.iValue.push_back(vert_[i].fit);
+    log.jValue.push_back(vert_[j].fit);
     log.fieldError.push_back(float(fieldErr * range_));
     CollapseTets& record = W.record;
     record.clear();
@@ -1668,7 +1672,7 @@ class Simplifier {
     // the value before back. (The paper keeps the sample; at 5% of Harmonic's tets fitting
     // lowers the RMS field error by a fifth.)
     represented_[j] += represented_[i];
-    if (fitsRegion(represented_[j])) fit_[j] = float(fitted(fieldQuadric_[j], p(j), fit_[j]));
+    if (fitsRegion(represented_[j])) vert_[j].fit = float(fitted(fieldQuadric_[j], p(j), vert_[j].fit));
 
     // Everything around j changed. j and its neighbours are re-evaluated lazily, when they reach
     // the top: those already queued keep their entry; a blocked one (no legal collapse last
@@ -1706,7 +1710,13 @@ class Simplifier {
   uint32_t V_ = 0, T_ = 0, alive_ = 0, tetsAlive_ = 0, flatInput_ = 0;
   const float* field_ = nullptr;
   double range_ = 1, diag_ = 1;
-  std::vector<float> fit_;  // the steering field's value at each vertex now (fitted, see collapse)
+  // Per vertex, what an evaluation reads of each neighbour, in one place (one cache line
+  // instead of two): its position and the steering field's value now (fitted, see collapse).
+  struct Vertex {
+    float x[3];
+    float fit;
+  };
+  std::vector<Vertex> vert_;
   std::vector<uint32_t> represented_;  // per vertex: input vertices it stands for (itself and those collapsed into it)
   bool fitOn_ = false;
   double fieldMin_ = 0, fieldMax_ = 0;
