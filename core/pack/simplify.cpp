@@ -808,7 +808,7 @@ class Simplifier {
   // quadrics were half of its time): it is asked for as soon as legal() passes the out-edge, and
   // only then. Asking for every neighbour's while legal() ran, as before session 21, fetched four
   // times what was used (about 3 of 14 out-edges are legal), and the two threads of the slabs
-  // share the memory's bandwidth: 5% more time in the simplifier on Harmonic 64³.
+  // share the memory's bandwidth: 3-5% more time in the simplifier on Harmonic 64³.
   void gatherCandidates(Lane& L, uint32_t i) {
     L.candidates.clear();
     L.passed.clear();
