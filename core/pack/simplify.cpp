@@ -132,7 +132,7 @@ class Simplifier {
     CollapseVerdict v = CollapseVerdict::Legal;
     prepareStar(L, i);
     if (legal(L, i, j, bitOf(slot), &v)) {
-      Candidate c = boundTerms(L, i, j, bitOf(slot));
+      Candidate c = boundTerms(L, i, j, bitOf(slot), L.removed, L.removedQuality);
       localTerm(L, i, c);
       finishCost(L, c, &v);
     }
@@ -689,7 +689,8 @@ class Simplifier {
 
   // Everything of the cost but the local field error and the exact shape term: the geometric
   // error, the region term of the field error and a lower bound of the shape term.
-  Candidate boundTerms(Lane& L, uint32_t i, uint32_t j, uint64_t bit) {
+  // (removed, removedQuality: what legal() found of the tets the collapse removes.)
+  Candidate boundTerms(Lane& L, uint32_t i, uint32_t j, uint64_t bit, int removed, double removedQuality) {
     const Point P = p(j);
     Candidate c;
     c.j = j;
@@ -719,8 +720,6 @@ class Simplifier {
     // E_s after the collapse with every new tet at the best quality (3/κ = 1), as the tets of
     // p_j's star that stay are known: most candidates lose without finishCost(). Scaled down a
     // little so that round-off (its sums run in another order) never lifts it above E_s.
-    const double removedQuality = L.removedQuality;  // (from legal())
-    const int removed = L.removed;
     const double moved = double(L.star.size()) - removed, after = double(star_[j].size()) - removed + moved;
     c.shapeBound = after > 0 ? std::max(0.0, 1.0 - (qualitySum_[j] - removedQuality + moved) / after) : 0.0;
     setCost(c, 0.0);  // a lower bound: the local error is at least 0 (rounding is monotone)
@@ -825,9 +824,7 @@ class Simplifier {
       __builtin_prefetch(&represented_[w]);
     }
     for (const Lane::Passed& x : L.passed) {
-      L.removed = x.removed;  // (what boundTerms() takes from legal())
-      L.removedQuality = x.removedQuality;
-      L.candidates.push_back(boundTerms(L, i, L.nbr[x.place], bitOf(x.place)));
+      L.candidates.push_back(boundTerms(L, i, L.nbr[x.place], bitOf(x.place), x.removed, x.removedQuality));
     }
   }
 
