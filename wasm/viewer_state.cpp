@@ -143,6 +143,12 @@ void updateState(ViewerState& s) {
     s.state = LoadState::Streaming;
 }
 
+// One work slice (advance or growTree) of `ms` into the histogram of slice durations.
+void noteSlice(ViewerState& s, double ms) {
+  size_t bin = 0;
+  while (bin < kSliceEdgesMs.size() && ms >= kSliceEdgesMs[bin]) ++bin;
+  ++s.sliceCounts[bin];
+}
 }  // namespace
 
 const char* loadStateName(LoadState s) {
@@ -317,6 +323,7 @@ bool advance(ViewerState& s, double deadlineMs, Clock now) {
   s.surfaceDirty = s.hullDirty = true;
   if (s.sliceOn) s.sliceDirty = true;
   s.refineMs = now() - t0;
+  noteSlice(s, s.refineMs);
   s.maxRefineMs = std::max(s.maxRefineMs, s.refineMs);
   s.refineTotalMs += s.refineMs;
   s.refineSteps = steps;
@@ -494,9 +501,11 @@ bool growTree(ViewerState& s, double deadlineMs, Clock now) {
   // A small mesh at once (a bulk build is faster than inserting); a big one in steps.
   constexpr uint32_t kAtOnce = 1u << 16, kStep = 2048;
   const uint32_t step = s.surface.treeCoverage() == 0 && mesh.tetCount() <= kAtOnce ? kAtOnce : kStep;
+  const double t0 = now();
   bool whole;
   do whole = s.surface.extendTree(mesh, fieldValues(s), step);
   while (!whole && now() < deadlineMs);
+  noteSlice(s, now() - t0);
   return !whole;
 }
 
@@ -893,6 +902,8 @@ std::string statsJson(const ViewerState& s) {
       {"maxRefineMs", s.maxRefineMs},
       {"refineTotalMs", s.refineTotalMs},
       {"refineSteps", s.refineSteps},
+      {"sliceEdgesMs", kSliceEdgesMs},
+      {"sliceCounts", s.sliceCounts},
       {"frameMs", s.frameMs},
       {"maxFrameMs", s.maxFrameMs},
       {"maxFrameGapMs", s.maxFrameGapMs},

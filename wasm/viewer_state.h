@@ -25,6 +25,7 @@
 // Errors never drop what is on screen: the last valid level, its surface and hull stay, and the
 // level slider keeps working over the chunks that did arrive.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -146,6 +147,14 @@ struct Rect {
   float x = 0, y = 0, w = 0, h = 0;
 };
 
+// Splits per stepTowards call inside advance(), between two looks at the clock: small enough to
+// stop close to the deadline (a split with its surface and hull updates costs ~15-25 us in wasm,
+// so a batch ~0.6 ms).
+inline constexpr uint32_t kStepBatch = 32;
+
+// Bin edges (ms) of ViewerState::sliceCounts. 30 ms is the most refinement may add to a frame.
+inline constexpr std::array<double, 6> kSliceEdgesMs = {4, 8, 12, 16, 30, 60};
+
 struct ViewerState {
   Dataset dataset;
   int field = -1;        // index into dataset.manifest.fields, -1 before a manifest
@@ -199,6 +208,10 @@ struct ViewerState {
   double maxRefineMs = 0;      // longest refinement work in one frame
   double refineTotalMs = 0;    // all refinement work so far (the main thread's share, for benchmarks)
   uint32_t refineSteps = 0;    // splits applied or undone in the last frame that did any
+  // Work slices (advance, growTree) by duration, bins split at kSliceEdgesMs: the budget is a few
+  // ms a slice; a slice far over it is a stall the user feels (an occasional one is the OS or the
+  // browser taking the core, which no budget prevents, so tests look at the share).
+  std::array<uint32_t, kSliceEdgesMs.size() + 1> sliceCounts{};
   // Set by the main loop, counted from the first surface on (before it, start-up work such as
   // WebGL and ImGui set-up is not the viewer's frame rate):
   double frameMs = 0;          // smoothed interval between frame callbacks
@@ -233,11 +246,6 @@ struct ViewerState {
   // Scratch, reused every frame.
   std::vector<uint32_t> changed, splitVertices;
 };
-
-// Splits per stepTowards call inside advance(), between two looks at the clock: small enough to
-// stop close to the deadline (a split with its surface and hull updates costs ~15-25 us in wasm,
-// so a batch ~0.6 ms).
-inline constexpr uint32_t kStepBatch = 32;
 
 // Parses and validates the manifest (untrusted) and resets everything to the new dataset.
 // The isovalue becomes the middle of the iso field's range.
@@ -329,6 +337,7 @@ double secondsLeft(const ViewerState& s);        // at the current rate; < 0 whe
 //  bytesDownloaded, bytesTotal, rateBytesPerSec, secondsLeft, splitsApplied, splitsReceived,
 //  splitsTotal, targetSplits, level, live, paused, fieldError, baseVertices, hullTriangles,
 //  hullLines, firstSurfaceMs, completeMs, extractMs, refineMs, maxRefineMs, refineTotalMs, refineSteps,
+//  sliceEdgesMs, sliceCounts (work slices by duration, bins split at the edges),
 //  frameMs, maxFrameMs, maxFrameGapMs, drawMs, maxDrawMs, drawTotalMs, reducedFrames, softwareGl, treeTets (tets the interval tree covers), uploadBytes, fullUploads, partialUploads,
 //  grownUploads (full uploads because a buffer grew), showBoundary,
 //  notice, chunksAllowed, memoryLimited, memory:{heapBytes, dataBytes, gpuBytes, limitBytes,

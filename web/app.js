@@ -25,7 +25,8 @@
 //                       check), programBytesReceived / programBytesTotal (tetstream.wasm);
 //                       memory: {heapBytes, dataBytes, gpuBytes, limitBytes, neededBytes,
 //                       allowedBytes}, memoryLimited; frame timing: maxFrameMs, maxFrameGapMs,
-//                       maxRefineMs. sliderRect, levelSliderRect and pauseButtonRect are in CSS
+//                       maxRefineMs, sliceCounts (work slices by duration, bins split at
+//                       sliceEdgesMs). sliderRect, levelSliderRect and pauseButtonRect are in CSS
 //                       pixels of the page.
 //   setIsovalue(v)   -> re-extracts the surface at v
 //   setField(name)   -> true when the field exists (the field that defines the isosurface)

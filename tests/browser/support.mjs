@@ -23,9 +23,11 @@ const chromiumArgs = [
   '--disable-background-networking', '--disable-component-update', '--disable-sync', '--disable-quic',
 ];
 
-// SwiftShader renders in software, so frames are far slower than on a GPU: a generous bound.
-// The real figures go to the test output (t.diagnostic).
-export const MAX_FRAME_MS = 250;
+// A frame callback is almost all drawing, and SwiftShader renders in software on the same two
+// cores as everything else: 20-130 ms a frame here, 345 ms once on a loaded CI machine. So this
+// bound only catches a stall; the viewer's own budget is checked on its work slices
+// (assertSlices). The real figures go to the test output (t.diagnostic).
+export const MAX_FRAME_MS = 500;
 
 // Listens on 127.0.0.1 with the project's server `files` behind a /slow/... route that serves
 // `slowTo`/... with every chunk `delayMs` late (a slow link, so a test can act mid-stream).
@@ -131,10 +133,28 @@ export async function waitForLevel(page, timeout = 120000) {
   return page.evaluate(() => window.tetstream.stats());
 }
 
+// Refinement and interval tree work run in slices of 8 ms (4 while the user drags: wasm/main.cpp);
+// issue 3 allows a frame no more than ~30 ms of it. A single slice over that is the OS or the
+// browser taking the core on a busy machine, which no budget prevents: one was 70 ms in a run
+// whose other slices were 8-27 ms. A budget that does not hold shows in many slices.
+export function assertSlices(s) {
+  const total = s.sliceCounts.reduce((a, b) => a + b, 0);
+  const over = (ms) => s.sliceCounts.reduce((n, c, bin) => n + (bin > 0 && s.sliceEdgesMs[bin - 1] >= ms ? c : 0), 0);
+  assert.ok(total > 0, 'refinement ran in slices');
+  assert.ok(over(16) * 2 < total, `most slices over 16 ms: ${sliceReport(s)}`);
+  assert.ok(over(30) <= Math.max(2, total / 20), `more than one slice in 20 over 30 ms: ${sliceReport(s)}`);
+}
+
+export function sliceReport(s) {
+  const bins = s.sliceCounts.map((c, bin) =>
+    `${bin === 0 ? '<' + s.sliceEdgesMs[0] : bin === s.sliceEdgesMs.length ? '≥' + s.sliceEdgesMs[bin - 1] : s.sliceEdgesMs[bin - 1] + '-' + s.sliceEdgesMs[bin]}: ${c}`);
+  return `work slices by ms ${bins.join(', ')}`;
+}
+
 export function frameReport(s) {
   return `max frame callback ${s.maxFrameMs.toFixed(1)} ms (drawing ${s.maxDrawMs.toFixed(1)} ms; ${s.reducedFrames} reduced frames), ` +
     `max gap between frames ${s.maxFrameGapMs.toFixed(1)} ms, ` +
-    `max refinement slice ${s.maxRefineMs.toFixed(1)} ms; uploads ${s.partialUploads} partial / ${s.fullUploads} full ` +
+    `max refinement slice ${s.maxRefineMs.toFixed(1)} ms (${sliceReport(s)}); uploads ${s.partialUploads} partial / ${s.fullUploads} full ` +
     `(${s.grownUploads} to grow a buffer), ` +
     `${(s.uploadBytes / 1048576).toFixed(1)} MB`;
 }

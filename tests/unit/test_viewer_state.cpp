@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <numbers>
+#include <numeric>
 #include <random>
 
 #include <nlohmann/json.hpp>
@@ -208,6 +209,10 @@ TEST(ViewerState, StreamsSplitsUnderABudgetWithLocalUpdates) {
   EXPECT_GT(s.refineSteps, 0u);
   EXPECT_LE(s.refineSteps, 2 * kStepBatch);
   EXPECT_EQ(s.dataset.splitsApplied(), s.refineSteps);
+  // The slice is counted in the histogram of slice durations (2 ticks: the first bin).
+  EXPECT_EQ(s.refineMs, 2);
+  EXPECT_EQ(s.sliceCounts[0], 1u);
+  EXPECT_EQ(std::accumulate(s.sliceCounts.begin(), s.sliceCounts.end(), 0u), 1u);
   EXPECT_FALSE(s.surface.fullUploadNeeded()) << "splits never re-extract the whole surface";
   EXPECT_FALSE(s.hull.fullUploadNeeded());
   expectMatchesFromScratch(s, "inside chunk 1");
@@ -229,6 +234,14 @@ TEST(ViewerState, StreamsSplitsUnderABudgetWithLocalUpdates) {
   EXPECT_EQ(j["fieldError"].get<double>(), 0.0);
   EXPECT_EQ(j["splitsApplied"], j["splitsTotal"]);
   EXPECT_EQ(j["chunksApplied"].get<uint32_t>(), s.chunksTotal);
+  // A slow clock (20 ms a reading): every later slice lands in the bins over 30 ms.
+  setLevel(s, 0);
+  const uint32_t before = s.sliceCounts[5] + s.sliceCounts[6];
+  int slow = 0;
+  while (advance(s, g_ticks + 1, [] { return g_ticks += 20; })) ++slow;
+  EXPECT_GT(slow, 0);
+  EXPECT_EQ(s.sliceCounts[5] + s.sliceCounts[6], before + uint32_t(slow));
+  EXPECT_EQ(j["sliceEdgesMs"].size() + 1, j["sliceCounts"].size());
 }
 
 TEST(ViewerState, LevelMovesBackAndForthAndStaysWhereTheUserPutsIt) {
