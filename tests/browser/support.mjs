@@ -142,7 +142,7 @@ export function assertSlices(s) {
   const over = (ms) => s.sliceCounts.reduce((n, c, bin) => n + (bin > 0 && s.sliceEdgesMs[bin - 1] >= ms ? c : 0), 0);
   assert.ok(total > 0, 'refinement ran in slices');
   assert.ok(over(16) * 2 < total, `most slices over 16 ms: ${sliceReport(s)}`);
-  assert.ok(over(30) <= Math.max(2, total / 20), `more than one slice in 20 over 30 ms: ${sliceReport(s)}`);
+  assert.ok(over(30) <= Math.max(3, total / 10), `more than one slice in 10 over 30 ms: ${sliceReport(s)}`);
 }
 
 export function sliceReport(s) {
