@@ -13,7 +13,7 @@
 //   complete        every chunk received and every split applied, against bytes ÷ bandwidth
 //   frames          rAF intervals from the first surface to complete: how many over 33 ms,
 //                   95th percentile, longest; the viewer's own longest frame callback and
-//                   refinement slice
+//                   refinement slice, and all work slices (refinement, interval tree) by duration
 // Writes build/bench/stream.json. Not a test: nothing is asserted; single runs unless --runs.
 // EXTRA_QUERY (environment) is appended to the viewer's URL, e.g. "&boundary=0"; VW and VH set
 // the window size (default 1280 x 800).
@@ -22,7 +22,7 @@ import path from 'node:path';
 import { createServer } from '../../server/serve.mjs';
 import { parseRate, parseMs } from '../../server/link.mjs';
 import { precompressDir } from '../../server/precompress.mjs';
-import { root, webDir, cli, launchBrowser, checkBuilds } from '../browser/support.mjs';
+import { root, webDir, cli, launchBrowser, checkBuilds, sliceReport } from '../browser/support.mjs';
 
 const args = process.argv.slice(2);
 const opt = (name, fallback) => {
@@ -101,6 +101,7 @@ async function measure(browser, url) {
       frameP95: streaming.length ? streaming[Math.floor(0.95 * (streaming.length - 1))] : 0,
       frameMax: streaming.length ? streaming[streaming.length - 1] : 0,
       maxFrameMs: s.maxFrameMs, maxRefineMs: s.maxRefineMs, maxDrawMs: s.maxDrawMs,
+      sliceEdgesMs: s.sliceEdgesMs, sliceCounts: s.sliceCounts,
       refineTotalMs: s.refineTotalMs, drawTotalMs: s.drawTotalMs, softwareGl: s.softwareGl, reducedFrames: s.reducedFrames, uploads: { bytes: s.uploadBytes, full: s.fullUploads, partial: s.partialUploads, grown: s.grownUploads },
       heapMB: s.memory.heapBytes / 1048576, dataMB: s.memory.dataBytes / 1048576, gpuMB: s.memory.gpuBytes / 1048576,
     };
@@ -123,6 +124,7 @@ function report(r) {
     `  frames while streaming: ${r.frames}, ${r.framesOver33} over 33 ms, p95 ${r.frameP95.toFixed(1)} ms, ` +
       `longest ${r.frameMax.toFixed(1)} ms; viewer: longest callback ${r.maxFrameMs.toFixed(1)} ms, ` +
       `refinement ${r.maxRefineMs.toFixed(1)} ms, drawing ${(r.maxDrawMs ?? 0).toFixed(1)} ms`,
+    `  ${sliceReport(r)}`,
     `  main thread from navigation to complete (${f(r.completeMs)} ms): refinement ${f(r.refineTotalMs)} ms ` +
       `(${f(r.splits / r.refineTotalMs * 1000)} splits/s), drawing ${f(r.drawTotalMs)} ms`,
     `  memory: heap ${r.heapMB.toFixed(0)} MB, data ${r.dataMB.toFixed(1)} MB, GPU ${r.gpuMB.toFixed(1)} MB` +
