@@ -142,17 +142,25 @@ void starOf(const ProgressiveMesh& pm, uint32_t v, std::vector<uint32_t>& tets) 
 }
 
 void neighboursOf(const ProgressiveMesh& pm, uint32_t v, std::vector<uint32_t>& vertices) {
-  vertices.clear();
+  // The star's tets lie anywhere in the tet array, and this is the first look at them in a
+  // split: their vertices are copied out in a pass without branches, so that the cache misses
+  // overlap, and only then de-duplicated (in place: the kept ones never overtake the reads).
+  const std::span<const uint32_t> corners = pm.stars.corners(v);
+  vertices.resize(4 * corners.size());
+  uint32_t* out = vertices.data();
+  for (uint32_t c : corners) {
+    std::memcpy(out, &pm.mesh.tets[c & ~3u], 4 * sizeof(uint32_t));
+    out += 4;
+  }
   const uint32_t stamp = nextStamp(pm);
   pm.seen[v] = stamp;
-  for (uint32_t c : pm.stars.corners(v)) {
-    const uint32_t* t = &pm.mesh.tets[c & ~3u];
-    for (int k = 0; k < 4; ++k)
-      if (pm.seen[t[k]] != stamp) {
-        pm.seen[t[k]] = stamp;
-        vertices.push_back(t[k]);
-      }
-  }
+  size_t n = 0;
+  for (uint32_t w : vertices)
+    if (pm.seen[w] != stamp) {
+      pm.seen[w] = stamp;
+      vertices[n++] = w;
+    }
+  vertices.resize(n);
   sortSmall(vertices);
 }
 
