@@ -144,23 +144,23 @@ void starOf(const ProgressiveMesh& pm, uint32_t v, std::vector<uint32_t>& tets) 
 void neighboursOf(const ProgressiveMesh& pm, uint32_t v, std::vector<uint32_t>& vertices) {
   // The star's tets lie anywhere in the tet array, and this is the first look at them in a
   // split: their vertices are copied out in a pass without branches, so that the cache misses
-  // overlap, and only then de-duplicated (in place: the kept ones never overtake the reads).
+  // overlap, and only then de-duplicated.
   const std::span<const uint32_t> corners = pm.stars.corners(v);
-  vertices.resize(4 * corners.size());
-  uint32_t* out = vertices.data();
+  std::vector<uint32_t>& ids = pm.cornerIds;
+  if (ids.size() < 4 * corners.size()) ids.resize(4 * corners.size());  // grows rarely: no zeroing per call
+  uint32_t* out = ids.data();
   for (uint32_t c : corners) {
     std::memcpy(out, &pm.mesh.tets[c & ~3u], 4 * sizeof(uint32_t));
     out += 4;
   }
+  vertices.clear();
   const uint32_t stamp = nextStamp(pm);
   pm.seen[v] = stamp;
-  size_t n = 0;
-  for (uint32_t w : vertices)
-    if (pm.seen[w] != stamp) {
-      pm.seen[w] = stamp;
-      vertices[n++] = w;
+  for (const uint32_t* w = ids.data(); w != out; ++w)
+    if (pm.seen[*w] != stamp) {
+      pm.seen[*w] = stamp;
+      vertices.push_back(*w);
     }
-  vertices.resize(n);
   sortSmall(vertices);
 }
 

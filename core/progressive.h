@@ -89,6 +89,7 @@ struct ProgressiveMesh {
   // Scratch for de-duplicating vertices without sorting: a stamp per vertex.
   mutable std::vector<uint32_t> seen;
   mutable uint32_t stamp = 0;
+  mutable std::vector<uint32_t> cornerIds;  // neighboursOf's scratch: the vertices of a star's tets
 
   uint32_t vertexCount() const { return mesh.vertexCount(); }
   uint32_t tetCount() const { return mesh.tetCount(); }
