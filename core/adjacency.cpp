@@ -10,7 +10,7 @@
 
 namespace tetstream {
 
-constexpr size_t kParallelHalfFaces = 400000;  // 100,000 tets
+[[maybe_unused]] constexpr size_t kParallelHalfFaces = 400000;  // 100,000 tets (native only)
 
 namespace {
 
