@@ -76,7 +76,7 @@ struct SimplifyOptions {
   // the values before, so splits restore them exactly. Off: every vertex keeps its sample.
   bool fitValues = true;
   // With fitValues, at the end the values of the vertices that stand for others are fitted again,
-  // all together, to the input field at every input vertex (least squares; simplify.cpp).
+  // all together, to the input field at every input vertex (least squares; simplify_refit.cpp).
   bool refitValues = true;
   std::function<void(uint32_t done, uint32_t planned)> progress;  // called now and then
   // Keep in the log what each split reads (CollapseLog::star), for StreamOptions::orderSplits.
@@ -88,7 +88,7 @@ struct SimplifyOptions {
   int threads = 2;
   uint32_t parallelMinVertices = 20000;
   // Meshes of at least this many vertices are simplified in slabs at once for most of the
-  // way (simplify.cpp, runParts); the result depends on this, not on `threads`.
+  // way (simplify_slabs.cpp); the result depends on this, not on `threads`.
   uint32_t partitionMinVertices = 50000;
 };
 

@@ -1,0 +1,155 @@
+// Simplifier set-up: stars, face adjacency, boundary and field quadrics, κ, first costs (simplifier.h).
+#include "pack/simplifier.h"
+
+namespace tetstream::simplify_detail {
+
+void Simplifier::init() {
+  V_ = mesh_.vertexCount();
+  T_ = mesh_.tetCount();
+  field_ = mesh_.fields[size_t(opt_.field)].values.data();
+  vert_.resize(V_);
+  for (uint32_t v = 0; v < V_; ++v) {
+    const float* q = &mesh_.positions[3 * size_t(v)];
+    vert_[v] = {{q[0], q[1], q[2]}, field_[v]};
+  }
+  fitOn_ = opt_.fitValues;
+  Range r = computeRange(mesh_.fields[size_t(opt_.field)].values);
+  range_ = r.max > r.min ? double(r.max) - r.min : 1.0;
+  fieldMin_ = r.min;
+  fieldMax_ = r.max;
+  diag_ = computeBounds(mesh_.positions).diagonal();
+  if (!(diag_ > 0)) diag_ = 1;
+
+  assert(!takeTets_ || takeTets_ == &mesh_.tets);
+  if (takeTets_) out_.tets = std::move(*takeTets_);  // (mesh_.tets is not read again: T_ counts them)
+  else out_.tets = mesh_.tets;
+  out_.tetAlive.assign(T_, 1);
+  out_.vertexAlive.assign(V_, 0);
+  star_.assign(V_, {});
+  {
+    std::vector<uint32_t> size(V_, 0);  // each star reserved at its size (no regrowth)
+    for (uint32_t v : out_.tets) ++size[v];
+    for (uint32_t v = 0; v < V_; ++v) star_[v].reserve(size[v]);
+  }
+  for (uint32_t t = 0; t < T_; ++t)
+    for (int k = 0; k < 4; ++k) star_[out_.tets[4 * size_t(t) + k]].push_back(t);
+  alive_ = 0;
+  for (uint32_t v = 0; v < V_; ++v)
+    if (!star_[v].empty()) { out_.vertexAlive[v] = 1; ++alive_; }
+
+  if (adjacency_ && adjacency_->opposite.size() == out_.tets.size()) {
+    opp_ = std::move(adjacency_->opposite);
+  } else {
+    FaceAdjacency adj;
+    buildFaceAdjacency(out_.tets, V_, adj);
+    opp_ = std::move(adj.opposite);
+  }
+  boundary_.assign(V_, 0);
+  // Only boundary vertices have a quadric (a tenth of a grid's vertices, fewer in a real mesh):
+  // 88 bytes each, stored for those alone.
+  quadricOf_.assign(V_, kNoQuadric);
+  quadrics_.clear();
+  for (uint32_t h = 0; h < 4 * T_; ++h) {
+    if (opp_[h] != kNoNeighbor) continue;
+    const uint32_t* v = &out_.tets[h & ~3u];
+    uint32_t a = v[kFaces[h & 3][0]], b = v[kFaces[h & 3][1]], c = v[kFaces[h & 3][2]];
+    const Point pa = p(a), pb = p(b), pc = p(c);
+    double u[3] = {pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]}, w[3] = {pc[0] - pa[0], pc[1] - pa[1], pc[2] - pa[2]};
+    double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+    double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    for (uint32_t x : {a, b, c}) {
+      boundary_[x] = 1;
+      if (quadricOf_[x] == kNoQuadric) {
+        quadricOf_[x] = uint32_t(quadrics_.size());
+        quadrics_.emplace_back();
+      }
+    }
+    if (len == 0) continue;
+    for (double& x : n) x /= len;
+    double d = -(n[0] * pa[0] + n[1] * pa[1] + n[2] * pa[2]);
+    const double plane[4] = {n[0], n[1], n[2], d};
+    for (uint32_t x : {a, b, c}) quadrics_[quadricOf_[x]].addSquare(plane, 0.5 * len);
+  }
+  kappa_.resize(T_);
+  qualitySum_.assign(V_, 0.0);
+  fieldQuadric_.assign(V_, {});
+  // κ of every tet and the per-vertex sums over them (3/κ, field quadrics) on two threads: each
+  // adds to the vertices of its own range only, taking the tets in order, so every sum is
+  // formed in the same order as on one thread; a tet with vertices in both ranges is computed
+  // by both (few, in a mesh numbered coherently).
+  uint32_t flat[2] = {0, 0};
+  auto sums = [&](int part, uint32_t lo, uint32_t hi) {
+    for (uint32_t t = 0; t < T_; ++t) {
+      const uint32_t* v = &out_.tets[4 * size_t(t)];
+      bool mine[4], any = false;
+      for (int k = 0; k < 4; ++k) any |= mine[k] = v[k] >= lo && v[k] < hi;
+      if (!any) continue;
+      const float kappa = tetKappa(t);
+      if (mine[0]) {  // (the owner of its first vertex writes κ)
+        kappa_[t] = kappa;
+        flat[part] += kappa >= kKappaCap;
+      }
+      for (int k = 0; k < 4; ++k)
+        if (mine[k]) qualitySum_[v[k]] += 3.0 / kappa;
+      double hyperplane[5], w;
+      if (fieldHyperplane(v, hyperplane, w))
+        for (int k = 0; k < 4; ++k)
+          if (mine[k]) fieldQuadric_[v[k]].addSquare(hyperplane, w);
+    }
+  };
+  onBoth([&](int part) { sums(part, part ? V_ / 2 : 0, part ? V_ : V_ / 2); });
+  flatInput_ += flat[0] + flat[1];
+  queued_.assign(V_, 0);
+  represented_.assign(V_, 1);
+  lastCost_.assign(V_, float(kInf));
+  // Every vertex's first cost, on two threads (each with its own scratch lane; the mesh is
+  // only read), then queued in vertex order so the result does not depend on the threads.
+  main_.lane = &mainLane_;
+  lanes_.resize(kRoundSize);
+  for (size_t k = 0; k < 2; ++k) lanes_[k].reset(V_);  // (the rest: readyLanes())
+  auto work = [this](Lane& L, uint32_t begin, uint32_t end) {
+    for (uint32_t v = begin; v < end; ++v)
+      if (out_.vertexAlive[v]) lastCost_[v] = bestCost(L, v);
+  };
+  onBoth([&](int part) { work(lanes_[size_t(part)], part ? V_ / 2 : 0, part ? V_ : V_ / 2); });
+  for (uint32_t v = 0; v < V_; ++v) queued_[v] = lastCost_[v] < float(kInf);  // (run() queues them)
+}
+
+// The linear field s(x) = g·x + c of tet v (its four vertex values) as the hyperplane
+// (g, −1, c) of the field quadric, with a quarter of the volume as weight (one quarter to each
+// vertex). False for a flat tet, which defines no gradient.
+bool Simplifier::fieldHyperplane(const uint32_t* v, double (&hyperplane)[5], double& w) const {
+  const Point p0 = p(v[0]), p1 = p(v[1]), p2 = p(v[2]), p3 = p(v[3]);
+  double e[3][3], ds[3];
+  for (int k = 0; k < 3; ++k) {
+    e[0][k] = p1[k] - p0[k];
+    e[1][k] = p2[k] - p0[k];
+    e[2][k] = p3[k] - p0[k];
+  }
+  for (int k = 0; k < 3; ++k) ds[k] = double(field_[v[k + 1]]) - field_[v[0]];
+  // Gradient g solves e·g = ds (Cramer's rule).
+  double det = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) - e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+               e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
+  if (!(std::abs(det) > 0)) return false;
+  double g[3];
+  for (int col = 0; col < 3; ++col) {
+    double m[3][3];
+    for (int r = 0; r < 3; ++r)
+      for (int k = 0; k < 3; ++k) m[r][k] = k == col ? ds[r] : e[r][k];
+    g[col] = (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+              m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])) / det;
+  }
+  const double c = field_[v[0]] - (g[0] * p0[0] + g[1] * p0[1] + g[2] * p0[2]);
+  w = std::abs(det) / 24.0;
+  hyperplane[0] = g[0], hyperplane[1] = g[1], hyperplane[2] = g[2], hyperplane[3] = -1.0, hyperplane[4] = c;
+  return true;
+}
+
+float Simplifier::tetKappa(uint32_t t) const {
+  const uint32_t* v = &out_.tets[4 * size_t(t)];
+  const TetShape shape = tetShape(p(v[0]), p(v[1]), p(v[2]), p(v[3]));
+  if (shape.det <= kFlat * shape.longestEdge * std::sqrt(shape.longestEdge)) return kKappaCap;
+  return float(std::min<double>(kKappaCap, shape.kappa()));
+}
+
+}  // namespace tetstream::simplify_detail
