@@ -174,6 +174,7 @@ do {                                                                 \
 #undef TS_LINK_RESULT
 }
 
+// The plain reference for linkCondition(): the three links as sorted sets (tests only).
 bool Simplifier::linkConditionBySorting(uint32_t i, uint32_t j) {
   std::vector<uint32_t> lvI, lvJ, lvE;  // (tests only: allocates)
   std::vector<uint64_t> leI, leJ, leE;
@@ -182,7 +183,7 @@ bool Simplifier::linkConditionBySorting(uint32_t i, uint32_t j) {
   gatherLink(j, lvJ, leJ, ltJ);
   if (intersectionSize(ltI, ltJ) != 0) return false;
   // Link of the edge: the opposite edges of the tets around it, and the boundary faces at it.
-      forEdgeLink(i, j, [&](const uint32_t o[2]) {
+  forEdgeLink(i, j, [&](const uint32_t o[2]) {
     lvE.insert(lvE.end(), o, o + 2);
     leE.push_back(makeEdge(o[0], o[1]));
   }, [&](uint32_t k) {
