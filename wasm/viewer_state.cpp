@@ -149,6 +149,7 @@ void noteSlice(ViewerState& s, double ms) {
   while (bin < kSliceEdgesMs.size() && ms >= kSliceEdgesMs[bin]) ++bin;
   ++s.sliceCounts[bin];
 }
+
 }  // namespace
 
 const char* loadStateName(LoadState s) {
