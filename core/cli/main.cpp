@@ -35,7 +35,10 @@ int main(int argc, char** argv) {
     if (!sub->parsed()) continue;
     // Every command but gen reads a mesh or a packed dataset: decided once, before any work
     // (the program may start again here, with huge pages: huge_pages.h).
-    if (sub->get_name() != "gen") useHugePages(argv);
+    if (sub->get_name() != "gen") {
+      const CLI::Option* input = sub->get_option_no_throw("input");
+      useHugePages(argv, input && input->count() ? input->as<std::string>() : std::string());
+    }
     return run();
   }
   return 2;

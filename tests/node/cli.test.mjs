@@ -131,7 +131,8 @@ test('the other input formats: notes on stdout, --q names the PLOT3D solution', 
 
 // The commands that read an input start the program again with glibc's huge pages on
 // (core/cli/huge_pages.h): the pack must be the same byte for byte with them, without them
-// (TETSTREAM_HUGE_PAGES=0) and with a user's own GLIBC_TUNABLES kept, and the restart must happen
+// (TETSTREAM_HUGE_PAGES=0) and with a user's own GLIBC_TUNABLES kept (a small input also gets
+// heap settings of its own, which must not override the user's), and the restart must happen
 // once, not again and again (a loop would hit the timeout).
 test('huge pages on, off or with the user\'s own glibc tunables: the same pack', () => {
   const dir = tempDir('huge-pages');
@@ -139,7 +140,7 @@ test('huge pages on, off or with the user\'s own glibc tunables: the same pack',
   assert.equal(cli('gen', 'harmonic', '--n', '10', '-o', vtu).status, 0);
   const manifests = [];
   for (const [name, env] of [['default', {}], ['off', { TETSTREAM_HUGE_PAGES: '0' }],
-    ['own tunables', { GLIBC_TUNABLES: 'glibc.malloc.check=0' }]]) {
+    ['own tunables', { GLIBC_TUNABLES: 'glibc.malloc.check=0' }], ['own heap tunables', { GLIBC_TUNABLES: 'glibc.malloc.top_pad=0' }]]) {
     const out = path.join(dir, name.replace(/ /g, '-'));
     const r = spawnSync(cliPath, ['pack', vtu, '-o', out, '--json'],
       { encoding: 'utf8', timeout: 60000, env: { ...process.env, ...env } });
@@ -149,4 +150,5 @@ test('huge pages on, off or with the user\'s own glibc tunables: the same pack',
   }
   assert.equal(manifests[1], manifests[0], 'without huge pages');
   assert.equal(manifests[2], manifests[0], 'with the user\'s tunables');
+  assert.equal(manifests[3], manifests[0], 'with the user\'s own heap settings');
 });
