@@ -17,6 +17,11 @@ add_library(tetstream_imgui STATIC
   ${TETSTREAM_IMGUI_DIR}/backends/imgui_impl_opengl3.cpp
 )
 target_include_directories(tetstream_imgui PUBLIC ${TETSTREAM_IMGUI_DIR} ${CMAKE_CURRENT_LIST_DIR})
+# The backend's read-back of GL state before it draws, answered without a wait on the GPU
+# process where the viewer knows the answer (imgui_gl_state.cpp).
+target_sources(tetstream_imgui PRIVATE ${CMAKE_CURRENT_LIST_DIR}/imgui_gl_state.cpp)
+set_source_files_properties(${TETSTREAM_IMGUI_DIR}/backends/imgui_impl_opengl3.cpp PROPERTIES
+  COMPILE_DEFINITIONS glGetIntegerv=tetstreamImGuiGetIntegerv)
 # One config header for every ImGui file, ours included: WebGL2 (GLES3) everywhere.
 target_compile_definitions(tetstream_imgui PUBLIC IMGUI_USER_CONFIG="imconfig_tetstream.h")
 
