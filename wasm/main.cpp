@@ -4,9 +4,9 @@
 // ---------------------------------------------------------------------------------------------
 // JS surface (the module is built with -sMODULARIZE -sEXPORT_NAME=createTetstream):
 //
-//   const Module = await createTetstream({ canvas, onPauseChange(paused) { ... }, softwareGl });
-//   softwareGl (optional boolean): whether WebGL renders in software (SwiftShader, llvmpipe), if
-//   the page found out already; otherwise main() asks a throwaway context itself.
+//   const Module = await createTetstream({ canvas, onPauseChange(paused) { ... }, antialias });
+//   antialias (optional boolean): multisample the scene or not; by default it is, unless WebGL
+//   renders in software (SwiftShader, llvmpipe), which main() asks of its own context.
 //   Module.callMain([]);   // once: creates the WebGL2 context, ImGui and the frame loop
 //   Built with -sINVOKE_RUN=0 so the shell can validate the manifest and start the chunk
 //   downloads first; the functions below work before main() has run. Setting up WebGL on a
@@ -114,7 +114,7 @@ struct App {
   Renderer renderer;
   GLFWwindow* window = nullptr;
   std::string platformError;  // set when WebGL 2 / GLFW could not start; sticky
-  bool softwareGl = false;    // SwiftShader & co: drawn without multisampling
+  bool softwareGl = false;    // SwiftShader & co: drawn without multisampling, reduced while refining
 
   int width = 0, height = 0;  // canvas size in device pixels (= GLFW window and framebuffer size)
   double pixelRatio = 1;      // device pixels per CSS pixel
@@ -524,27 +524,9 @@ bool initPlatform(std::string& error) {
   glfwWindowHint(GLFW_CLIENT_API, GLFW_OPENGL_ES_API);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 0);
-  // A software rasterizer (SwiftShader or llvmpipe: also Chrome's fallback when the GPU is
-  // unusable) pays for 4x multisampling with 2-3x the frame time, hardware hardly notices it.
-  // The renderer's name is only visible through a context, so a throwaway one is asked first;
-  // the shell may have asked already while the program downloaded (Module.softwareGl), which
-  // takes this 30-300 ms (on SwiftShader) off the way to the first picture.
-  g_app.softwareGl = EM_ASM_INT({
-    if (typeof Module.softwareGl === 'boolean') return Module.softwareGl ? 1 : 0;
-    try {
-      const gl = document.createElement('canvas').getContext('webgl2');
-      if (!gl) return 0;
-      const info = gl.getExtension('WEBGL_debug_renderer_info');
-      const name = String(info ? gl.getParameter(info.UNMASKED_RENDERER_WEBGL) : 0);
-      const lose = gl.getExtension('WEBGL_lose_context');
-      if (lose) lose.loseContext();
-      return /swiftshader|llvmpipe|softpipe|software/i.test(name) ? 1 : 0;
-    } catch (e) {
-      return 0;
-    }
-  }) != 0;
-  glfwWindowHint(GLFW_SAMPLES, g_app.softwareGl ? 0 : 4);
-  g_app.state.softwareGl = g_app.softwareGl;
+  // The canvas has no multisampling of its own: the scene is multisampled in an offscreen target
+  // (renderer.h) once the context can tell whether it renders in software (below).
+  glfwWindowHint(GLFW_SAMPLES, 0);
   double cssW = 0, cssH = 0;
   emscripten_get_element_css_size("#canvas", &cssW, &cssH);
   g_app.pixelRatio = std::max(1.0, emscripten_get_device_pixel_ratio());
@@ -556,6 +538,26 @@ bool initPlatform(std::string& error) {
     return false;
   }
   glfwMakeContextCurrent(g_app.window);
+  // A software rasterizer (SwiftShader or llvmpipe: also Chrome's fallback when the GPU is
+  // unusable) pays for 4x multisampling with 2-3x the frame time, hardware hardly notices it. The
+  // renderer's name is asked of the viewer's own context: before, a throwaway context asked it
+  // first (the canvas's multisampling is fixed when its context is made), which on SwiftShader
+  // cost the main thread ~350 ms and, asked from a worker, made a third context in the GPU process
+  // just as the first frames were drawn.
+  g_app.softwareGl = EM_ASM_INT({
+    try {
+      const gl = Module.canvas.getContext('webgl2');
+      const info = gl && gl.getExtension('WEBGL_debug_renderer_info');
+      const name = String(info ? gl.getParameter(info.UNMASKED_RENDERER_WEBGL) : 0);
+      return /swiftshader|llvmpipe|softpipe|software/i.test(name) ? 1 : 0;
+    } catch (e) {
+      return 0;
+    }
+  }) != 0;
+  g_app.state.softwareGl = g_app.softwareGl;
+  const int antialias = EM_ASM_INT({ return typeof Module.antialias === 'boolean' ? (Module.antialias ? 1 : 0) : -1; });
+  g_app.renderer.samples = antialias == 1 || (antialias < 0 && !g_app.softwareGl) ? 4 : 0;
+  g_app.state.samples = g_app.renderer.samples;
   glfwSetMouseButtonCallback(g_app.window, onMouseButton);
   glfwSetCursorPosCallback(g_app.window, onCursorPos);
   emscripten_set_wheel_callback("#canvas", nullptr, EM_TRUE, onWheel);
@@ -568,7 +570,8 @@ bool initPlatform(std::string& error) {
     error = "The viewer's WebGL 2 shaders could not be set up: " + error;
     return false;
   }
-  std::printf("tetstream viewer: %s%s\n", info.c_str(), g_app.softwareGl ? " | software rasterizer: no MSAA" : "");
+  std::printf("tetstream viewer: %s%s | %s\n", info.c_str(), g_app.softwareGl ? " | software rasterizer" : "",
+              g_app.renderer.samples ? (std::to_string(g_app.renderer.samples) + "x multisampling").c_str() : "no multisampling");
   warmUpRenderer(g_app.renderer, g_app.softwareGl);
 
   IMGUI_CHECKVERSION();

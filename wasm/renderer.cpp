@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <span>
+#include <tuple>
 
 #include <glm/gtc/type_ptr.hpp>
 
@@ -116,45 +117,52 @@ void main() { fragColor = vec4(mix(vec3(0.07, 0.08, 0.10), vec3(0.23, 0.26, 0.31
 )";
 
 // ---------------------------------------------------------------- helpers
-GLuint compile(GLenum type, const char* src, std::string& error) {
+// Shaders are compiled and linked without asking how it went: in WebGL each such question waits
+// for the GPU process to finish everything queued before it (on SwiftShader 2-30 ms each, twelve
+// of them on the way to the first picture). linkStatus() asks once per program after all of them
+// are queued, and reads the logs only when a link failed.
+GLuint compile(GLenum type, const char* src) {
   GLuint s = glCreateShader(type);
   glShaderSource(s, 1, &src, nullptr);
   glCompileShader(s);
-  GLint ok = 0;
-  glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    char log[2048] = {};
-    glGetShaderInfoLog(s, sizeof log, nullptr, log);
-    error += std::string(type == GL_VERTEX_SHADER ? "vertex" : "fragment") + " shader: " + log;
-    glDeleteShader(s);
-    return 0;
-  }
   return s;
 }
 
-GLuint link(const char* vs, const char* fs, std::string& error) {
-  GLuint v = compile(GL_VERTEX_SHADER, vs, error), f = compile(GL_FRAGMENT_SHADER, fs, error);
-  if (!v || !f) {
-    glDeleteShader(v);
-    glDeleteShader(f);
-    return 0;
-  }
-  GLuint p = glCreateProgram();
-  glAttachShader(p, v);
-  glAttachShader(p, f);
-  glLinkProgram(p);
-  glDeleteShader(v);
-  glDeleteShader(f);
-  GLint ok = 0;
-  glGetProgramiv(p, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    char log[2048] = {};
-    glGetProgramInfoLog(p, sizeof log, nullptr, log);
-    error += std::string("program: ") + log;
-    glDeleteProgram(p);
-    return 0;
-  }
+struct Program {
+  GLuint program, vertex, fragment;
+};
+
+Program link(const char* vs, const char* fs) {
+  Program p{glCreateProgram(), compile(GL_VERTEX_SHADER, vs), compile(GL_FRAGMENT_SHADER, fs)};
+  glAttachShader(p.program, p.vertex);
+  glAttachShader(p.program, p.fragment);
+  glLinkProgram(p.program);
   return p;
+}
+
+// The program, or 0 with what went wrong in `error` (its shaders' logs first, as a failed
+// compile is the usual cause of a failed link). Its shaders are released either way.
+GLuint linkStatus(const Program& p, std::string& error) {
+  GLint ok = 0;
+  glGetProgramiv(p.program, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    char log[2048];
+    for (const auto& [shader, what] : {std::pair{p.vertex, "vertex shader: "}, std::pair{p.fragment, "fragment shader: "}}) {
+      GLint compiled = 0;
+      glGetShaderiv(shader, GL_COMPILE_STATUS, &compiled);
+      if (compiled) continue;
+      log[0] = 0;
+      glGetShaderInfoLog(shader, sizeof log, nullptr, log);
+      error += std::string(what) + log;
+    }
+    log[0] = 0;
+    glGetProgramInfoLog(p.program, sizeof log, nullptr, log);
+    error += std::string("program: ") + log;
+  }
+  glDeleteShader(p.vertex);
+  glDeleteShader(p.fragment);
+  if (!ok) glDeleteProgram(p.program);
+  return ok ? p.program : 0;
 }
 
 std::string glString(GLenum name) {
@@ -232,16 +240,18 @@ uint64_t gpuBufferBytes(const Renderer& r) {
                              &r.slice.normals, &r.slice.colours, &r.slice.indices, &r.hullPositions, &r.hullNormals,
                              &r.lines})
     n += b->bytes;
-  return n;
+  return n + r.reduced.bytes + r.multisampled.bytes;
 }
 
 bool initRenderer(Renderer& r, std::string& info, std::string& error) {
   info = "GL_VERSION: " + glString(GL_VERSION) + " | GLSL: " + glString(GL_SHADING_LANGUAGE_VERSION) +
          " | GL_RENDERER: " + glString(GL_RENDERER);
-  r.isoProgram = link(kSurfaceVs, kSurfaceFs, error);
-  r.hullProgram = link(kSurfaceVs, kHullFs, error);
-  r.lineProgram = link(kLineVs, kLineFs, error);
-  r.backgroundProgram = link(kBackgroundVs, kBackgroundFs, error);
+  const Program programs[4] = {link(kSurfaceVs, kSurfaceFs), link(kSurfaceVs, kHullFs), link(kLineVs, kLineFs),
+                               link(kBackgroundVs, kBackgroundFs)};
+  r.isoProgram = linkStatus(programs[0], error);
+  r.hullProgram = linkStatus(programs[1], error);
+  r.lineProgram = linkStatus(programs[2], error);
+  r.backgroundProgram = linkStatus(programs[3], error);
   if (!r.isoProgram || !r.hullProgram || !r.lineProgram || !r.backgroundProgram) return false;
   r.isoView = glGetUniformLocation(r.isoProgram, "uView");
   r.isoProj = glGetUniformLocation(r.isoProgram, "uProj");
@@ -306,9 +316,11 @@ void destroyRenderer(Renderer& r) {
   glDeleteTextures(1, &r.colourMapTexture);
   GLuint vaos[5] = {r.iso.vao, r.slice.vao, r.hullVao, r.lineVao, r.emptyVao};
   glDeleteVertexArrays(5, vaos);
-  GLuint renderbuffers[2] = {r.reduced.colour, r.reduced.depth};
-  glDeleteRenderbuffers(2, renderbuffers);
-  glDeleteFramebuffers(1, &r.reduced.framebuffer);
+  for (OffscreenTarget* t : {&r.reduced, &r.multisampled}) {
+    GLuint renderbuffers[2] = {t->colour, t->depth};
+    glDeleteRenderbuffers(2, renderbuffers);
+    glDeleteFramebuffers(1, &t->framebuffer);
+  }
   r = Renderer{};
 }
 
@@ -329,11 +341,12 @@ void warmUpRenderer(Renderer& r, bool reducedToo) {
   r.hullVertexCount = 3;
   r.lineVertexCount = 2;
   drawScene(r, FrameParams{});
-  if (reducedToo) {  // the offscreen target's formats and the blit compile pipelines of their own
-    FrameParams tiny;
-    tiny.framebufferWidth = tiny.framebufferHeight = 2;
-    drawSceneScaled(r, tiny, 0.5f);
-  }
+  // The offscreen targets' formats and the blits compile pipelines of their own (the first real
+  // frame allocates the targets again at its size).
+  FrameParams tiny;
+  tiny.framebufferWidth = tiny.framebufferHeight = 2;
+  if (reducedToo) drawSceneScaled(r, tiny, 0.5f);
+  if (r.samples > 0) drawSceneScaled(r, tiny, 1.f);
   r.iso.indexCount = r.hullVertexCount = r.lineVertexCount = 0;
 }
 
@@ -448,38 +461,51 @@ void drawScene(const Renderer& r, const FrameParams& p) {
   glUseProgram(0);
 }
 
-void drawSceneScaled(Renderer& r, const FrameParams& p, float scale) {
-  const int w = std::max(1, int(std::lround(p.framebufferWidth * scale)));
-  const int h = std::max(1, int(std::lround(p.framebufferHeight * scale)));
-  if (scale >= 1.f || (w == p.framebufferWidth && h == p.framebufferHeight)) return drawScene(r, p);
-  ReducedTarget& t = r.reduced;
+namespace {
+// Binds t as the framebuffer, its renderbuffers (re)allocated for this size and sample count.
+void bindTarget(OffscreenTarget& t, int width, int height, int samples) {
   if (!t.framebuffer) {
     glGenFramebuffers(1, &t.framebuffer);
     glGenRenderbuffers(1, &t.colour);
     glGenRenderbuffers(1, &t.depth);
   }
   glBindFramebuffer(GL_FRAMEBUFFER, t.framebuffer);
-  if (t.width != w || t.height != h) {
-    glBindRenderbuffer(GL_RENDERBUFFER, t.colour);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, w, h);
-    glBindRenderbuffer(GL_RENDERBUFFER, t.depth);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, w, h);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, t.colour);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t.depth);
-    t.width = w;
-    t.height = h;
+  if (t.width == width && t.height == height && t.samples == samples) return;
+  for (const auto& [buffer, format, attachment] : {std::tuple{t.colour, GLenum(GL_RGBA8), GLenum(GL_COLOR_ATTACHMENT0)},
+                                                   std::tuple{t.depth, GLenum(GL_DEPTH_COMPONENT24), GLenum(GL_DEPTH_ATTACHMENT)}}) {
+    glBindRenderbuffer(GL_RENDERBUFFER, buffer);
+    if (samples > 0) glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, format, width, height);
+    else glRenderbufferStorage(GL_RENDERBUFFER, format, width, height);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, attachment, GL_RENDERBUFFER, buffer);
   }
   // No glCheckFramebufferStatus: in WebGL it waits for the GPU process to catch up (hundreds of
   // ms behind a SwiftShader frame), and RGBA8 colour with DEPTH_COMPONENT24 depth of equal
-  // sizes is complete by the GLES 3.0 spec.
-  FrameParams reduced = p;
-  reduced.framebufferWidth = w;
-  reduced.framebufferHeight = h;
-  drawScene(r, reduced);
+  // sizes and sample counts (4 at most, which every WebGL 2 allows) is complete by the GLES 3.0
+  // spec.
+  t.width = width;
+  t.height = height;
+  t.samples = samples;
+  t.bytes = uint64_t(width) * uint64_t(height) * uint64_t(std::max(samples, 1)) * 8;  // 4 bytes colour, 4 depth
+}
+}  // namespace
+
+void drawSceneScaled(Renderer& r, const FrameParams& p, float scale) {
+  const int w = std::max(1, int(std::lround(p.framebufferWidth * scale)));
+  const int h = std::max(1, int(std::lround(p.framebufferHeight * scale)));
+  const bool reduced = scale < 1.f && (w != p.framebufferWidth || h != p.framebufferHeight);
+  if (!reduced && r.samples == 0) return drawScene(r, p);
+  OffscreenTarget& t = reduced ? r.reduced : r.multisampled;
+  bindTarget(t, w, h, reduced ? 0 : r.samples);
+  FrameParams offscreen = p;
+  offscreen.framebufferWidth = w;
+  offscreen.framebufferHeight = h;
+  drawScene(r, offscreen);
   glBindFramebuffer(GL_READ_FRAMEBUFFER, t.framebuffer);
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
   glDisable(GL_SCISSOR_TEST);
-  glBlitFramebuffer(0, 0, w, h, 0, 0, p.framebufferWidth, p.framebufferHeight, GL_COLOR_BUFFER_BIT, GL_LINEAR);
+  // Scaled up with a linear filter, or resolved (a multisampled source needs equal sizes).
+  glBlitFramebuffer(0, 0, w, h, 0, 0, p.framebufferWidth, p.framebufferHeight, GL_COLOR_BUFFER_BIT,
+                    reduced ? GL_LINEAR : GL_NEAREST);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   glViewport(0, 0, p.framebufferWidth, p.framebufferHeight);
 }

@@ -40,14 +40,19 @@ struct SurfaceGpu {
   int32_t indexCount = 0;
 };
 
-// Where a frame's scene is drawn at reduced resolution before it is scaled up to the canvas.
-struct ReducedTarget {
+// Where a frame's scene is drawn before it is copied to the canvas: at reduced resolution (then
+// scaled up), or multisampled (then resolved).
+struct OffscreenTarget {
   uint32_t framebuffer = 0, colour = 0, depth = 0;  // renderbuffers
-  int width = 0, height = 0;
+  int width = 0, height = 0, samples = 0;
+  uint64_t bytes = 0;
 };
 
 struct Renderer {
-  ReducedTarget reduced;
+  // Multisampling: the scene is drawn into `multisampled` with this many samples per pixel and
+  // resolved into the canvas, whose own buffer has none (0: drawn straight into the canvas).
+  int samples = 0;
+  OffscreenTarget reduced, multisampled;
   uint32_t isoProgram = 0, hullProgram = 0, lineProgram = 0, backgroundProgram = 0;
   uint32_t hullVao = 0, lineVao = 0, emptyVao = 0;
   SurfaceGpu iso, slice;
@@ -69,7 +74,8 @@ void destroyRenderer(Renderer& r);
 // Draws one clipped-away triangle through every program and state drawScene uses, so that the
 // GL implementation compiles its pipelines now (while the dataset downloads) and not at the
 // first surface (~0.3 s on SwiftShader).
-// reducedToo: also through drawSceneScaled's offscreen target (a software GL uses it).
+// reducedToo: also through drawSceneScaled's reduced target (a software GL uses it); the
+// multisampled one whenever r.samples is set.
 void warmUpRenderer(Renderer& r, bool reducedToo);
 
 // Sends what changed since the model's last clearChanges(); the caller clears them afterwards.
@@ -89,17 +95,18 @@ struct FrameParams {
 // Loads a colour map into the texture (nothing when it is loaded already).
 void setColourMap(Renderer& r, ColourMap map);
 
-// Bytes allocated in the GPU buffers (the panel's memory line; textures and the framebuffer
-// are not counted).
+// Bytes allocated in the GPU buffers and the offscreen targets (the panel's memory line; the
+// colour map texture and the canvas's own buffers are not counted).
 uint64_t gpuBufferBytes(const Renderer& r);
 
 // Clears to the background gradient and draws surface, then hull and crease lines.
 void drawScene(const Renderer& r, const FrameParams& p);
 
 // drawScene at `scale` (< 1) of the framebuffer's width and height into an offscreen target,
-// then scaled up (linear filter) onto the canvas; at scale >= 1 simply drawScene. On a software
-// GL the fragments are most of a frame's cost, and that CPU time is taken from refinement.
-// Only for a single-sampled canvas (a blit cannot resolve into a multisampled one).
+// then scaled up (linear filter) onto the canvas: on a software GL the fragments are most of a
+// frame's cost, and that CPU time is taken from refinement. At scale >= 1 drawScene, into the
+// multisampled target when r.samples is set (then resolved onto the canvas). The canvas itself
+// is single-sampled (a blit cannot resolve into a multisampled one).
 void drawSceneScaled(Renderer& r, const FrameParams& p, float scale);
 
 }  // namespace tetstream::viewer

@@ -914,6 +914,7 @@ std::string statsJson(const ViewerState& s) {
       {"drawTotalMs", s.drawTotalMs},
       {"reducedFrames", s.reducedFrames},
       {"softwareGl", s.softwareGl},
+      {"samples", s.samples},
       {"uploadBytes", s.uploadBytes},
       {"fullUploads", s.fullUploads},
       {"partialUploads", s.partialUploads},

@@ -139,7 +139,6 @@ function withWasmBytes(bytes, fn) {
 function startViewer() {
   if (!viewer || viewerStarted || shell.aborted) return;
   viewerStarted = true;
-  if (typeof softwareGl === 'boolean') viewer.softwareGl = softwareGl;
   try {
     viewer.callMain([]);
   } catch (e) {
@@ -321,7 +320,7 @@ function setState(p = {}) {
 function stateQuery(st) {
   const q = new URLSearchParams();
   if (st.dataset) q.set('data', st.dataset);
-  for (const keep of ['maxMemoryMB', 'stallSeconds']) if (params.get(keep) !== null) q.set(keep, params.get(keep));
+  for (const keep of ['maxMemoryMB', 'stallSeconds', 'antialias']) if (params.get(keep) !== null) q.set(keep, params.get(keep));
   if (st.field === null) return q;
   q.set('field', st.field);
   q.set('iso', shortFloat(st.isovalue));
@@ -567,28 +566,11 @@ function loadScript(src) {
   });
 }
 
-// Whether WebGL renders in software here (SwiftShader, llvmpipe): the viewer then draws without
-// multisampling. Asked through a throwaway context in a worker (OffscreenCanvas) while the
-// program downloads: on SwiftShader creating a context takes 30-300 ms, which on the main thread
-// would hold up the downloads' callbacks. Without workers or OffscreenCanvas, main() asks itself.
-let softwareGl;
-function probeSoftwareGl() {
-  if (!window.Worker || !window.OffscreenCanvas) return;
-  const code = `try {
-      const gl = new OffscreenCanvas(1, 1).getContext('webgl2');
-      const info = gl && gl.getExtension('WEBGL_debug_renderer_info');
-      const name = gl ? String(info ? gl.getParameter(info.UNMASKED_RENDERER_WEBGL) : '') : null;
-      postMessage(name);
-    } catch (e) { postMessage(null); }`;
-  try {
-    const url = URL.createObjectURL(new Blob([code], { type: 'text/javascript' }));
-    const worker = new Worker(url);
-    worker.onmessage = (e) => {
-      if (typeof e.data === 'string') softwareGl = /swiftshader|llvmpipe|softpipe|software/i.test(e.data);
-      worker.terminate();
-      URL.revokeObjectURL(url);
-    };
-  } catch { /* the viewer asks itself */ }
+// ?antialias=0 or 1: multisample the scene or not (by default the viewer does, unless WebGL
+// renders in software).
+function antialiasOption() {
+  const a = params.get('antialias');
+  return a === '0' ? false : a === '1' ? true : undefined;
 }
 
 async function loadViewer() {
@@ -600,7 +582,7 @@ async function loadViewer() {
     // eslint-disable-next-line no-undef
     createTetstream({
       canvas,
-      softwareGl,
+      antialias: antialiasOption(),
       onAbort: viewerAborted,
       instantiateWasm(imports, receive) {
         instantiateProgram(imports).then((r) => receive(r.instance, r.module), reject);
@@ -983,7 +965,6 @@ async function start() {
     return fail(`"${data}" is not a valid dataset URL.`);
   }
   addEventListener('online', () => { if (loader) loader.retryNow(); });
-  probeSoftwareGl();
   statusTimer = setInterval(updateStatus, 250);
   try {
     await stream(manifestUrl);

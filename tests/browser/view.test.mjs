@@ -412,3 +412,28 @@ test('high-DPI: the canvas has device pixels and the panel keeps its size in CSS
   assert.deepEqual(problems, []);
   await page.close();
 });
+
+// The scene is multisampled in an offscreen target and resolved onto the canvas (the canvas has
+// none of its own), by default unless WebGL renders in software, as here; ?antialias=1 or 0 says
+// so explicitly. Multisampled, the picture is the same but for its edges, which are smoothed.
+test('?antialias: the scene multisampled through an offscreen target, the same picture with smoothed edges', async () => {
+  const view = { x: 420, y: 60, width: 520, height: 560 };
+  const shots = {};
+  for (const [name, query] of [['default', ''], ['on', '&antialias=1'], ['off', '&antialias=0']]) {
+    const { page, problems } = await openViewer(`?data=/two/manifest.json${query}`);
+    const s = await waitSettled(page);
+    assert.deepEqual(problems, [], name);
+    assert.equal(s.state, 'complete', name);
+    const expected = name === 'on' || (name === 'default' && !s.softwareGl) ? 4 : 0;
+    assert.equal(s.samples, expected, `${name}: samples`);
+    shots[name] = { png: await page.screenshot({ clip: view }), triangles: s.triangles, page };
+    if (name === 'on') await page.screenshot({ path: path.join(outDir, 'view-antialias.png'), clip: view });
+  }
+  assert.equal(shots.on.triangles, shots.off.triangles);
+  const page = shots.off.page;
+  const d = await pictureDifference(page, shots.off.png, shots.on.png);
+  // Edges only: some pixels differ, few of them by much (the surface's outline, the box's lines).
+  assert.ok(d.differing > 0.001 * d.pixels, `multisampling changed ${d.differing} of ${d.pixels} pixels`);
+  assert.ok(d.large < 0.05 * d.pixels, `${d.large} of ${d.pixels} pixels changed by more than 8 levels`);
+  for (const { page: p } of Object.values(shots)) await p.close();
+});
