@@ -566,6 +566,20 @@ function loadScript(src) {
   });
 }
 
+// Setting up WebGL takes the GPU process a while (~0.3 s on a software renderer, and the page
+// waits for it): asked for as soon as the base chunk is requested, it overlaps the program's
+// download instead of following it. main() later gets this same context (a canvas keeps its
+// first WebGL 2 context, whatever is asked again), so these are the attributes its GLFW window
+// asks for (Emscripten's library_glfw.js with the viewer's hints).
+let webGlPrepared = false;
+function prepareWebGl() {
+  if (webGlPrepared) return;
+  webGlPrepared = true;
+  try {
+    canvas.getContext('webgl2', { antialias: false, alpha: true, depth: true, stencil: true });
+  } catch { /* main() reports a missing WebGL 2 */ }
+}
+
 // ?antialias=0 or 1: multisample the scene or not (by default the viewer does, unless WebGL
 // renders in software).
 function antialiasOption() {
@@ -800,7 +814,10 @@ async function stream(manifestUrl) {
   // compiles: the first picture comes a round trip and a base download sooner.
   manifestPromise.then((bytes) => {
     const preview = previewManifest(bytes);
-    if (preview && !loader && shell.state !== 'error') startLoader(preview, manifestUrl);
+    if (preview && !loader && shell.state !== 'error') {
+      startLoader(preview, manifestUrl);
+      prepareWebGl();
+    }
   }, () => {});
 
   viewer = await viewerPromise; // a failure here has no viewer to report into: caught by start()
