@@ -346,7 +346,8 @@ double secondsLeft(const ViewerState& s);        // at the current rate; < 0 whe
 //  pauseButtonRect:{x,y,w,h}, sliceSliderRect:{x,y,w,h}, panelRect:{x,y,w,h}, targetLevel (the
 //  level asked for as a fraction of the full mesh's vertices; 1 while live), showBoundary,
 //  showHelp}. memory: heapBytes the wasm memory's size, dataBytes what the
-//  dataset, surface and hull hold, gpuBytes the GPU buffers, limitBytes the limit (null: none),
+//  dataset, surface and hull hold, gpuBytes the GPU buffers and offscreen targets (a
+//  multisampled scene: 32 bytes a device pixel), limitBytes the limit (null: none),
 //  neededBytes / allowedBytes the estimates for the full dataset / the last level that fits.
 // Times in ms; absolute times (firstSurfaceMs, completeMs) are null until they happen.
 std::string statsJson(const ViewerState& s);
