@@ -1,7 +1,8 @@
 // Browser tests of the ways to look at a dataset (issue 5's viewer): colour by a second field with
 // a colour bar, the slice plane (and that it follows refinement locally), the view as a URL that
 // reopens the same picture, screenshots, the help panel, opening a packed folder from the disk
-// by drag-and-drop, and touch gestures. Screenshots go to build/test-output/view-*.png.
+// by drag-and-drop, touch gestures, multisampling (?antialias), and that drawing makes no WebGL
+// call that waits for the GPU process. Screenshots go to build/test-output/view-*.png.
 //   node --test tests/browser/view.test.mjs
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
@@ -436,4 +437,53 @@ test('?antialias: the scene multisampled through an offscreen target, the same p
   assert.ok(d.differing > 0.001 * d.pixels, `multisampling changed ${d.differing} of ${d.pixels} pixels`);
   assert.ok(d.large < 0.05 * d.pixels, `${d.large} of ${d.pixels} pixels changed by more than 8 levels`);
   for (const { page: p } of Object.values(shots)) await p.close();
+});
+
+// WebGL calls that make the page wait for the GPU process to finish everything queued before
+// them (Chrome answers them there): once at start at most, never while frames are drawn. The
+// state the viewer and Dear ImGui read back each frame are bindings, which WebGL tracks in the
+// page. (Each wait was 0.5-3 ms on an idle GPU process here and up to the whole previous frame
+// on a busy one; 128 of them came before post.vtk's first surface until session 24.)
+test('drawing frames makes no WebGL call that waits for the GPU process; starting makes few', async () => {
+  const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
+  await page.addInitScript(() => {
+    window.__glCalls = [];
+    const proto = WebGL2RenderingContext.prototype;
+    for (const name of ['getParameter', 'getError', 'checkFramebufferStatus', 'getShaderParameter', 'getProgramParameter',
+      'getShaderInfoLog', 'getProgramInfoLog', 'getExtension', 'getSupportedExtensions', 'readPixels', 'finish',
+      'clientWaitSync', 'getBufferSubData', 'getFramebufferAttachmentParameter', 'getRenderbufferParameter']) {
+      const call = proto[name];
+      proto[name] = function (...args) {
+        window.__glCalls.push(name === 'getParameter' || name === 'getProgramParameter' ? `${name}(${args[args.length - 1]})` : name);
+        return call.apply(this, args);
+      };
+    }
+  });
+  await page.goto(`${baseUrl}/index.html?data=/two/manifest.json`);
+  await waitSettled(page);
+  const count = (calls, name) => calls.filter((c) => c === name || c.startsWith(`${name}(`)).length;
+  const atStart = await page.evaluate(() => window.__glCalls.splice(0));
+  assert.ok(count(atStart, 'getExtension') <= 1, `getExtension ${count(atStart, 'getExtension')} times (the renderer's name only)`);
+  for (const name of ['getSupportedExtensions', 'getShaderParameter', 'checkFramebufferStatus', 'readPixels', 'finish'])
+    assert.equal(count(atStart, name), 0, `${name} at start`);
+  assert.ok(count(atStart, 'getError') <= 1, 'getError at start');
+  assert.ok(count(atStart, 'getProgramParameter(35714)') <= 5, 'link status: once per program');  // LINK_STATUS
+  // Frames: the camera turned, the isovalue moved, the slice on (each redraws and uploads).
+  const gl = { ACTIVE_TEXTURE: 0x84e0, CURRENT_PROGRAM: 0x8b8d, TEXTURE_BINDING_2D: 0x8069, ARRAY_BUFFER_BINDING: 0x8894,
+    VERTEX_ARRAY_BINDING: 0x85b5 };
+  const bindings = new Set(Object.values(gl).map((pname) => `getParameter(${pname})`));
+  for (let k = 0; k < 6; k++) {
+    await page.mouse.move(700, 400);
+    await page.mouse.down();
+    await page.mouse.move(730 + 10 * k, 420);
+    await page.mouse.up();
+    await frames(page, 2);
+  }
+  await page.evaluate(() => window.tetstream.setState({ isovalue: 0.7, slice: { on: true, normal: [0, 0, 1], offset: 0.2 } }));
+  await frames(page, 4);
+  const drawn = await page.evaluate(() => window.__glCalls.splice(0));
+  const waits = drawn.filter((c) => !bindings.has(c));
+  assert.deepEqual(waits, [], 'calls that wait for the GPU process while drawing');
+  assert.ok(drawn.length > 0, 'the frames read the bindings back (Dear ImGui): the check saw them');
+  await page.close();
 });
