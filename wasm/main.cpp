@@ -549,6 +549,7 @@ bool initPlatform(std::string& error) {
       const gl = Module.canvas.getContext('webgl2');
       const info = gl && gl.getExtension('WEBGL_debug_renderer_info');
       const name = String(info ? gl.getParameter(info.UNMASKED_RENDERER_WEBGL) : 0);
+      Module.glRendererName = name;
       return /swiftshader|llvmpipe|softpipe|software/i.test(name) ? 1 : 0;
     } catch (e) {
       return 0;
@@ -564,14 +565,17 @@ bool initPlatform(std::string& error) {
   glfwSetKeyCallback(g_app.window, onKey);
   glfwSetCharCallback(g_app.window, onChar);
 
-  std::string info;
-  if (!initRenderer(g_app.renderer, info, error)) {
+  if (!initRenderer(g_app.renderer, error)) {
     std::fprintf(stderr, "tetstream: renderer setup failed: %s\n", error.c_str());
     error = "The viewer's WebGL 2 shaders could not be set up: " + error;
     return false;
   }
-  std::printf("tetstream viewer: %s%s | %s\n", info.c_str(), g_app.softwareGl ? " | software rasterizer" : "",
-              g_app.renderer.samples ? (std::to_string(g_app.renderer.samples) + "x multisampling").c_str() : "no multisampling");
+  // (The renderer's name, already asked: WebGL's version strings would each wait for the GPU
+  // process, for a line on the console.)
+  EM_ASM({
+    console.log('tetstream viewer: WebGL 2 on ' + (Module.glRendererName || 'an unnamed renderer') +
+                ($0 ? ' (software), ' : ', ') + ($1 ? $1 + 'x multisampling' : 'no multisampling'));
+  }, g_app.softwareGl, g_app.renderer.samples);
   warmUpRenderer(g_app.renderer, g_app.softwareGl);
 
   IMGUI_CHECKVERSION();

@@ -165,11 +165,6 @@ GLuint linkStatus(const Program& p, std::string& error) {
   return ok ? p.program : 0;
 }
 
-std::string glString(GLenum name) {
-  const GLubyte* s = glGetString(name);
-  return s ? reinterpret_cast<const char*>(s) : "?";
-}
-
 void bindFloat3(GLuint location, GLuint buffer) {
   glBindBuffer(GL_ARRAY_BUFFER, buffer);
   glEnableVertexAttribArray(location);
@@ -243,9 +238,7 @@ uint64_t gpuBufferBytes(const Renderer& r) {
   return n + r.reduced.bytes + r.multisampled.bytes;
 }
 
-bool initRenderer(Renderer& r, std::string& info, std::string& error) {
-  info = "GL_VERSION: " + glString(GL_VERSION) + " | GLSL: " + glString(GL_SHADING_LANGUAGE_VERSION) +
-         " | GL_RENDERER: " + glString(GL_RENDERER);
+bool initRenderer(Renderer& r, std::string& error) {
   const Program programs[4] = {link(kSurfaceVs, kSurfaceFs), link(kSurfaceVs, kHullFs), link(kLineVs, kLineFs),
                                link(kBackgroundVs, kBackgroundFs)};
   r.isoProgram = linkStatus(programs[0], error);

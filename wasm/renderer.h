@@ -67,8 +67,7 @@ struct Renderer {
 };
 
 // Compiles shaders and creates buffers. On failure returns false with the GL log in `error`.
-// `info` receives GL_VERSION, GL_SHADING_LANGUAGE_VERSION and GL_RENDERER for the console.
-bool initRenderer(Renderer& r, std::string& info, std::string& error);
+bool initRenderer(Renderer& r, std::string& error);
 void destroyRenderer(Renderer& r);
 
 // Draws one clipped-away triangle through every program and state drawScene uses, so that the
