@@ -570,12 +570,17 @@ function loadScript(src) {
 // waits for it): asked for as soon as the base chunk is requested, it overlaps the program's
 // download instead of following it. main() later gets this same context (a canvas keeps its
 // first WebGL 2 context, whatever is asked again), so these are the attributes its GLFW window
-// asks for (Emscripten's library_glfw.js with the viewer's hints).
+// asks for (Emscripten's library_glfw.js with the viewer's hints). The canvas gets the size in
+// device pixels that main() gives it (syncCanvasSize), so that its drawing buffer is made once
+// (a resize waited ~180 ms for the GPU process on SwiftShader).
 let webGlPrepared = false;
 function prepareWebGl() {
   if (webGlPrepared) return;
   webGlPrepared = true;
   try {
+    const box = canvas.getBoundingClientRect();
+    canvas.width = Math.max(1, Math.round(box.width * (window.devicePixelRatio || 1)));
+    canvas.height = Math.max(1, Math.round(box.height * (window.devicePixelRatio || 1)));
     canvas.getContext('webgl2', { antialias: false, alpha: true, depth: true, stencil: true });
   } catch { /* main() reports a missing WebGL 2 */ }
 }
