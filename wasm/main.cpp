@@ -500,7 +500,7 @@ void frame() {
   if (a.reducedShown && !reducedWanted(s)) requestRedraw(1);  // the still frame, full size
   // The first surface is drawn at once, even behind a frame the GPU has not finished.
   const bool firstSurface = s.surfaceReady && s.firstSurfaceMs < 0;
-  if (a.redrawFrames > 0 && (firstSurface || !gpuBusy(start))) {
+  if (a.redrawFrames > 0 && !s.contextLost && (firstSurface || !gpuBusy(start))) {
     --a.redrawFrames;
     a.lastDrawStart = start;
     drawFrame();
@@ -514,6 +514,40 @@ void frame() {
   notifyPause();
   const double end = emscripten_get_now();
   if (measuring) s.maxFrameMs = std::max(s.maxFrameMs, end - start);
+}
+
+// ---------------------------------------------------------------- WebGL context loss
+// The browser may take the GPU context away (a driver reset, another GPU, too many contexts):
+// every GL object goes with it. Streaming and refinement go on meanwhile; drawing waits. When the
+// browser gives a context back, the renderer's and the panel's GL objects are made again and
+// everything is uploaded in full.
+EM_BOOL onContextLost(int, const void*, void*) {
+  g_app.state.contextLost = true;
+  g_app.gpuFence = nullptr;  // (a sync object of the lost context)
+  return EM_TRUE;            // (the event's default is prevented: the browser may restore it)
+}
+
+EM_BOOL onContextRestored(int, const void*, void*) {
+  App& a = g_app;
+  ViewerState& s = a.state;
+  const Renderer lost = a.renderer;
+  a.renderer = Renderer{};
+  a.renderer.samples = lost.samples;
+  a.renderer.uploads = lost.uploads;
+  std::string error;
+  if (!initRenderer(a.renderer, error)) {
+    std::fprintf(stderr, "tetstream: renderer setup failed after the context came back: %s\n", error.c_str());
+    return EM_TRUE;  // (still lost to the viewer: the page says so)
+  }
+  warmUpRenderer(a.renderer, a.softwareGl);
+  // The panel's backend starts afresh (Dear ImGui 1.86 keeps its buffers' sizes past
+  // DestroyDeviceObjects, and would write past the new, empty buffers).
+  ImGui_ImplOpenGL3_Shutdown();
+  ImGui_ImplOpenGL3_Init("#version 300 es");
+  s.surfaceDirty = s.sliceDirty = s.hullDirty = true;
+  s.contextLost = false;
+  requestRedraw();
+  return EM_TRUE;
 }
 
 bool initPlatform(std::string& error) {
@@ -559,6 +593,8 @@ bool initPlatform(std::string& error) {
   const int antialias = EM_ASM_INT({ return typeof Module.antialias === 'boolean' ? (Module.antialias ? 1 : 0) : -1; });
   g_app.renderer.samples = antialias == 1 || (antialias < 0 && !g_app.softwareGl) ? 4 : 0;
   g_app.state.samples = g_app.renderer.samples;
+  emscripten_set_webglcontextlost_callback("#canvas", nullptr, EM_FALSE, onContextLost);
+  emscripten_set_webglcontextrestored_callback("#canvas", nullptr, EM_FALSE, onContextRestored);
   glfwSetMouseButtonCallback(g_app.window, onMouseButton);
   glfwSetCursorPosCallback(g_app.window, onCursorPos);
   emscripten_set_wheel_callback("#canvas", nullptr, EM_TRUE, onWheel);

@@ -915,6 +915,7 @@ std::string statsJson(const ViewerState& s) {
       {"reducedFrames", s.reducedFrames},
       {"softwareGl", s.softwareGl},
       {"samples", s.samples},
+      {"contextLost", s.contextLost},
       {"uploadBytes", s.uploadBytes},
       {"fullUploads", s.fullUploads},
       {"partialUploads", s.partialUploads},

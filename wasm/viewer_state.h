@@ -221,6 +221,7 @@ struct ViewerState {
   uint32_t reducedFrames = 0;        // frames whose scene was drawn at reduced resolution (software GL)
   bool softwareGl = false;           // SwiftShader & co (set by the platform layer)
   int samples = 0;                   // multisampling of the scene (0: none; set by the platform layer)
+  bool contextLost = false;          // the browser took the WebGL context away (not drawn until it is back)
   double maxFrameGapMs = 0;    // longest interval between two frame callbacks (browser included)
   uint64_t uploadBytes = 0;    // GPU bytes uploaded in all (renderer)
   uint32_t fullUploads = 0, partialUploads = 0;
@@ -339,7 +340,7 @@ double secondsLeft(const ViewerState& s);        // at the current rate; < 0 whe
 //  splitsTotal, targetSplits, level, live, paused, fieldError, baseVertices, hullTriangles,
 //  hullLines, firstSurfaceMs, completeMs, extractMs, refineMs, maxRefineMs, refineTotalMs, refineSteps,
 //  sliceEdgesMs, sliceCounts (work slices by duration, bins split at the edges),
-//  frameMs, maxFrameMs, maxFrameGapMs, drawMs, maxDrawMs, drawTotalMs, reducedFrames, softwareGl, samples, treeTets (tets the interval tree covers), uploadBytes, fullUploads, partialUploads,
+//  frameMs, maxFrameMs, maxFrameGapMs, drawMs, maxDrawMs, drawTotalMs, reducedFrames, softwareGl, samples, contextLost, treeTets (tets the interval tree covers), uploadBytes, fullUploads, partialUploads,
 //  grownUploads (full uploads because a buffer grew), showBoundary,
 //  notice, chunksAllowed, memoryLimited, memory:{heapBytes, dataBytes, gpuBytes, limitBytes,
 //  neededBytes, allowedBytes}, sliderRect:{x,y,w,h}, levelSliderRect:{x,y,w,h},

@@ -958,6 +958,10 @@ function updateStatus() {
       text = `${name}: all ${s.chunksTotal} parts, ${megabytes(s.bytesTotal)}; level ${(100 * s.level).toFixed(1)}%`;
     }
   }
+  if (s && s.contextLost) {
+    return showStatus('The browser took the graphics context away (a GPU reset or switch): the view comes back ' +
+      'when it gives it back; loading goes on.', bar, 'warn');
+  }
   if (notice) return showStatus(notice, bar, 'warn');
   showStatus(text, bar, s && s.state === 'complete' ? 'done' : '');
 }

@@ -487,3 +487,35 @@ test('drawing frames makes no WebGL call that waits for the GPU process; startin
   assert.ok(drawn.length > 0, 'the frames read the bindings back (Dear ImGui): the check saw them');
   await page.close();
 });
+
+// The browser may take the WebGL context away (a GPU reset or switch): the page says so, keeps
+// the data, and when the context comes back the viewer makes its GL objects again and shows the
+// same picture.
+test('a lost WebGL context: the page says so, and the same picture comes back with the context', async () => {
+  const { page, problems } = await openViewer('?data=/two/manifest.json');
+  const s = await waitSettled(page);
+  const view = { x: 420, y: 60, width: 520, height: 560 };
+  const panelTop = { x: 10, y: 10, width: 340, height: 180 };  // (its lines that do not change)
+  const before = await page.screenshot({ clip: view });
+  const panelBefore = await page.screenshot({ clip: panelTop });
+  await page.evaluate(() => {
+    window.__loseContext = document.getElementById('canvas').getContext('webgl2').getExtension('WEBGL_lose_context');
+    window.__loseContext.loseContext();
+  });
+  await page.waitForFunction(() => window.tetstream.stats().contextLost === true);
+  await page.waitForFunction(() => /graphics context/.test(document.getElementById('status-text').textContent), null,
+    { timeout: 5000 });
+  await page.evaluate(() => window.__loseContext.restoreContext());
+  await page.waitForFunction(() => window.tetstream.stats().contextLost === false);
+  await frames(page, 6);
+  const after = await page.evaluate(() => window.tetstream.stats());
+  assert.equal(after.triangles, s.triangles);
+  assert.equal(after.state, 'complete');
+  const d = await pictureDifference(page, before, await page.screenshot({ clip: view }));
+  assert.ok(d.large <= 0.001 * d.pixels, `${d.large} of ${d.pixels} pixels differ by more than 8 levels after the restore`);
+  const p = await pictureDifference(page, panelBefore, await page.screenshot({ clip: panelTop }));
+  assert.ok(p.large <= 0.001 * p.pixels, `the panel: ${p.large} of ${p.pixels} pixels differ after the restore`);
+  await page.screenshot({ path: path.join(outDir, 'view-context-restored.png') });
+  assert.deepEqual(problems.filter((m) => !/context/i.test(m)), []);
+  await page.close();
+});
