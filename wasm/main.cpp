@@ -516,6 +516,9 @@ void frame() {
   if (measuring) s.maxFrameMs = std::max(s.maxFrameMs, end - start);
 }
 
+// The GLSL of Dear ImGui's shaders: WebGL 2's (started at init and again after a lost context).
+constexpr const char* kImGuiGlsl = "#version 300 es";
+
 // ---------------------------------------------------------------- WebGL context loss
 // The browser may take the GPU context away (a driver reset, another GPU, too many contexts):
 // every GL object goes with it. Streaming and refinement go on meanwhile; drawing waits. When the
@@ -543,7 +546,7 @@ EM_BOOL onContextRestored(int, const void*, void*) {
   // The panel's backend starts afresh (Dear ImGui 1.86 keeps its buffers' sizes past
   // DestroyDeviceObjects, and would write past the new, empty buffers).
   ImGui_ImplOpenGL3_Shutdown();
-  ImGui_ImplOpenGL3_Init("#version 300 es");
+  ImGui_ImplOpenGL3_Init(kImGuiGlsl);
   s.surfaceDirty = s.sliceDirty = s.hullDirty = true;
   s.contextLost = false;
   requestRedraw();
@@ -633,7 +636,7 @@ bool initPlatform(std::string& error) {
   style.ItemSpacing = ImVec2(8.f, 6.f);
   style.ScaleAllSizes(g_app.uiScale);
   ImGui_ImplGlfw_InitForOpenGL(g_app.window, true);
-  ImGui_ImplOpenGL3_Init("#version 300 es");
+  ImGui_ImplOpenGL3_Init(kImGuiGlsl);
   glfwSetScrollCallback(g_app.window, ignoreScroll);  // wheel goes through onWheel instead
   return true;
 }
