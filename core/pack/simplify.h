@@ -1,9 +1,11 @@
 // Tetrahedral mesh simplification by half-edge collapses hec(p_i → p_j) (paper §3).
 //
 // Every half-edge sits in a priority queue keyed by its cost (both directions; they differ):
-//   cost = sqrt(n)·(w_g·E_g + w_f·E_f) + w_s·E_s, each term dimensionless, where n counts the
-//   input vertices i and j stand for together (sqrt(n)·error approximates the root of the summed
-//   squared error at them, paper eq. 5: what a collapse adds to the RMS over the whole mesh):
+//   cost = sqrt(n)·(w_g·E_g + w_f·E_f) + w_s·E_s, each term dimensionless, where n measures
+//   what i and j stand for together: the larger of their count of input vertices and their
+//   input volume over the mean volume per vertex (sqrt(n)·error approximates the root of the
+//   summed squared error there, paper eq. 5: what a collapse adds to the RMS at the input's
+//   vertices, or to the field's volume error, which isosurfaces show; see boundTerms()):
 //   E_g  geometric error, paper eq. (3)-(4): boundary plane quadrics (area weighted, summed on
 //        collapse) evaluated at p_j, as an RMS distance divided by the bounding-box diagonal.
 //        Zero for interior vertices, whose collapse does not move the boundary.
@@ -78,6 +80,10 @@ struct SimplifyOptions {
   // With fitValues, at the end the values of the vertices that stand for others are fitted again,
   // all together, to the input field at every input vertex (least squares; simplify_refit.cpp).
   bool refitValues = true;
+  // How much of the input a collapse stands for, the weight of its error terms (see the cost
+  // above and boundTerms()): the larger of its input vertices and its volume (in units of the
+  // mean volume per vertex), or (false) the vertices alone, as before session 25 (tests compare).
+  bool weighByVolume = true;
   std::function<void(uint32_t done, uint32_t planned)> progress;  // called now and then
   // Keep in the log what each split reads (CollapseLog::star), for StreamOptions::orderSplits.
   bool recordReadSets = false;

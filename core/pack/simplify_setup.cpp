@@ -99,6 +99,16 @@ void Simplifier::init() {
   };
   onBoth([&](int part) { sums(part, part ? V_ / 2 : 0, part ? V_ : V_ / 2); });
   flatInput_ += flat[0] + flat[1];
+  // The unit of volume (boundTerms): the mean of the interior vertices', which on an even grid is
+  // every interior vertex's own (boundary vertices stand for half a star or less).
+  double volume = 0;
+  uint32_t interior = 0;
+  for (uint32_t v = 0; v < V_; ++v)
+    if (out_.vertexAlive[v] && !boundary_[v]) {
+      volume += fieldQuadric_[v].weight;
+      ++interior;
+    }
+  meanVertexVolume_ = interior > 0 && volume > 0 ? volume / interior : 1.0;
   queued_.assign(V_, 0);
   represented_.assign(V_, 1);
   lastCost_.assign(V_, float(kInf));
