@@ -100,15 +100,19 @@ void Simplifier::init() {
   onBoth([&](int part) { sums(part, part ? V_ / 2 : 0, part ? V_ : V_ / 2); });
   flatInput_ += flat[0] + flat[1];
   // The unit of volume (boundTerms): the mean of the interior vertices', which on an even grid is
-  // every interior vertex's own (boundary vertices stand for half a star or less).
-  double volume = 0;
-  uint32_t interior = 0;
+  // every interior vertex's own (boundary vertices stand for half a star or less); of all
+  // vertices when none is inside (a slab one tet thick). With no volume at all (every tet flat)
+  // the count alone remains.
+  double volume[2] = {0, 0};
+  uint32_t count[2] = {0, 0};
   for (uint32_t v = 0; v < V_; ++v)
-    if (out_.vertexAlive[v] && !boundary_[v]) {
-      volume += fieldQuadric_[v].weight;
-      ++interior;
+    if (out_.vertexAlive[v]) {
+      volume[boundary_[v]] += fieldQuadric_[v].weight;
+      ++count[boundary_[v]];
     }
-  meanVertexVolume_ = interior > 0 && volume > 0 ? volume / interior : 1.0;
+  const double inside = count[0] ? volume[0] / count[0] : 0;
+  const double all = alive_ ? (volume[0] + volume[1]) / alive_ : 0;
+  meanVertexVolume_ = inside > 0 ? inside : all > 0 ? all : kInf;
   queued_.assign(V_, 0);
   represented_.assign(V_, 1);
   lastCost_.assign(V_, float(kInf));
