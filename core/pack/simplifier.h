@@ -445,7 +445,7 @@ class Simplifier {
   }
   std::vector<float> kappa_, lastCost_;
   std::vector<FieldQuadric> fieldQuadric_;  // (its weight: the input volume a vertex stands for, a quarter of each tet)
-  double meanVertexVolume_ = 1;              // the mean over interior input vertices (see init(), boundTerms())
+  double meanVertexVolume_ = 1;              // the unit of the volume measure (init(), boundTerms())
   std::vector<double> qualitySum_;  // per vertex: Σ 3/κ over its star
   std::vector<uint8_t> queued_;  // per vertex: has an entry in the queue (or in the current round)
   Lane mainLane_;

@@ -3,7 +3,7 @@
 // Every half-edge sits in a priority queue keyed by its cost (both directions; they differ):
 //   cost = sqrt(n)·(w_g·E_g + w_f·E_f) + w_s·E_s, each term dimensionless, where n measures
 //   what i and j stand for together: the larger of their count of input vertices and their
-//   input volume over the mean volume per vertex (sqrt(n)·error approximates the root of the
+//   input volume over an interior vertex's mean volume (sqrt(n)·error approximates the root of the
 //   summed squared error there, paper eq. 5: what a collapse adds to the RMS at the input's
 //   vertices, or to the field's volume error, which isosurfaces show; see boundTerms()):
 //   E_g  geometric error, paper eq. (3)-(4): boundary plane quadrics (area weighted, summed on
@@ -81,8 +81,9 @@ struct SimplifyOptions {
   // all together, to the input field at every input vertex (least squares; simplify_refit.cpp).
   bool refitValues = true;
   // How much of the input a collapse stands for, the weight of its error terms (see the cost
-  // above and boundTerms()): the larger of its input vertices and its volume (in units of the
-  // mean volume per vertex), or (false) the vertices alone, as before session 25 (tests compare).
+  // above and boundTerms()): the larger of its input vertices and its volume (in units of an
+  // interior vertex's mean volume), or (false) the vertices alone, as before session 25 (tests
+  // compare the two).
   bool weighByVolume = true;
   std::function<void(uint32_t done, uint32_t planned)> progress;  // called now and then
   // Keep in the log what each split reads (CollapseLog::star), for StreamOptions::orderSplits.
