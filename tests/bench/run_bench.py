@@ -146,6 +146,7 @@ def bench_mesh(name, mesh, field, iso, tmp, with_vtk, quick, repeat, light=False
             vtk_out = os.path.join(tmp, f"vtk-{n}.vtu")
             runs = vtk5 if n == target else [run_json(["/usr/bin/python3", VTK_SCRIPT, mesh, vtk_out, str(n), field])]
             row["vtk"] = run_json([BENCH, "error", mesh, vtk_out, "--field", field])
+            row["vtkIso"] = run_json([BENCH, "isodist", mesh, vtk_out, "--field", field, "--value", str(iso)])
             row["vtkSeconds"] = median([v["seconds"] for v in runs])
             row["vtkRunsSeconds"] = [v["seconds"] for v in runs]
             # VTK's decimation may stop well short of the request (it does on Blunt Fin): then
@@ -155,6 +156,7 @@ def bench_mesh(name, mesh, field, iso, tmp, with_vtk, quick, repeat, light=False
                 row["vtkStoppedShort"] = True
         _, ours = (pack5, ours5) if compare_at == target else our_level(mesh, tmp, compare_at, field)
         row["ours"] = run_json([BENCH, "error", mesh, ours, "--field", field])
+        row["oursIso"] = run_json([BENCH, "isodist", mesh, ours, "--field", field, "--value", str(iso)])
         res["error"].append(row)
     if light:  # pack time and errors only
         return res
@@ -201,10 +203,11 @@ def markdown(results, machine):
         runs = r["pack5"]["runsMs"]
         ours_ms = f"{ours:.0f}" + (f" ({min(runs):.0f}–{max(runs):.0f})" if len(runs) > 1 else "")
         lines.append(f"| {r['name']} | {r['tets']:,} | {ours_ms} | {vtk_ms} | {ratio} | {r['pack5']['bytesPerInputTet']:.0f} B |")
-    lines += ["", "Field error sampled at the original vertices; quality is the mean 3/κ of the tets (1 = equilateral). "
+    lines += ["", "Field error sampled at the original vertices; isosurface distance at the isovalue of the isosurface table below "
+              "(mean of both ways, relative to the diagonal); quality is the mean 3/κ of the tets (1 = equilateral). "
               "Where VTK stopped short of the requested count, both are compared at the count VTK reached (marked *).", "",
-              "| dataset | level (tets) | ours RMS / max (rel. to range) | VTK RMS / max | ours volume ratio | VTK volume ratio | quality ours / VTK |",
-              "|---|---|---|---|---|---|---|"]
+              "| dataset | level (tets) | ours RMS / max (rel. to range) | VTK RMS / max | isosurface distance ours / VTK | ours volume ratio | VTK volume ratio | quality ours / VTK |",
+              "|---|---|---|---|---|---|---|---|"]
     for r in results:
         for e in r["error"]:
             o, v = e["ours"], e.get("vtk")
@@ -212,8 +215,9 @@ def markdown(results, machine):
             vvol = f"{v['volumeRatio']:.5f}" if v else "n/a"
             vq = f"{v['meanQuality']:.3f}" if v else "n/a"
             star = "*" if e.get("vtkStoppedShort") else ""
+            iso = f"{e['oursIso']['meanRelative']:.2e} / " + (f"{e['vtkIso']['meanRelative']:.2e}" if "vtkIso" in e else "n/a")
             lines.append(f"| {r['name']} | {e['fraction']:.0%}{star} ({o['tets']:,}) | {o['rmsRelative']:.5f} / {o['maxRelative']:.4f} | {vtxt} | "
-                         f"{o['volumeRatio']:.5f} | {vvol} | {o['meanQuality']:.3f} / {vq} |")
+                         f"{iso} | {o['volumeRatio']:.5f} | {vvol} | {o['meanQuality']:.3f} / {vq} |")
     results = [r for r in results if "size" in r]  # (the --large and --huge cases stop after the errors)
     lines += ["", "Default pack (one run; `--compact`: splits by kept vertex inside each chunk):", "",
               "| dataset | packed bits/tet | bytes/split | zstd -19 raw bits/tet | base | chunks | --compact bits/tet (bytes) | pack ms / --compact | peak MB / --compact |",
