@@ -747,7 +747,7 @@ double volumeRms(const TetMesh& in, const TetMesh& coarse) {
 // its input vertices and its volume. On a graded grid (CFD boundary layers: most vertices in a
 // thin layer at a wall) the vertices alone let the coarse far field go first, and its
 // isosurfaces drift; with the volume the far field is kept, and the RMS at the vertices, which
-// the layer dominates, stays about the same.
+// the layer dominates, is no worse.
 TEST(Progressive, GradedMeshKeepsTheFarFieldWhereIsosurfacesAre) {
   TetMesh m = makeGridMesh(12);
   for (size_t v = 0; v < m.vertexCount(); ++v) {
