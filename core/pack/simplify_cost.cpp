@@ -144,7 +144,7 @@ Simplifier::Candidate Simplifier::boundTerms(Lane& L, uint32_t i, uint32_t j, ui
   //   isosurface of density 1.2 lay 9× farther from the input's (3.6e-4 of the diagonal, mean,
   //   against 3.9e-5 now; session 25).
   // The manifest reports the unweighted E_f.
-  const double volume = (fieldQuadric_[i].weight + fieldQuadric_[j].weight) / meanVertexVolume_;
+  const double volume = fq.weight / meanVertexVolume_;  // (fq: i's and j's field quadrics, summed above)
   c.weight = std::sqrt(opt_.weighByVolume ? std::max(double(count), volume) : double(count));
   // E_s after the collapse with every new tet at the best quality (3/κ = 1), as the tets of
   // p_j's star that stay are known: most candidates lose without finishCost(). Scaled down a
