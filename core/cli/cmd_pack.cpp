@@ -185,8 +185,8 @@ Runner addPack(CLI::App& app) {
       std::printf("  error     base field error at the input's vertices: RMS %.3g%s, largest %.3g%s\n", b.fieldRms,
                   share(b.fieldRms).c_str(), b.fieldMax, share(b.fieldMax).c_str());
     }
-    std::printf("  stream    %u splits in %zu chunks, %.2f MB in all, %.1f bits/tet, %.1f bytes/split\n", s.splits,
-                m.chunks.size() - 1, bytes / 1e6, bitsPerTet, bytesPerSplit);
+    std::printf("  stream    %u splits in %zu chunk%s, %.2f MB in all, %.1f bits/tet, %.1f bytes/split\n", s.splits,
+                m.chunks.size() - 1, m.chunks.size() == 2 ? "" : "s", bytes / 1e6, bitsPerTet, bytesPerSplit);
     std::printf("  values    %s\n", m.lossless ? "lossless float32"
                                                 : ("quantized, " + std::to_string(m.positionBits) + "-bit positions, " +
                                                    std::to_string(m.fieldBits) + "-bit fields").c_str());
