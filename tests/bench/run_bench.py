@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
 """Progressive-engine benchmarks (issue 3 figures), side by side with VTK where it is installed.
 
-   python3 tests/bench/run_bench.py [--n 64] [--quick] [--repeat 5] [--large] [--huge]   (scripts/bench.sh builds first)
+   python3 tests/bench/run_bench.py [--n 64] [--quick] [--repeat 5] [--large] [--huge] [--only TEXT]
+   (scripts/bench.sh builds first; --only: the cases whose name contains TEXT)
 
 For Harmonic N³ and for the real meshes in ../shared/datasets that have a point field (post.vtk,
-Blunt Fin, and without --quick the carotid data; with --large also ironProt.vtk, 1.8M tets, for
+Blunt Fin, the kiefer bracket, and without --quick the carotid data; with --large also ironProt.vtk, 1.8M tets, for
 the pack time and field error only, as each VTK run on it takes ~25 s; with --huge also Harmonic
 128³, 12.3M tets, for the pack time, memory and the field error at 5%, one run each, as each takes
 about a minute):
@@ -325,6 +326,12 @@ def main():
             # PLOT3D: read by our reader, written out as .vtu so that VTK gets the very same tets.
             fin_vtu = as_vtu(fin, tmp, "bluntfin")
             cases.append(("Blunt Fin (real, PLOT3D)", fin_vtu, "density", 1.2))
+        kiefer = os.path.join(DATASETS, "kiefer_dataset.vtu")
+        if os.path.exists(kiefer):
+            # Quadratic tets with cell data: VTK's decimation takes neither, so both get the mesh as
+            # our reader makes it (the corner tets, the stress averaged to the vertices) as .vtu.
+            kiefer_vtu = as_vtu(kiefer, tmp, "kiefer")
+            cases.append(("kiefer bracket (real, FEA)", kiefer_vtu, "Equivalent (von-Mises) Stress (psi)", 4.0))
         carotid = os.path.join(DATASETS, "carotid.vtk")
         if os.path.exists(carotid) and not quick:
             # Structured points, split into tets by our reader; large enough (167,580 vertices)
@@ -340,6 +347,9 @@ def main():
             # Seven times the largest real mesh here, for how both tools scale: one run each (about
             # a minute), the error at 5% only. Made when its turn comes (a 537 MB file).
             cases.append(("Harmonic 128³ (--huge, one run)", os.path.join(tmp, "harmonic-128.vtu"), "harmonic", 0.2, "huge"))
+        if "--only" in sys.argv:  # the cases whose name contains this text
+            only = sys.argv[sys.argv.index("--only") + 1].lower()
+            cases = [c for c in cases if only in c[0].lower()]
         for name, mesh, field, iso, *kind in cases:
             huge = kind == ["huge"]
             if huge:
