@@ -653,6 +653,40 @@ TEST(ReaderBadInput, RandomByteDamageNeverCrashes) {
   }
 }
 
+// Base64 broken into lines (as some writers wrap it), the breaks falling inside 4-character
+// groups and inside the compressed blocks' header words: the same mesh as the one-line text.
+TEST(ReaderVtu, WrappedBase64ReadsAlike) {
+  for (const char* file : {"vtk_binary_zlib.vtu", "meshio_zlib.vtu", "vtk_binary_u64.vtu"}) {
+    const std::string text = loadFile(fixturePath(file));
+    std::string wrapped;
+    size_t arrays = 0;
+    for (size_t at = 0;;) {
+      const size_t tag = text.find("format=\"binary\"", at);
+      if (tag == std::string::npos) {
+        wrapped += text.substr(at);
+        break;
+      }
+      const size_t begin = text.find('>', tag) + 1, end = text.find('<', begin);
+      wrapped += text.substr(at, begin - at);
+      for (size_t k = begin; k < end; ++k) {
+        wrapped += text[k];
+        if ((k - begin) % 7 == 6) wrapped += (k % 2 ? "\n    " : "\r\n\t");
+      }
+      at = end;
+      ++arrays;
+    }
+    ASSERT_GT(arrays, 2u) << file;
+    TetMesh a, b;
+    ReadReport ra, rb;
+    ASSERT_TRUE(readBytes(text, file, a, ra)) << file;
+    ASSERT_TRUE(readBytes(wrapped, file, b, rb)) << file;
+    EXPECT_EQ(a.positions, b.positions) << file;
+    EXPECT_EQ(a.tets, b.tets) << file;
+    ASSERT_EQ(a.fields.size(), b.fields.size()) << file;
+    for (size_t f = 0; f < a.fields.size(); ++f) EXPECT_EQ(a.fields[f].values, b.fields[f].values) << file;
+  }
+}
+
 TEST(ReaderBadInput, BadBase64AndZlib) {
   std::string b64 = loadFile(fixturePath("vtk_binary.vtu"));
   size_t at = b64.find("format=\"binary\"");
