@@ -653,6 +653,45 @@ TEST(ReaderBadInput, RandomByteDamageNeverCrashes) {
   }
 }
 
+// ASCII integers as every text reader takes them: the quick path for plain digits and the full
+// one for the rest agree on what they accept, the value, and where pos ends.
+TEST(ReaderText, ParseNextInt) {
+  using tetstream::vtkio::parseNextInt;
+  struct Case {
+    const char* text;
+    int result;
+    int64_t value;
+    size_t pos;  // after the call
+  };
+  const Case cases[] = {
+      {"  42 7", 1, 42, 4},          {"\t\n-12\n", 1, -12, 5},   {"+7", 1, 7, 2},
+      {"007 ", 1, 7, 3},             {"-0", 1, 0, 2},               {"4.0 1", 1, 4, 3},
+      {"4e0", 1, 4, 3},              {"4.5", -1, 0, 0},             {"12abc", -1, 0, 0},
+      {" -", -1, 0, 1},              {"   ", 0, 0, 3},              {"", 0, 0, 0},
+      {"123456789012345678", 1, 123456789012345678, 18},
+      {"1234567890123456789", 1, 1234567890123456789, 19},     // 19 digits: past the quick path
+      {"-9223372036854775808", 1, INT64_MIN, 20},
+      {"99999999999999999999", -1, 0, 0},                      // beyond int64
+  };
+  for (const Case& c : cases) {
+    size_t pos = 0;
+    int64_t v = 0;
+    EXPECT_EQ(parseNextInt(c.text, pos, v), c.result) << '"' << c.text << '"';
+    if (c.result == 1) {
+      EXPECT_EQ(v, c.value) << '"' << c.text << '"';
+    }
+    EXPECT_EQ(pos, c.pos) << '"' << c.text << '"';
+  }
+  // A run of numbers read one after another.
+  std::string_view text = "1 -2\t3\n\n 40 5";
+  size_t pos = 0;
+  int64_t v = 0, sum = 0;
+  int n = 0;
+  while (parseNextInt(text, pos, v) == 1) sum += v, ++n;
+  EXPECT_EQ(n, 5);
+  EXPECT_EQ(sum, 47);
+}
+
 // Base64 broken into lines (as some writers wrap it), the breaks falling inside 4-character
 // groups and inside the compressed blocks' header words: the same mesh as the one-line text.
 TEST(ReaderVtu, WrappedBase64ReadsAlike) {
