@@ -91,32 +91,32 @@ class ByteSource {
  private:
   ByteSource(std::string_view d, bool b64) : data_(d), b64_(b64) {}
 
-  static int value(char c) {
-    if (c >= 'A' && c <= 'Z') return c - 'A';
-    if (c >= 'a' && c <= 'z') return c - 'a' + 26;
-    if (c >= '0' && c <= '9') return c - '0' + 52;
-    if (c == '+') return 62;
-    if (c == '/') return 63;
-    if (c == '=') return 64;
-    return -1;
+  // Each character's meaning in base64 text: its 6 bits (0-63), kPad for '=', kSpace for the
+  // white space allowed between characters, kBad for the rest. One table for both decoders.
+  static constexpr uint8_t kPad = 64, kSpace = 0x80, kBad = 0xff;
+  static const std::array<uint8_t, 256>& meaning() {
+    static const std::array<uint8_t, 256> table = [] {
+      std::array<uint8_t, 256> t;
+      t.fill(kBad);
+      const char* alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+      for (int k = 0; k < 64; ++k) t[uint8_t(alphabet[k])] = uint8_t(k);
+      t[uint8_t('=')] = kPad;
+      for (char c : {' ', '\n', '\r', '\t'}) t[uint8_t(c)] = kSpace;
+      return t;
+    }();
+    return table;
   }
 
   // Decodes whole groups straight into dst while the text is plain base64, four characters a
   // group with no white space, padding or stray character (decodeGroup() takes those, one group
-  // at a time): a table lookup a character. Returns the bytes written, a multiple of 3, at most n.
+  // at a time). Returns the bytes written, a multiple of 3, at most n.
   size_t plainGroups(uint8_t* dst, size_t n) {
-    static const std::array<uint8_t, 256> table = [] {
-      std::array<uint8_t, 256> t;
-      t.fill(0x80);
-      for (int c = 0; c < 256; ++c)
-        if (int x = value(char(c)); x >= 0 && x < 64) t[size_t(c)] = uint8_t(x);
-      return t;
-    }();
+    const std::array<uint8_t, 256>& table = meaning();
     const auto* text = reinterpret_cast<const unsigned char*>(data_.data());
     size_t done = 0;
     for (; n - done >= 3 && data_.size() - pos_ >= 4; done += 3, pos_ += 4) {
       const uint32_t a = table[text[pos_]], b = table[text[pos_ + 1]], c = table[text[pos_ + 2]], d = table[text[pos_ + 3]];
-      if ((a | b | c | d) & 0x80) break;
+      if ((a | b | c | d) >= kPad) break;  // (each is below 64 or at least kPad)
       const uint32_t bits = a << 18 | b << 12 | c << 6 | d;
       dst[done] = uint8_t(bits >> 16);
       dst[done + 1] = uint8_t(bits >> 8);
@@ -133,13 +133,13 @@ class ByteSource {
         error_ = got ? "base64 text ends inside a 4-character group" : "base64 text ends early";
         return false;
       }
-      char c = data_[pos_];
-      if (c == ' ' || c == '\n' || c == '\r' || c == '\t') {
+      const char c = data_[pos_];
+      const uint8_t x = meaning()[uint8_t(c)];
+      if (x == kSpace) {
         ++pos_;
         continue;
       }
-      int x = value(c);
-      if (x < 0) {
+      if (x == kBad) {
         char buf[64];
         std::snprintf(buf, sizeof buf, "invalid base64 character 0x%02x", unsigned(static_cast<unsigned char>(c)));
         error_ = buf;
