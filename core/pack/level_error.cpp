@@ -2,11 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <thread>
 
 #include "adjacency.h"
 
 namespace tetstream {
 namespace {
+
+uint32_t mixTet(uint32_t x) {
+  x *= 0x9e3779b1u;
+  return x ^ x >> 15;
+}
 
 // The level's field at coordinates l of tet t, clamped to the tet (outside it, a point of the
 // tet stands in).
@@ -19,14 +25,6 @@ double interpolate(const std::vector<uint32_t>& tets, const std::vector<float>& 
     weight += w;
   }
   return sum / weight;
-}
-
-uint32_t mix(uint32_t x) {
-  x *= 0x9e3779b1u;
-  x ^= x >> 16;
-  x *= 0x85ebca6bu;
-  x ^= x >> 13;
-  return x;
 }
 
 }  // namespace
@@ -67,80 +65,95 @@ double LevelErrorMeter::TetFrame::coordinates(const float* x, double l[4], doubl
   return std::min(lo, rest);
 }
 
-void LevelErrorMeter::link(uint32_t v, uint32_t t) {
-  Sample& s = samples_[v];
-  s.tet = t;
-  s.prev = kNone;
-  s.next = head_[t];
-  if (head_[t] != kNone) samples_[head_[t]].prev = v;
-  head_[t] = v;
-  occupied_.set(t);
+const LevelErrorMeter::TetFrame* LevelErrorMeter::frameOf(Scratch& s, uint32_t t) const {
+  Scratch::FrameSlot& slot = s.frames[mixTet(t) & (s.frames.size() - 1)];
+  if (slot.tet != t || slot.epoch != s.epoch) {
+    slot.tet = t;
+    slot.epoch = s.epoch;
+    slot.solid = slot.frame.make(*this, t);
+  }
+  return slot.solid ? &slot.frame : nullptr;
 }
 
-void LevelErrorMeter::unlink(uint32_t v) {
-  Sample& s = samples_[v];
-  if (s.tet >= kVertex) return;
-  if (s.prev != kNone) samples_[s.prev].next = s.next;
-  else if ((head_[s.tet] = s.next) == kNone) occupied_.clear(s.tet);
-  if (s.next != kNone) samples_[s.next].prev = s.prev;
-  s.tet = kNone;
-}
-
-void LevelErrorMeter::setError(uint32_t v, uint32_t t, const double l[4]) {
-  samples_[v].err = float(std::abs(samples_[v].value - interpolate(mesh_->tets, levelValues(), t, l)));
+float LevelErrorMeter::errorAt(uint32_t v, uint32_t t, const double l[4]) const {
+  return float(std::abs(samples_[v].value - interpolate(mesh_->tets, levelValues(), t, l)));
 }
 
 void LevelErrorMeter::becomeVertex(uint32_t v, uint32_t level) {
-  unlink(v);
   samples_[v].tet = kVertex;
   samples_[v].err = float(std::abs(samples_[v].value - double(levelValues()[level])));
+  outside_[v] = 0;
 }
 
-// From tet t across the face of the most negative coordinate (across(t, k): the tet beyond the
-// face opposite corner k, or kNone); the best tet seen wins when the walk leaves the mesh or
-// takes too long. Returns the smallest coordinate there (negative: outside the mesh).
+// From tet t towards input vertex v, across the face of the most negative coordinate
+// (across(t, k): the tet beyond the face opposite corner k, or kNone). Where that face is on
+// the boundary, across the next negative one that is not (and not back): around a concave part
+// of the boundary, where the straight way would leave a non-convex mesh. The best tet seen wins
+// when no way is left or the walk takes too long.
 template <typename Across>
-double LevelErrorMeter::walk(uint32_t v, uint32_t t, Across across) {
+LevelErrorMeter::Found LevelErrorMeter::walk(Scratch& s, uint32_t v, uint32_t t, Across across) const {
   const float* x = samples_[v].x;
-  uint32_t bestTet = kNone;
+  uint32_t bestTet = kNone, previous = kNone;
   double best = -HUGE_VAL, bestL[4];
   for (int step = 0; step < 256; ++step) {
-    TetFrame frame;
-    if (!frame.make(*this, t)) break;  // flat: no way on
+    const TetFrame* frame = frameOf(s, t);
+    if (!frame) break;  // flat: no way on
     double l[4];
-    const double lo = frame.coordinates(x, l);
+    const double lo = frame->coordinates(x, l);
     if (lo > best) {
       best = lo;
       bestTet = t;
       std::copy(l, l + 4, bestL);
     }
-    if (lo >= 0) break;
-    const uint32_t next = across(t, int(std::min_element(l, l + 4) - l));
+    if (lo >= kInside) break;
+    int order[4] = {0, 1, 2, 3};
+    std::sort(order, order + 4, [&](int a, int b) { return l[a] < l[b]; });
+    uint32_t next = kNone;
+    for (int n = 0; n < 4 && l[order[n]] < 0 && next == kNone; ++n) {
+      const uint32_t u = across(t, order[n]);
+      if (u != previous || n == 0) next = u;
+    }
     if (next == kNone) break;
+    previous = t;
     t = next;
   }
-  if (bestTet == kNone) return best;
-  unlink(v);
-  link(v, bestTet);
-  setError(v, bestTet, bestL);
-  markOutside(v, best < 0);
-  return best;
+  if (bestTet == kNone) return {kNone, 0.0f, true};
+  return {bestTet, errorAt(v, bestTet, bestL), best < kInside};
 }
 
-void LevelErrorMeter::markOutside(uint32_t v, bool outside) {
-  if (!outside) return outside_.clear(v);
-  outside_.set(v);
-  if (!listed_.test(v)) {
-    listed_.set(v);
-    outsideList_.push_back(v);
+// Whether one of `tets` holds input vertex v (then `found` says where).
+template <typename Tets>
+bool LevelErrorMeter::lookAmong(Scratch& s, uint32_t v, const Tets& tets, Found& found) const {
+  for (uint32_t t : tets) {
+    const TetFrame* f = frameOf(s, t);
+    double l[4] = {};
+    if (f && f->coordinates(samples_[v].x, l, kInside) >= kInside) {  // (l is whole then)
+      found = {t, errorAt(v, t, l), false};
+      return true;
+    }
   }
+  return false;
 }
 
 // The tet beyond the face of t opposite corner k, from the stars of the face's vertices.
-uint32_t LevelErrorMeter::acrossByStars(uint32_t t, int k) const {
+uint32_t LevelErrorMeter::acrossByStars(Scratch& s, uint32_t t, int k) const {
+  const uint32_t face = 4 * t + uint32_t(k);
+  Scratch::AcrossSlot& slot = s.across[mixTet(face) & (s.across.size() - 1)];
+  if (slot.face != face || slot.epoch != s.epoch) {
+    slot.face = face;
+    slot.epoch = s.epoch;
+    slot.tet = acrossByStarsUncached(t, k);
+  }
+  return slot.tet;
+}
+
+uint32_t LevelErrorMeter::acrossByStarsUncached(uint32_t t, int k) const {
   const uint32_t* v = &mesh_->tets[4 * size_t(t)];
-  const uint32_t b = v[(k + 2) & 3], c = v[(k + 3) & 3];
-  for (uint32_t corner : stars_->corners(v[(k + 1) & 3])) {
+  uint32_t a = v[(k + 1) & 3], b = v[(k + 2) & 3], c = v[(k + 3) & 3];
+  // Around the face's corner with the fewest tets.
+  if (stars_->corners(b).size() < stars_->corners(a).size()) std::swap(a, b);
+  if (stars_->corners(c).size() < stars_->corners(a).size()) std::swap(a, c);
+  for (uint32_t corner : stars_->corners(a)) {
     const uint32_t u = corner >> 2;
     const uint32_t* w = &mesh_->tets[4 * size_t(u)];
     if (u != t && (w[0] == b || w[1] == b || w[2] == b || w[3] == b) && (w[0] == c || w[1] == c || w[2] == c || w[3] == c))
@@ -149,176 +162,151 @@ uint32_t LevelErrorMeter::acrossByStars(uint32_t t, int k) const {
   return kNone;
 }
 
-// The input vertices outside the level mesh keep the tet they were least outside of, but splits
-// elsewhere move the boundary: walk each from there again (the boundary layer of Blunt Fin's
-// samples kept 5× the RMS of a fresh location without this).
-void LevelErrorMeter::relocateOutside() {
-  size_t keep = 0;
-  for (uint32_t v : outsideList_) {
-    if (outside_.test(v) && samples_[v].tet < kVertex &&
-        walk(v, samples_[v].tet, [this](uint32_t t, int k) { return acrossByStars(t, k); }) < 0) {
-      outsideList_[keep++] = v;
-    } else {
-      outside_.clear(v);
-      listed_.clear(v);
-    }
-  }
-  outsideList_.resize(keep);
+// Input vertex v left its tet, or was outside the mesh: a walk from there. If that ends outside,
+// a look among the tets of the level vertex that v was collapsed into (directly or not), where
+// v lies unless a collapse along the boundary moved the boundary past it. (A walk can leave a
+// non-convex mesh on the way to a point inside it: Blunt Fin's input vertices near the fin.)
+LevelErrorMeter::Found LevelErrorMeter::locateAgain(Scratch& s, uint32_t v) const {
+  Found found = walk(s, v, samples_[v].tet, [&](uint32_t t, int k) { return acrossByStars(s, t, k); });
+  if (!found.outside) return found;
+  uint32_t x = v;
+  while (levelOf_[x] == kNone && intoOf_[x] != x) x = intoOf_[x];
+  if (levelOf_[x] == kNone) return found;
+  struct Tets {  // the tets of a star, from its corners
+    std::span<const uint32_t> corners;
+    struct It {
+      const uint32_t* c;
+      uint32_t operator*() const { return *c >> 2; }
+      It& operator++() { return ++c, *this; }
+      bool operator!=(const It& o) const { return c != o.c; }
+    };
+    It begin() const { return {corners.data()}; }
+    It end() const { return {corners.data() + corners.size()}; }
+  };
+  lookAmong(s, v, Tets{stars_->corners(levelOf_[x])}, found);
+  return found;
+}
+
+void LevelErrorMeter::place(uint32_t v, const Found& f) {
+  if (f.tet == kNone) return;
+  samples_[v].tet = f.tet;
+  samples_[v].err = f.err;
+  outside_[v] = f.outside;
 }
 
 void LevelErrorMeter::begin(std::span<const float> positions, std::span<const float> values, const TetMesh& level,
-                            const StarPool* stars, size_t field, std::span<const uint32_t> levelOf,
-                            std::span<const uint32_t> baseOf, uint32_t maxSamples) {
+                            size_t field, std::span<const uint32_t> levelOf, std::span<const uint32_t> baseOf,
+                            std::span<const uint32_t> intoOf) {
+  intoOf_ = intoOf;
+  levelOf_.assign(levelOf.begin(), levelOf.end());
   mesh_ = &level;
-  stars_ = stars;
+  stars_ = nullptr;
   field_ = field;
+  Scratch& s = scratch_[0];
+  s.next();
   const std::vector<uint32_t>& tets = level.tets;
   const size_t V = values.size();
-  // An even sample: by a hash of the id, as samples by id alone would follow the numbering's
-  // pattern (every fourth column of a grid, say).
-  const uint64_t stride = (V + maxSamples - 1) / std::max(maxSamples, 1u);
   samples_.resize(V);
-  sampled_.resize(V);
-  outside_.resize(V);
-  listed_.resize(V);
-  for (uint32_t v = 0; v < V; ++v) {
-    const bool in = stride <= 1 || mix(v) % stride == 0;
-    samples_[v] = {{positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]}, values[v], 0.0f, in ? kNone : kSkip, kNone, kNone};
-    if (in) sampled_.set(v);
-  }
-  head_.assign(level.tetCount(), kNone);
-  occupied_.resize(level.tetCount());
+  outside_.assign(V, 0);
+  for (uint32_t v = 0; v < V; ++v)
+    samples_[v] = {{positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]}, values[v], 0.0f, kNone};
   inputOf_.assign(level.vertexCount(), kNone);
-  std::vector<uint32_t> someTet(level.vertexCount(), kNone);  // per base vertex: a tet around it
-  for (size_t c = 0; c < tets.size(); ++c) someTet[tets[c]] = uint32_t(c / 4);
-  // Across faces by the level's stars when it has them (the encoder's meter), else by a face
-  // adjacency built here (measure(), on its own thread): the base's faces are not paired twice.
+  // Per base vertex its tets (the base is small), around which its input vertices lie.
+  std::vector<uint32_t> starBegin(level.vertexCount() + 1, 0), star(tets.size());
+  for (uint32_t x : tets) ++starBegin[x + 1];
+  for (size_t x = 1; x < starBegin.size(); ++x) starBegin[x] += starBegin[x - 1];
+  for (size_t c = 0; c < tets.size(); ++c) star[starBegin[tets[c]]++] = uint32_t(c / 4);
+  for (size_t x = starBegin.size() - 1; x > 0; --x) starBegin[x] = starBegin[x - 1];
+  starBegin[0] = 0;
   FaceAdjacency adjacency;
-  if (!stars_) buildFaceAdjacency(tets, level.vertexCount(), adjacency);
+  buildFaceAdjacency(tets, level.vertexCount(), adjacency);
   auto across = [&](uint32_t t, int k) {
-    if (stars_) return acrossByStars(t, k);
     const uint32_t h = adjacency.opposite[4 * size_t(t) + size_t(k)];
     return h == kNoNeighbor ? kNone : h >> 2;
   };
   for (uint32_t v = 0; v < V; ++v) {
     if (levelOf[v] != kNone) inputOf_[levelOf[v]] = v;
-    if (!sampled_.test(v) || !std::isfinite(values[v])) continue;
+    const uint32_t at = levelOf[baseOf[v]];
+    if (!std::isfinite(values[v]) || at == kNone || starBegin[at] == starBegin[at + 1]) continue;  // in no tet
     if (levelOf[v] != kNone) {
-      if (someTet[levelOf[v]] != kNone) becomeVertex(v, levelOf[v]);
+      becomeVertex(v, levelOf[v]);
       continue;
     }
-    const uint32_t at = levelOf[baseOf[v]];
-    if (at == kNone || someTet[at] == kNone) continue;  // in no tet
-    walk(v, someTet[at], across);
+    const std::span<const uint32_t> around(&star[starBegin[at]], starBegin[at + 1] - starBegin[at]);
+    Found f = walk(s, v, around[0], across);
+    if (f.outside) lookAmong(s, v, around, f);
+    place(v, f);
   }
 }
 
-LevelError LevelErrorMeter::measure(std::span<const float> positions, std::span<const float> values, const TetMesh& level,
-                                    size_t field, std::span<const uint32_t> levelOf, std::span<const uint32_t> baseOf) {
-  LevelErrorMeter m;
-  m.begin(positions, values, level, nullptr, field, levelOf, baseOf, ~0u);
-  return m.current();
-}
-
-void LevelErrorMeter::afterSplit(uint32_t input, uint32_t j, std::span<const uint32_t> moved, uint32_t firstNew,
-                                 bool jValueChanged) {
-  const uint32_t tetCount = mesh_->tetCount();
-  head_.resize(tetCount, kNone);
-  occupied_.resize(tetCount);
-  inputOf_.push_back(input);
-  if (sampled_.test(input)) {
-    if (std::isfinite(samples_[input].value)) becomeVertex(input, mesh_->vertexCount() - 1);
-    else unlink(input);
-  }
-
-  // The input vertices inside the moved tets are located again among the moved and the new
-  // tets. Most stay in their old tet (a moved tet keeps part of its region); the others try the
-  // rest. A tet's frame is set up when first needed.
-  bool any = false;
-  for (uint32_t t : moved) any |= occupied_.test(t);
-  if (!any) return updateAroundJ(j, jValueChanged);
-  const size_t n = moved.size() + (tetCount - firstNew);
-  candidates_.assign(moved.begin(), moved.end());
-  for (uint32_t t = firstNew; t < tetCount; ++t) candidates_.push_back(t);
-  frames_.resize(n);
-  frameState_.assign(n, 0);  // 0: not set up, 1: set up, 2: flat
-  auto frame = [&](size_t c) -> const TetFrame* {
-    if (frameState_[c] == 0) frameState_[c] = frames_[c].make(*this, candidates_[c]) ? 1 : 2;
-    return frameState_[c] == 1 ? &frames_[c] : nullptr;
-  };
-  pending_.clear();
-  pendingFrom_.clear();
-  for (uint32_t k = 0; k < moved.size(); ++k) {
-    if (!occupied_.test(moved[k])) continue;
-    for (uint32_t v = head_[moved[k]], next; v != kNone; v = next) {
-      next = samples_[v].next;
-      double l[4];
-      const TetFrame* f = frame(k);
-      if (f && f->coordinates(samples_[v].x, l, 0.0) >= 0) {
-        setError(v, moved[k], l);
-        markOutside(v, false);
-      } else {
-        unlink(v);
-        pending_.push_back(v);
-        pendingFrom_.push_back(k);
-      }
-    }
-  }
-  for (size_t s = 0; s < pending_.size(); ++s) {
-    const uint32_t v = pending_[s], old = pendingFrom_[s];
-    const float* x = samples_[v].x;
-    size_t found = n;
-    double l[4];
-    for (size_t c = 0; c < n && found == n; ++c) {
-      const TetFrame* f = c != old ? frame(c) : nullptr;
-      if (f && f->coordinates(x, l, 0.0) >= 0) found = c;
-    }
-    markOutside(v, found == n);
-    if (found == n) {  // outside all of them: the one it is least outside of
-      double best = -HUGE_VAL;
-      for (size_t c = 0; c < n; ++c) {
-        const TetFrame* f = frame(c);
-        if (!f) continue;
-        const double lo = f->coordinates(x, l);
-        if (lo > best) best = lo, found = c;
-      }
-      if (found == n) continue;  // all flat
-    }
-    frames_[found].coordinates(x, l);
-    link(v, candidates_[found]);
-    setError(v, candidates_[found], l);
-  }
-
-  updateAroundJ(j, jValueChanged);
-}
-
-// A new value at j: every tet around it interpolates anew.
-void LevelErrorMeter::updateAroundJ(uint32_t j, bool jValueChanged) {
-  if (!jValueChanged) return;
-  if (inputOf_[j] != kNone && samples_[inputOf_[j]].tet == kVertex) becomeVertex(inputOf_[j], j);  // (not kSkip)
-  for (uint32_t c : stars_->corners(j)) {
-    const uint32_t t = c >> 2;
-    TetFrame f;
-    if (!occupied_.test(t) || !f.make(*this, t)) continue;
-    for (uint32_t v = head_[t]; v != kNone; v = samples_[v].next) {
-      double l[4];
-      f.coordinates(samples_[v].x, l);
-      setError(v, t, l);
-    }
-  }
-}
-
-LevelError LevelErrorMeter::current() {
-  if (stars_) relocateOutside();
+LevelError LevelErrorMeter::total() const {
   double sum = 0, max = 0;
   size_t n = 0;
   for (const Sample& s : samples_) {
-    if (s.tet >= kSkip || !std::isfinite(s.err)) continue;
+    if (s.tet == kNone || !std::isfinite(s.err)) continue;
     sum += double(s.err) * s.err;
     max = std::max(max, double(s.err));
     ++n;
   }
   return {n ? std::sqrt(sum / double(n)) : 0.0, max};
+}
+
+void LevelErrorMeter::markDirty(uint32_t t) {
+  if (t >= dirty_.size() * 64) dirty_.resize(std::max<size_t>(t / 64 + 1, 2 * dirty_.size()), 0);
+  dirty_[t >> 6] |= uint64_t(1) << (t & 63);
+}
+
+void LevelErrorMeter::afterSplit(uint32_t input, uint32_t j, std::span<const uint32_t> moved, const StarPool& stars,
+                                 bool jValueChanged) {
+  restored_.push_back(input);
+  for (uint32_t t : moved) markDirty(t);
+  if (!jValueChanged) return;
+  revalued_.push_back(j);
+  for (uint32_t c : stars.corners(j)) markDirty(c >> 2);
+}
+
+// Input vertices [begin, end): those in a dirty tet are tested there (most are still inside),
+// those that left it and those outside the mesh are located again. Writes only these vertices'
+// samples and flags, and s.
+void LevelErrorMeter::follow(Scratch& s, uint32_t begin, uint32_t end) {
+  const size_t words = dirty_.size();
+  for (uint32_t v = begin; v < end; ++v) {
+    const uint32_t t = samples_[v].tet;
+    if (t >= kVertex) continue;
+    const bool dirty = (t >> 6) < words && (dirty_[t >> 6] >> (t & 63) & 1);
+    if (!dirty && !outside_[v]) continue;
+    if (dirty && !outside_[v]) {
+      const TetFrame* f = frameOf(s, t);
+      double l[4] = {};
+      if (f && f->coordinates(samples_[v].x, l, kInside) >= kInside) {  // (l is whole then)
+        samples_[v].err = errorAt(v, t, l);
+        continue;
+      }
+    }
+    place(v, locateAgain(s, v));
+  }
+}
+
+LevelError LevelErrorMeter::current(const TetMesh& level, const StarPool& stars, int threads) {
+  mesh_ = &level;
+  stars_ = &stars;
+  for (uint32_t input : restored_) {
+    levelOf_[input] = uint32_t(inputOf_.size());
+    inputOf_.push_back(input);
+    if (std::isfinite(samples_[input].value)) becomeVertex(input, uint32_t(inputOf_.size() - 1));
+    else samples_[input].tet = kNone;
+  }
+  restored_.clear();
+  for (uint32_t j : revalued_)
+    if (inputOf_[j] != kNone && samples_[inputOf_[j]].tet == kVertex) becomeVertex(inputOf_[j], j);
+  revalued_.clear();
+  // Every input vertex in a dirty tet or outside the mesh: half of them on each of two threads
+  // when there are many (the tets are only read); each vertex's result is the same either way.
+  const uint32_t V = uint32_t(samples_.size()), half = V / 2;
+  for (Scratch& s : scratch_) s.next();
+  onTwo(threads > 1 && V >= kTwoThreads, [&](int k) { follow(scratch_[k], k ? half : 0, k ? V : half); });
+  std::fill(dirty_.begin(), dirty_.end(), 0);
+  return total();
 }
 
 }  // namespace tetstream

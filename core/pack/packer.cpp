@@ -222,6 +222,7 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   stream.zstdLevel = opt.zstdLevel;
   stream.ringWalk = opt.ringWalk;
   stream.orderSplits = opt.orderSplits;
+  stream.threads = opt.threads;
   stream.progress = [&](uint32_t done, uint32_t planned) { progress("encode", done, planned); };
   EncodedStream enc;
   if (Result r = encodeStream(mesh, simplified, m, stream, enc); !r) return r;

@@ -47,7 +47,7 @@ class Encoder {
     Result r = encodeSplits(C);
     Result b = base.get();
     if (metered_) {
-      const LevelError e = baseError_.get();
+      const LevelError e = baseError();
       out_.baseInfo.fieldRms = e.rms;
       out_.baseInfo.fieldMax = e.max;
     }
@@ -128,10 +128,10 @@ class Encoder {
   }
   static constexpr double kFirstGuessBytesPerSplit = 12;  // Harmonic 64³: 11.5, carotid 14
 
-  // Each level's field error, measured at the input's vertices (level_error.h) for the field
-  // that steered the simplification: the base at every input vertex on another thread (it reads
-  // out_.base and a copy of its vertex ids, which stay as they are), the levels after it at a
-  // sample, here, as the splits are replayed.
+  // Each level's field error, measured at every input vertex (level_error.h) for the field that
+  // steered the simplification. The meter locates them in the base on another thread (it reads
+  // out_.base and a copy of its vertex ids, which stay as they are) while the splits are encoded
+  // and applied to pm_, a copy of the base; it takes them up at the first measurement.
   void startMeter(int iso) {
     metered_ = iso >= 0;
     if (!metered_) return;
@@ -139,17 +139,26 @@ class Encoder {
     baseOf_.resize(mesh_.vertexCount());
     for (uint32_t v = 0; v < baseOf_.size(); ++v) baseOf_[v] = v;
     for (uint32_t c = log.size(); c-- > 0;) baseOf_[log.i[c]] = baseOf_[log.j[c]];
+    intoOf_.resize(mesh_.vertexCount());
+    for (uint32_t v = 0; v < intoOf_.size(); ++v) intoOf_[v] = v;
+    for (uint32_t c = 0; c < log.size(); ++c) intoOf_[log.i[c]] = log.j[c];
     const std::span<const float> values = mesh_.fields[size_t(iso)].values;
     baseError_ = std::async(std::launch::async, [this, iso, values, levelOf = out_.streamVertexOf] {
-      return LevelErrorMeter::measure(mesh_.positions, values, out_.base, size_t(iso), levelOf, baseOf_);
+      meter_.begin(mesh_.positions, values, out_.base, size_t(iso), levelOf, baseOf_, intoOf_);
+      return meter_.total();
     });
-    meter_.begin(mesh_.positions, values, pm_.mesh, &pm_.stars, size_t(iso), out_.streamVertexOf, baseOf_,
-                 LevelErrorMeter::kMaxSamples);
+  }
+
+  // The base's error (once the meter has located the input's vertices there).
+  const LevelError& baseError() {
+    if (baseError_.valid()) baseErrorValue_ = baseError_.get();
+    return baseErrorValue_;
   }
 
   void measure(ChunkInfo& info) {
     if (!metered_) return;
-    const LevelError e = meter_.current();
+    baseError();
+    const LevelError e = meter_.current(pm_.mesh, pm_.stars, opt_.threads);
     info.fieldRms = e.rms;
     info.fieldMax = e.max;
   }
@@ -312,9 +321,8 @@ class Encoder {
       jValueChanged = jValue != pm_.mesh.fields[f].values[js];
     }
     changed_.clear();
-    const uint32_t firstNew = pm_.tetCount();
     applySplit(pm_, SplitOp{js, moved_, newTets_, pi, fields_.data(), s_.valuesField >= 0 ? &jValue : nullptr}, changed_);
-    if (metered_) meter_.afterSplit(i, js, moved_, firstNew, jValueChanged);
+    if (metered_) meter_.afterSplit(i, js, moved_, pm_.stars, jValueChanged);
   }
 
   // A cycle's or path's vertices (ring_) as a walk in p_j's link (FORMAT.md §4, flag bit 5):
@@ -466,7 +474,9 @@ class Encoder {
   LevelErrorMeter meter_;
   bool metered_ = false;
   std::vector<uint32_t> baseOf_;          // per input vertex: the base vertex it went into
+  std::vector<uint32_t> intoOf_;          // ... the vertex it went into directly (itself if none)
   std::future<LevelError> baseError_;     // measured on another thread
+  LevelError baseErrorValue_;
   std::vector<float> prefixMax_, fields_;
   std::vector<uint8_t> columns_[kSplitColumns];  // the current chunk's records, column by column
   std::vector<Pair> pairs_, chain_;

@@ -24,6 +24,7 @@ struct StreamOptions {
   // Inside each chunk, splits in waves by kept vertex instead of in cost order (split_order.h):
   // a smaller kept-vertex column. Needs the simplifier's read sets (recordReadSets).
   bool orderSplits = false;
+  int threads = 2;  // threads that measure each level's field error (1 or 2; the same figures)
   std::function<void(uint32_t done, uint32_t planned)> progress;  // splits encoded so far
 };
 
