@@ -117,20 +117,22 @@ LevelErrorMeter::Found LevelErrorMeter::walk(Scratch& s, uint32_t v, uint32_t t,
     previous = t;
     t = next;
   }
-  if (bestTet == kNone) return {kNone, 0.0f, true};
-  return {bestTet, errorAt(v, bestTet, bestL), best < kInside};
+  if (bestTet == kNone) return {kNone, 0.0f, true, -HUGE_VAL};
+  return {bestTet, errorAt(v, bestTet, bestL), best < kInside, best};
 }
 
-// Whether one of `tets` holds input vertex v (then `found` says where).
+// Whether one of `tets` holds input vertex v (then `found` says where). If not, `found` becomes
+// the one of them that v is least outside of, if it is less outside of it than of found's.
 template <typename Tets>
 bool LevelErrorMeter::lookAmong(Scratch& s, uint32_t v, const Tets& tets, Found& found) const {
   for (uint32_t t : tets) {
     const TetFrame* f = frameOf(s, t);
-    double l[4] = {};
-    if (f && f->coordinates(samples_[v].x, l, kInside) >= kInside) {  // (l is whole then)
-      found = {t, errorAt(v, t, l), false};
-      return true;
-    }
+    double l[4];
+    if (!f) continue;
+    const double lo = f->coordinates(samples_[v].x, l);
+    if (lo <= found.lo) continue;
+    found = {t, errorAt(v, t, l), lo < kInside, lo};
+    if (!found.outside) return true;
   }
   return false;
 }
@@ -165,13 +167,13 @@ uint32_t LevelErrorMeter::acrossByStarsUncached(uint32_t t, int k) const {
 // Input vertex v left its tet, or was outside the mesh: a walk from there. If that ends outside,
 // a look among the tets of the level vertex that v was collapsed into (directly or not), where
 // v lies unless a collapse along the boundary moved the boundary past it. (A walk can leave a
-// non-convex mesh on the way to a point inside it: Blunt Fin's input vertices near the fin.)
+// non-convex mesh on the way to a point inside it: Blunt Fin's input vertices near the fin.) If
+// v is outside the mesh after all, it takes the tet it is least outside of among those and the
+// tets around the corners of the one where the walk ended: nearer than that one, where a
+// coarse level cuts across a curved boundary (the kiefer bracket's holes).
 LevelErrorMeter::Found LevelErrorMeter::locateAgain(Scratch& s, uint32_t v) const {
   Found found = walk(s, v, samples_[v].tet, [&](uint32_t t, int k) { return acrossByStars(s, t, k); });
-  if (!found.outside) return found;
-  uint32_t x = v;
-  while (levelOf_[x] == kNone && intoOf_[x] != x) x = intoOf_[x];
-  if (levelOf_[x] == kNone) return found;
+  if (!found.outside || found.tet == kNone) return found;
   struct Tets {  // the tets of a star, from its corners
     std::span<const uint32_t> corners;
     struct It {
@@ -183,7 +185,13 @@ LevelErrorMeter::Found LevelErrorMeter::locateAgain(Scratch& s, uint32_t v) cons
     It begin() const { return {corners.data()}; }
     It end() const { return {corners.data() + corners.size()}; }
   };
-  lookAmong(s, v, Tets{stars_->corners(levelOf_[x])}, found);
+  uint32_t x = v;
+  while (levelOf_[x] == kNone && intoOf_[x] != x) x = intoOf_[x];
+  if (levelOf_[x] != kNone && lookAmong(s, v, Tets{stars_->corners(levelOf_[x])}, found)) return found;
+  uint32_t ended[4];
+  std::copy_n(&mesh_->tets[4 * size_t(found.tet)], 4, ended);
+  for (uint32_t corner : ended)
+    if (lookAmong(s, v, Tets{stars_->corners(corner)}, found)) break;
   return found;
 }
 
@@ -234,7 +242,13 @@ void LevelErrorMeter::begin(std::span<const float> positions, std::span<const fl
     }
     const std::span<const uint32_t> around(&star[starBegin[at]], starBegin[at + 1] - starBegin[at]);
     Found f = walk(s, v, around[0], across);
-    if (f.outside) lookAmong(s, v, around, f);
+    if (f.outside && f.tet != kNone && !lookAmong(s, v, around, f)) {  // (as locateAgain)
+      uint32_t ended[4];
+      std::copy_n(&tets[4 * size_t(f.tet)], 4, ended);
+      for (uint32_t corner : ended)
+        if (lookAmong(s, v, std::span<const uint32_t>(&star[starBegin[corner]], starBegin[corner + 1] - starBegin[corner]), f))
+          break;
+    }
     place(v, f);
   }
 }

@@ -15,9 +15,9 @@
 // split by split, in about the same time: it missed carotid's largest error by up to half, 36.9
 // against 76.4 after five chunks, and Harmonic 64³'s by up to 43%.)
 // An input vertex outside the level mesh (where a coarse level cuts across a curved or
-// non-convex boundary) takes the tet at which a walk towards it ends, with its coordinates
-// clamped to that tet; as splits move the boundary, those are walked again from there at each
-// measurement.
+// non-convex boundary) takes the tet it is least outside of among those near where a walk
+// towards it ends, with its coordinates clamped to that tet; as splits move the boundary, those
+// are walked again from there at each measurement.
 #pragma once
 #include <cmath>
 #include <cstdint>
@@ -104,6 +104,7 @@ class LevelErrorMeter {
     uint32_t tet;
     float err;
     bool outside;
+    double lo;  // the smallest coordinate of v in the tet
   };
   template <typename Across>
   Found walk(Scratch& s, uint32_t v, uint32_t t, Across across) const;
