@@ -172,7 +172,14 @@ uint32_t LevelErrorMeter::acrossByStarsUncached(uint32_t t, int k) const {
 // tets around the corners of the one where the walk ended: nearer than that one, where a
 // coarse level cuts across a curved boundary (the kiefer bracket's holes).
 LevelErrorMeter::Found LevelErrorMeter::locateAgain(Scratch& s, uint32_t v) const {
-  Found found = walk(s, v, samples_[v].tet, [&](uint32_t t, int k) { return acrossByStars(s, t, k); });
+  return nearby(s, v, walkFrom(s, v));
+}
+
+LevelErrorMeter::Found LevelErrorMeter::walkFrom(Scratch& s, uint32_t v) const {
+  return walk(s, v, samples_[v].tet, [&](uint32_t t, int k) { return acrossByStars(s, t, k); });
+}
+
+LevelErrorMeter::Found LevelErrorMeter::nearby(Scratch& s, uint32_t v, Found found) const {
   if (!found.outside || found.tet == kNone) return found;
   struct Tets {  // the tets of a star, from its corners
     std::span<const uint32_t> corners;
@@ -289,7 +296,12 @@ void LevelErrorMeter::follow(Scratch& s, uint32_t begin, uint32_t end) {
     if (t >= kVertex) continue;
     const bool dirty = (t >> 6) < words && (dirty_[t >> 6] >> (t & 63) & 1);
     if (!dirty && !outside_[v]) continue;
-    if (dirty && !outside_[v]) {
+    if (!dirty) {  // outside the mesh: walked again, as splits elsewhere move the boundary
+      const Found f = walkFrom(s, v);
+      if (f.tet != t || !f.outside) place(v, nearby(s, v, f));  // (else as it was)
+      continue;
+    }
+    if (!outside_[v]) {
       const TetFrame* f = frameOf(s, t);
       double l[4] = {};
       if (f && f->coordinates(samples_[v].x, l, kInside) >= kInside) {  // (l is whole then)

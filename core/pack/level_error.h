@@ -111,6 +111,8 @@ class LevelErrorMeter {
   template <typename Tets>
   bool lookAmong(Scratch& s, uint32_t v, const Tets& tets, Found& found) const;
   Found locateAgain(Scratch& s, uint32_t v) const;
+  Found walkFrom(Scratch& s, uint32_t v) const;            // (locateAgain's first step)
+  Found nearby(Scratch& s, uint32_t v, Found walked) const;  // (and its second)
   void place(uint32_t v, const Found& f);
   float errorAt(uint32_t v, uint32_t t, const double l[4]) const;
   void becomeVertex(uint32_t v, uint32_t level);
