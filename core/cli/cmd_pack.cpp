@@ -111,7 +111,7 @@ Runner addPack(CLI::App& app) {
   sub->add_option("--zstd-level", o->level, "zstd compression level")->check(CLI::Range(1, 22))->capture_default_str();
   sub->add_option("--max-memory", o->maxMemoryGb, "refuse meshes that need more memory than this, in GB (default: 90% of RAM)")
       ->check(CLI::PositiveNumber);
-  sub->add_option("--threads", o->threads, "threads for simplification (1 or 2; the output is the same)")
+  sub->add_option("--threads", o->threads, "threads for simplification and for measuring each level's error (1 or 2; the output is the same)")
       ->check(CLI::Range(1, 2))->capture_default_str();
   sub->add_flag("--json", o->json, "print the result as JSON on stdout");
   return [o, me, bv, bt] {
