@@ -239,6 +239,9 @@ void LevelErrorMeter::begin(std::span<const float> positions, std::span<const fl
     const uint32_t h = adjacency.opposite[4 * size_t(t) + size_t(k)];
     return h == kNoNeighbor ? kNone : h >> 2;
   };
+  // Vertices next to each other in the numbering mostly lie in the same tet: the last one found
+  // is tried first.
+  uint32_t last = kNone;
   for (uint32_t v = 0; v < V; ++v) {
     if (levelOf[v] != kNone) inputOf_[levelOf[v]] = v;
     const uint32_t at = levelOf[baseOf[v]];
@@ -246,6 +249,14 @@ void LevelErrorMeter::begin(std::span<const float> positions, std::span<const fl
     if (levelOf[v] != kNone) {
       becomeVertex(v, levelOf[v]);
       continue;
+    }
+    if (last != kNone) {
+      const TetFrame* frame = frameOf(s, last);
+      double l[4] = {};
+      if (frame && frame->coordinates(samples_[v].x, l, kInside) >= kInside) {  // (l is whole then)
+        place(v, {last, errorAt(v, last, l), false, 0.0});
+        continue;
+      }
     }
     const std::span<const uint32_t> around(&star[starBegin[at]], starBegin[at + 1] - starBegin[at]);
     Found f = walk(s, v, around[0], across);
@@ -257,6 +268,7 @@ void LevelErrorMeter::begin(std::span<const float> positions, std::span<const fl
           break;
     }
     place(v, f);
+    last = f.outside ? kNone : f.tet;
   }
 }
 
