@@ -475,7 +475,9 @@ class Encoder {
   bool metered_ = false;
   std::vector<uint32_t> baseOf_;          // per input vertex: the base vertex it went into
   std::vector<uint32_t> intoOf_;          // ... the vertex it went into directly (itself if none)
-  std::future<LevelError> baseError_;     // measured on another thread (declared after all its task reads: destroyed, and so waited for, first)
+  // The base's error, measured on another thread: declared after all that task reads, so it is
+  // destroyed, and waited for, first.
+  std::future<LevelError> baseError_;
   LevelError baseErrorValue_;
   std::vector<float> prefixMax_, fields_;
   std::vector<uint8_t> columns_[kSplitColumns];  // the current chunk's records, column by column
