@@ -12,8 +12,8 @@
 // vertices in order, on two threads, and tests those in dirty tets there; those no longer inside
 // walk from it to the tet that holds them now. Each vertex is tested at most once a measurement
 // however many splits its tet went through. (Before, a sample of 16,384 vertices was followed
-// split by split, in about the same time: it missed carotid's largest error by up to half, 36.9
-// against 76.4 at the level of 23,939 vertices, and Harmonic 64³'s by up to 43%.)
+// split by split, in about the same time: it missed carotid's largest error by more than half,
+// 36.9 against 76.4 at the level of 23,939 vertices, and Harmonic 64³'s by up to 43%.)
 // An input vertex outside the level mesh (where a coarse level cuts across a curved or
 // non-convex boundary) takes the tet it is least outside of among those near where a walk
 // towards it ends, with its coordinates clamped to that tet; as splits move the boundary, those
