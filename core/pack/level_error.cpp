@@ -168,9 +168,9 @@ uint32_t LevelErrorMeter::acrossByStarsUncached(uint32_t t, int k) const {
 // a look among the tets of the level vertex that v was collapsed into (directly or not), where
 // v lies unless a collapse along the boundary moved the boundary past it. (A walk can leave a
 // non-convex mesh on the way to a point inside it: Blunt Fin's input vertices near the fin.) If
-// v is outside the mesh after all, it takes the tet it is least outside of among those and the
-// tets around the corners of the one where the walk ended: nearer than that one, where a
-// coarse level cuts across a curved boundary (the kiefer bracket's holes).
+// v is outside the mesh after all, it takes the tet it is least outside of among those, the
+// walk's, and the tets around the corners of the best of these: often much nearer than the
+// walk's own where a coarse level cuts across a curved boundary (the kiefer bracket's holes).
 LevelErrorMeter::Found LevelErrorMeter::locateAgain(Scratch& s, uint32_t v) const {
   return nearby(s, v, walkFrom(s, v));
 }
