@@ -4,10 +4,22 @@
 #include <cmath>
 #include <thread>
 
-#include "adjacency.h"
 
 namespace tetstream {
 namespace {
+
+// The tets of a star, from its corners (4t + k).
+struct Tets {
+  std::span<const uint32_t> corners;
+  struct It {
+    const uint32_t* c;
+    uint32_t operator*() const { return *c >> 2; }
+    It& operator++() { return ++c, *this; }
+    bool operator!=(const It& o) const { return c != o.c; }
+  };
+  It begin() const { return {corners.data()}; }
+  It end() const { return {corners.data() + corners.size()}; }
+};
 
 uint32_t mixTet(uint32_t x) {
   x *= 0x9e3779b1u;
@@ -85,14 +97,13 @@ void LevelErrorMeter::becomeVertex(uint32_t v, uint32_t level) {
   outside_[v] = 0;
 }
 
-// From tet t towards input vertex v, across the face of the most negative coordinate
-// (across(t, k): the tet beyond the face opposite corner k, or kNone). Where that face is on
-// the boundary, across the next negative one that is not (and not back): around a concave part
-// of the boundary, where the straight way would leave a non-convex mesh. The best tet seen wins
-// when no way is left or the walk takes too long.
-template <typename Across>
-LevelErrorMeter::Found LevelErrorMeter::walk(Scratch& s, uint32_t v, uint32_t t, Across across) const {
+// From input vertex v's tet towards it, across the face of the most negative coordinate. Where
+// that face is on the boundary, across the next negative one that is not (and not back): around
+// a concave part of the boundary, where the straight way would leave a non-convex mesh. The
+// best tet seen wins when no way is left or the walk takes too long.
+LevelErrorMeter::Found LevelErrorMeter::walk(Scratch& s, uint32_t v) const {
   const float* x = samples_[v].x;
+  uint32_t t = samples_[v].tet;
   uint32_t bestTet = kNone, previous = kNone;
   double best = -HUGE_VAL, bestL[4];
   for (int step = 0; step < 256; ++step) {
@@ -110,7 +121,7 @@ LevelErrorMeter::Found LevelErrorMeter::walk(Scratch& s, uint32_t v, uint32_t t,
     std::sort(order, order + 4, [&](int a, int b) { return l[a] < l[b]; });
     uint32_t next = kNone;
     for (int n = 0; n < 4 && l[order[n]] < 0 && next == kNone; ++n) {
-      const uint32_t u = across(t, order[n]);
+      const uint32_t u = acrossByStars(s, t, order[n]);
       if (u != previous || n == 0) next = u;
     }
     if (next == kNone) break;
@@ -172,26 +183,11 @@ uint32_t LevelErrorMeter::acrossByStarsUncached(uint32_t t, int k) const {
 // walk's, and the tets around the corners of the best of these: often much nearer than the
 // walk's own where a coarse level cuts across a curved boundary (the kiefer bracket's holes).
 LevelErrorMeter::Found LevelErrorMeter::locateAgain(Scratch& s, uint32_t v) const {
-  return nearby(s, v, walkFrom(s, v));
-}
-
-LevelErrorMeter::Found LevelErrorMeter::walkFrom(Scratch& s, uint32_t v) const {
-  return walk(s, v, samples_[v].tet, [&](uint32_t t, int k) { return acrossByStars(s, t, k); });
+  return nearby(s, v, walk(s, v));
 }
 
 LevelErrorMeter::Found LevelErrorMeter::nearby(Scratch& s, uint32_t v, Found found) const {
   if (!found.outside || found.tet == kNone) return found;
-  struct Tets {  // the tets of a star, from its corners
-    std::span<const uint32_t> corners;
-    struct It {
-      const uint32_t* c;
-      uint32_t operator*() const { return *c >> 2; }
-      It& operator++() { return ++c, *this; }
-      bool operator!=(const It& o) const { return c != o.c; }
-    };
-    It begin() const { return {corners.data()}; }
-    It end() const { return {corners.data() + corners.size()}; }
-  };
   uint32_t x = v;
   while (levelOf_[x] == kNone && intoOf_[x] != x) x = intoOf_[x];
   if (levelOf_[x] != kNone && lookAmong(s, v, Tets{stars_->corners(levelOf_[x])}, found)) return found;
@@ -226,26 +222,20 @@ void LevelErrorMeter::begin(std::span<const float> positions, std::span<const fl
   for (uint32_t v = 0; v < V; ++v)
     samples_[v] = {{positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]}, values[v], 0.0f, kNone};
   inputOf_.assign(level.vertexCount(), kNone);
-  // Per base vertex its tets (the base is small), around which its input vertices lie.
-  std::vector<uint32_t> starBegin(level.vertexCount() + 1, 0), star(tets.size());
-  for (uint32_t x : tets) ++starBegin[x + 1];
-  for (size_t x = 1; x < starBegin.size(); ++x) starBegin[x] += starBegin[x - 1];
-  for (size_t c = 0; c < tets.size(); ++c) star[starBegin[tets[c]]++] = uint32_t(c / 4);
-  for (size_t x = starBegin.size() - 1; x > 0; --x) starBegin[x] = starBegin[x - 1];
-  starBegin[0] = 0;
-  FaceAdjacency adjacency;
-  buildFaceAdjacency(tets, level.vertexCount(), adjacency);
-  auto across = [&](uint32_t t, int k) {
-    const uint32_t h = adjacency.opposite[4 * size_t(t) + size_t(k)];
-    return h == kNoNeighbor ? kNone : h >> 2;
-  };
+  // The base's stars (it is small), for the same search as at every later level; the meter
+  // keeps none of it (current() is given the encoder's).
+  StarPool stars;
+  stars.reserve(level.vertexCount(), tets.size());
+  for (uint32_t x = 0; x < level.vertexCount(); ++x) stars.addVertex(8);
+  for (size_t c = 0; c < tets.size(); ++c) stars.add(tets[c], uint32_t(c));
+  stars_ = &stars;
   // Vertices next to each other in the numbering mostly lie in the same tet: the last one found
   // is tried first.
   uint32_t last = kNone;
   for (uint32_t v = 0; v < V; ++v) {
     if (levelOf[v] != kNone) inputOf_[levelOf[v]] = v;
     const uint32_t at = levelOf[baseOf[v]];
-    if (!std::isfinite(values[v]) || at == kNone || starBegin[at] == starBegin[at + 1]) continue;  // in no tet
+    if (!std::isfinite(values[v]) || at == kNone || stars.corners(at).empty()) continue;  // in no tet
     if (levelOf[v] != kNone) {
       becomeVertex(v, levelOf[v]);
       continue;
@@ -258,18 +248,12 @@ void LevelErrorMeter::begin(std::span<const float> positions, std::span<const fl
         continue;
       }
     }
-    const std::span<const uint32_t> around(&star[starBegin[at]], starBegin[at + 1] - starBegin[at]);
-    Found f = walk(s, v, around[0], across);
-    if (f.outside && f.tet != kNone && !lookAmong(s, v, around, f)) {  // (as locateAgain)
-      uint32_t ended[4];
-      std::copy_n(&tets[4 * size_t(f.tet)], 4, ended);
-      for (uint32_t corner : ended)
-        if (lookAmong(s, v, std::span<const uint32_t>(&star[starBegin[corner]], starBegin[corner + 1] - starBegin[corner]), f))
-          break;
-    }
+    samples_[v].tet = stars.corners(at)[0] >> 2;  // (where the walk starts)
+    const Found f = locateAgain(s, v);
     place(v, f);
     last = f.outside ? kNone : f.tet;
   }
+  stars_ = nullptr;
 }
 
 LevelError LevelErrorMeter::total() const {
@@ -309,7 +293,7 @@ void LevelErrorMeter::follow(Scratch& s, uint32_t begin, uint32_t end) {
     const bool dirty = (t >> 6) < words && (dirty_[t >> 6] >> (t & 63) & 1);
     if (!dirty && !outside_[v]) continue;
     if (!dirty) {  // outside the mesh: walked again, as splits elsewhere move the boundary
-      const Found f = walkFrom(s, v);
+      const Found f = walk(s, v);
       if (f.tet != t || !f.outside) place(v, nearby(s, v, f));  // (else as it was)
       continue;
     }

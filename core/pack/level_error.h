@@ -106,13 +106,11 @@ class LevelErrorMeter {
     bool outside;
     double lo;  // the smallest coordinate of v in the tet
   };
-  template <typename Across>
-  Found walk(Scratch& s, uint32_t v, uint32_t t, Across across) const;
+  Found walk(Scratch& s, uint32_t v) const;
   template <typename Tets>
   bool lookAmong(Scratch& s, uint32_t v, const Tets& tets, Found& found) const;
   Found locateAgain(Scratch& s, uint32_t v) const;
-  Found walkFrom(Scratch& s, uint32_t v) const;            // (locateAgain's first step)
-  Found nearby(Scratch& s, uint32_t v, Found walked) const;  // (and its second)
+  Found nearby(Scratch& s, uint32_t v, Found walked) const;  // (locateAgain's second step)
   void place(uint32_t v, const Found& f);
   float errorAt(uint32_t v, uint32_t t, const double l[4]) const;
   void becomeVertex(uint32_t v, uint32_t level);
