@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <thread>
+#include <utility>
 
 
 namespace tetstream {
@@ -206,10 +207,10 @@ void LevelErrorMeter::place(uint32_t v, const Found& f) {
 }
 
 void LevelErrorMeter::begin(std::span<const float> positions, std::span<const float> values, const TetMesh& level,
-                            size_t field, std::span<const uint32_t> levelOf, std::span<const uint32_t> baseOf,
+                            size_t field, std::vector<uint32_t> levelOf, std::span<const uint32_t> baseOf,
                             std::span<const uint32_t> intoOf) {
   intoOf_ = intoOf;
-  levelOf_.assign(levelOf.begin(), levelOf.end());
+  levelOf_ = std::move(levelOf);
   mesh_ = &level;
   stars_ = nullptr;
   field_ = field;
@@ -233,11 +234,11 @@ void LevelErrorMeter::begin(std::span<const float> positions, std::span<const fl
   // is tried first.
   uint32_t last = kNone;
   for (uint32_t v = 0; v < V; ++v) {
-    if (levelOf[v] != kNone) inputOf_[levelOf[v]] = v;
-    const uint32_t at = levelOf[baseOf[v]];
+    if (levelOf_[v] != kNone) inputOf_[levelOf_[v]] = v;
+    const uint32_t at = levelOf_[baseOf[v]];
     if (!std::isfinite(values[v]) || at == kNone || stars.corners(at).empty()) continue;  // in no tet
-    if (levelOf[v] != kNone) {
-      becomeVertex(v, levelOf[v]);
+    if (levelOf_[v] != kNone) {
+      becomeVertex(v, levelOf_[v]);
       continue;
     }
     if (last != kNone) {

@@ -43,7 +43,7 @@ class LevelErrorMeter {
   // afterSplit() is called (which touches nothing begin() does), as long as current() comes after
   // both. The meter keeps `intoOf`.
   void begin(std::span<const float> positions, std::span<const float> values, const TetMesh& level, size_t field,
-             std::span<const uint32_t> levelOf, std::span<const uint32_t> baseOf, std::span<const uint32_t> intoOf);
+             std::vector<uint32_t> levelOf, std::span<const uint32_t> baseOf, std::span<const uint32_t> intoOf);
   LevelError total() const;
 
   // After applySplit() restored input vertex `input` next to level vertex j, moving the listed

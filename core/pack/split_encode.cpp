@@ -143,8 +143,8 @@ class Encoder {
     for (uint32_t v = 0; v < intoOf_.size(); ++v) intoOf_[v] = v;
     for (uint32_t c = 0; c < log.size(); ++c) intoOf_[log.i[c]] = log.j[c];
     const std::span<const float> values = mesh_.fields[size_t(iso)].values;
-    baseError_ = std::async(std::launch::async, [this, iso, values, levelOf = out_.streamVertexOf] {
-      meter_.begin(mesh_.positions, values, out_.base, size_t(iso), levelOf, baseOf_, intoOf_);
+    baseError_ = std::async(std::launch::async, [this, iso, values, levelOf = out_.streamVertexOf]() mutable {
+      meter_.begin(mesh_.positions, values, out_.base, size_t(iso), std::move(levelOf), baseOf_, intoOf_);
       return meter_.total();
     });
   }
