@@ -360,10 +360,10 @@ class Simplifier {
   static constexpr float kTauGrowth = 1.41421356f;
   static constexpr uint32_t kMaxSlabs = 3;
 
-  uint32_t slabsOf(const std::vector<uint32_t>& order, uint32_t alive, bool staggered, std::vector<uint32_t>& slab) const;
+  uint32_t slabsOf(const std::vector<uint32_t>& order, bool staggered, std::vector<uint8_t>& slab) const;
   void runParts(uint32_t planned);
   void mergeRound(uint32_t slabs);
-  void markInner(const std::vector<uint32_t>& slab);
+  void markInner(const std::vector<uint8_t>& slab);
 
   // ------------------------------------------------------------------ link condition
   void gatherLink(uint32_t v, std::vector<uint32_t>& verts, std::vector<uint64_t>& edges, std::vector<Tri>& tris);

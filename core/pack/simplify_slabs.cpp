@@ -53,16 +53,16 @@ void appendCollapse(CollapseLog& dst, const CollapseLog& src, uint32_t c) {
 
 }  // namespace
 
-// The slab of every alive vertex: two cut at the median of `order`'s alive vertices or, on
-// staggered rounds, three cut at the quartiles. Returns the number of slabs.
-uint32_t Simplifier::slabsOf(const std::vector<uint32_t>& order, uint32_t alive, bool staggered, std::vector<uint32_t>& slab) const {
+// The slab of every vertex of `order` (the alive ones): two cut at its median or, on staggered
+// rounds, three cut at its quartiles. Returns the number of slabs.
+uint32_t Simplifier::slabsOf(const std::vector<uint32_t>& order, bool staggered, std::vector<uint8_t>& slab) const {
   const uint32_t count = staggered ? 3 : 2;
+  const uint64_t alive = order.size();
   uint32_t rank = 0, s = 0;
   for (uint32_t v : order) {
-    if (!out_.vertexAlive[v]) continue;
     // Slab s holds the ranks below its upper quantile: 1/2, or 1/4 and 3/4.
-    while (s + 1 < count && 4 * uint64_t(rank) >= uint64_t(alive) * (staggered ? 2 * s + 1 : 2)) ++s;
-    slab[v] = s;
+    while (s + 1 < count && 4 * uint64_t(rank) >= alive * (staggered ? 2 * s + 1 : 2)) ++s;
+    slab[v] = uint8_t(s);
     ++rank;
   }
   return count;
@@ -72,14 +72,21 @@ void Simplifier::runParts(uint32_t planned) {
   // The order the slabs follow: the vertex numbering (meshes are mostly numbered coherently,
   // and the split stream then compresses best: Harmonic 64³'s grew by 9% with slabs across its
   // numbering) or an axis, whichever crosses fewest vertices when halved.
-  std::vector<uint32_t> order, candidate, slab(V_, 0);
+  // (Each axis sorts the order of the one before, stably: ties keep that order.)
+  std::vector<uint32_t> order, candidate;  // (alive vertices only: those that die leave each round)
+  std::vector<uint8_t> slab(V_, 0);
+  std::vector<std::pair<float, uint32_t>> byAxis;
   for (uint32_t v = 0; v < V_; ++v)
     if (out_.vertexAlive[v]) candidate.push_back(v);
   size_t fewest = ~size_t(0);
   for (int axis = -1; axis < 3; ++axis) {
-    if (axis >= 0)
-      std::stable_sort(candidate.begin(), candidate.end(), [&](uint32_t a, uint32_t b) { return p(a)[axis] < p(b)[axis]; });
-    slabsOf(candidate, alive_, false, slab);
+    if (axis >= 0) {
+      byAxis.clear();
+      for (uint32_t v : candidate) byAxis.push_back({vert_[v].x[axis], v});
+      std::stable_sort(byAxis.begin(), byAxis.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+      for (size_t k = 0; k < byAxis.size(); ++k) candidate[k] = byAxis[k].second;
+    }
+    slabsOf(candidate, false, slab);
     markInner(slab);
     size_t border = 0;
     for (uint32_t v : candidate) border += !inner_[v];
@@ -127,13 +134,14 @@ void Simplifier::runParts(uint32_t planned) {
   // Rounds end when the budget is spent, nothing is queued, or two rounds in a row (one of each
   // kind) collapsed nothing: what is left waits along the cuts for the whole mesh's queue.
   for (int round = 0, idle = 0; idle < 2; ++round) {
-    const uint32_t slabs = slabsOf(order, alive_ - collapsedAll, round & 1, slab);
+    std::erase_if(order, [&](uint32_t v) { return !out_.vertexAlive[v]; });
+    const uint32_t slabs = slabsOf(order, round & 1, slab);
     markInner(slab);
     // The slabs' queues anew: every queued inner vertex under its last known cost.
     std::vector<Entry> entries[kMaxSlabs];
     std::fill(inner, inner + kMaxSlabs, 0.0);
     for (uint32_t v : order) {
-      if (!out_.vertexAlive[v] || !inner_[v]) continue;
+      if (!inner_[v]) continue;
       inner[slab[v]] += 1;
       if (queued_[v]) entries[slab[v]].push_back({queueKey(v), v});
     }
@@ -211,7 +219,7 @@ void Simplifier::mergeRound(uint32_t slabs) {
 }
 
 // inner_[v]: every alive tet around v lies in v's slab.
-void Simplifier::markInner(const std::vector<uint32_t>& slab) {
+void Simplifier::markInner(const std::vector<uint8_t>& slab) {
   inner_.assign(V_, 1);
   for (uint32_t t = 0; t < T_; ++t) {
     if (!out_.tetAlive[t]) continue;
