@@ -5,7 +5,6 @@
 #include <thread>
 #include <utility>
 
-
 namespace tetstream {
 namespace {
 
