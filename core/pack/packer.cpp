@@ -102,6 +102,13 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   };
   if (Result r = checkMemoryFor(mesh, opt); !r) return r;
   progress("validate", 0, 0);
+  // A numbering that scatters neighbours costs cache misses at every step from here on, the
+  // validation's included (renumber.h): such meshes are renumbered first (the stream has its
+  // own numbering), when their indices and positions are usable at all (the validation says
+  // what is wrong with the others). The kiefer bracket's validation: 22 → 11 ms.
+  const double spread = mesh.tetCount() >= opt.renumberMinTets && renumberable(mesh) ? numberingSpread(mesh) : 0.0;
+  const bool renumber = spread > kScatteredNumbering;
+  if (renumber) renumberForLocality(mesh);
   FaceAdjacency adjacency;  // built by the validation, used again by the simplifier
   ValidationReport report = validateMesh(mesh, &adjacency);
   if (report.fatal()) {
@@ -137,10 +144,7 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
     }
   if (summary.flippedTets)
     summary.notes.push_back("re-oriented " + std::to_string(summary.flippedTets) + " negatively oriented tetrahedra");
-  // A numbering that scatters neighbours costs the simplifier and the encoder cache misses at
-  // every step (renumber.h): such meshes are renumbered first (the stream has its own numbering).
-  if (const double spread = mesh.tetCount() >= opt.renumberMinTets ? numberingSpread(mesh) : 0.0; spread > kScatteredNumbering) {
-    renumberForLocality(mesh, adjacency);
+  if (renumber) {
     char note[160];
     std::snprintf(note, sizeof note, "renumbered vertices and tetrahedra for speed: the file's numbering scatters "
                   "neighbours (a tetrahedron's vertex ids span %.0f%% of them, median)", 100 * spread);

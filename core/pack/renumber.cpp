@@ -35,7 +35,16 @@ double numberingSpread(const TetMesh& mesh) {
   return double(spans[spans.size() / 2]) / V;
 }
 
-void renumberForLocality(TetMesh& mesh, FaceAdjacency& adjacency) {
+bool renumberable(const TetMesh& mesh) {
+  const uint32_t V = mesh.vertexCount();
+  for (uint32_t v : mesh.tets)
+    if (v >= V) return false;
+  for (float x : mesh.positions)
+    if (!std::isfinite(x)) return false;
+  return true;
+}
+
+void renumberForLocality(TetMesh& mesh) {
   const uint32_t V = mesh.vertexCount(), T = mesh.tetCount();
   const Bounds b = computeBounds(mesh.positions);
   std::vector<std::pair<uint64_t, uint32_t>> order(V);
@@ -79,15 +88,6 @@ void renumberForLocality(TetMesh& mesh, FaceAdjacency& adjacency) {
   for (uint32_t t = 0; t < T; ++t)
     for (int k = 0; k < 4; ++k) tets[4 * size_t(newTet[t]) + k] = mesh.tets[4 * size_t(t) + k];
   mesh.tets = std::move(tets);
-  if (adjacency.opposite.size() == mesh.tets.size()) {
-    std::vector<uint32_t> opposite(adjacency.opposite.size());
-    for (uint32_t t = 0; t < T; ++t)
-      for (uint32_t f = 0; f < 4; ++f) {
-        const uint32_t h = adjacency.opposite[4 * size_t(t) + f];
-        opposite[4 * size_t(newTet[t]) + f] = h == kNoNeighbor ? kNoNeighbor : 4 * newTet[h >> 2] + (h & 3);
-      }
-    adjacency.opposite = std::move(opposite);
-  }
 }
 
 }  // namespace tetstream

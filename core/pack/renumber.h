@@ -6,7 +6,6 @@
 #pragma once
 #include <cstdint>
 
-#include "adjacency.h"
 #include "mesh.h"
 
 namespace tetstream {
@@ -21,9 +20,13 @@ double numberingSpread(const TetMesh& mesh);
 // numbering (CylinderLinear.vtk's 1,522 tets packed no faster, into a stream 2% larger).
 inline constexpr double kScatteredNumbering = 0.2;
 
+// Whether renumberForLocality can take the mesh: every index names a vertex, every coordinate
+// is finite (else the validation says what is wrong).
+bool renumberable(const TetMesh& mesh);
+
 // Renumbers the vertices along a Morton (Z-order) curve through their positions and the tets
 // by their smallest new vertex id (ties: the old order), keeping each tet's slot order (so its
-// orientation), and permutes `adjacency` (FaceAdjacency of the mesh, or empty) to match.
-void renumberForLocality(TetMesh& mesh, FaceAdjacency& adjacency);
+// orientation). Before anything is built on the mesh: the packer renumbers before validating.
+void renumberForLocality(TetMesh& mesh);
 
 }  // namespace tetstream

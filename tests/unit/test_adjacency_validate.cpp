@@ -105,25 +105,44 @@ TEST(Validate, CleanGridHasNoFindings) {
   EXPECT_EQ(r.positiveTets, m.tetCount());
 }
 
+// Each kind of flaw counted once, on a small grid and on one large enough for the second thread
+// (validate.cpp: the shapes and duplicates beside the faces from 10,000 tets).
 TEST(Validate, ReportsEachKindOfFlaw) {
-  TetMesh m = makeGridMesh(4);
-  addHarmonicField(m);
-  const uint32_t V = m.vertexCount();
-  std::swap(m.tets[2], m.tets[3]);                          // one inverted tet
-  m.tets.insert(m.tets.end(), m.tets.begin() + 4, m.tets.begin() + 8);  // a duplicate
-  m.positions.insert(m.positions.end(), {5, 5, 5});         // an unused vertex
-  m.fields[0].values.push_back(std::numeric_limits<float>::quiet_NaN());
-  // A flat tet: four coplanar vertices of the grid's bottom face.
-  m.tets.insert(m.tets.end(), {0, 1, 4, 5});
-  ValidationReport r = validateMesh(m);
-  EXPECT_EQ(r.invertedTets, 1u);
-  EXPECT_EQ(r.duplicateTets, 1u);
-  EXPECT_EQ(r.unusedVertices, 1u);
-  EXPECT_EQ(r.nonFiniteFieldValues, 1u);
-  EXPECT_EQ(r.zeroVolumeTets, 1u);
-  EXPECT_FALSE(r.fatal());
-  EXPECT_GE(r.findings.size(), 5u);
-  (void)V;
+  for (uint32_t n : {4u, 20u}) {  // 162 and 41,154 tets
+    TetMesh m = makeGridMesh(n);
+    addHarmonicField(m);
+    const uint32_t middle = 4 * (m.tetCount() / 2);
+    std::swap(m.tets[middle + 2], m.tets[middle + 3]);                    // one inverted tet
+    m.tets.insert(m.tets.end(), m.tets.begin() + 4, m.tets.begin() + 8);  // a duplicate
+    m.positions.insert(m.positions.end(), {5, 5, 5});                     // an unused vertex
+    m.fields[0].values.push_back(std::numeric_limits<float>::quiet_NaN());
+    // A flat tet: four coplanar vertices of the grid's bottom face.
+    m.tets.insert(m.tets.end(), {0, 1, n, n + 1});
+    ValidationReport r = validateMesh(m);
+    EXPECT_EQ(r.invertedTets, 1u) << n;
+    EXPECT_EQ(r.duplicateTets, 1u) << n;
+    EXPECT_EQ(r.unusedVertices, 1u) << n;
+    EXPECT_EQ(r.nonFiniteFieldValues, 1u) << n;
+    EXPECT_EQ(r.zeroVolumeTets, 1u) << n;
+    EXPECT_EQ(r.positiveTets + r.negativeTets + r.zeroVolumeTets, m.tetCount()) << n;
+    EXPECT_FALSE(r.fatal()) << n;
+    EXPECT_GE(r.findings.size(), 5u) << n;
+  }
+}
+
+TEST(Validate, CountsNonManifoldBoundaryEdges) {
+  // Two tets meeting in an edge only: four boundary triangles share it.
+  TetMesh m;
+  m.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, -1, 0, 0, 0, -1};
+  m.tets = {0, 1, 2, 3, 0, 1, 4, 5};
+  EXPECT_EQ(validateMesh(m).nonManifoldBoundaryEdges, 1u);
+  // Triangles alone: an open one has three edges with one triangle each; a closed
+  // tetrahedron's surface none.
+  const std::vector<uint32_t> open = {7, 3, 9};
+  EXPECT_EQ(countNonManifoldBoundaryEdges(open), 3u);
+  const std::vector<uint32_t> closed = {0, 2, 1, 0, 1, 3, 1, 2, 3, 0, 3, 2};
+  EXPECT_EQ(countNonManifoldBoundaryEdges(closed), 0u);
+  EXPECT_EQ(countNonManifoldBoundaryEdges(std::vector<uint32_t>{}), 0u);
 }
 
 TEST(Validate, FatalFlaws) {
