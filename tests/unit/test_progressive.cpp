@@ -364,6 +364,27 @@ TEST(Renumber, ShuffledMeshRoundTripsExactly) {
   roundTrip("renumber-shuffled", m, o);
 }
 
+// A scattered mesh with a bad index or coordinate is not renumbered (renumberable()) but refused
+// by the validation with the reason, as any mesh is: no crash, no stream.
+TEST(Renumber, BrokenScatteredMeshIsRefusedNotRenumbered) {
+  const TetMesh good = shuffled(harmonic(12), 5);
+  PackOptions o;
+  o.renumberMinTets = 0;
+  for (int broken = 0; broken < 2; ++broken) {
+    TetMesh m = good;
+    if (broken == 0) m.tets[17] = m.vertexCount() + 3;
+    else m.positions[10] = std::numeric_limits<float>::infinity();
+    PackSummary s;
+    const std::string dir = tempDir("renumber-broken-" + std::to_string(broken));
+    Result r = packMesh(m, dir, o, s);
+    EXPECT_FALSE(r);
+    EXPECT_EQ(r.status, broken == 0 ? Status::OutOfRange : Status::NonFinite) << r.message;
+    EXPECT_NE(r.message.find(broken == 0 ? "reference a vertex that does not exist" : "NaN or infinite"), std::string::npos)
+        << r.message;
+    EXPECT_FALSE(std::filesystem::exists(std::filesystem::path(dir) / "manifest.json"));
+  }
+}
+
 // Simplifies m with o on one thread and on two: the collapses must be exactly the same.
 void expectSameOnOneThreadAndTwo(const TetMesh& m, SimplifyOptions o, SimplifyResult& one, SimplifyResult& two) {
   o.threads = 1;
