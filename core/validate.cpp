@@ -109,16 +109,15 @@ ValidationReport validateMesh(const TetMesh& m, FaceAdjacency* adjacency) {
   if (!indicesOk || T == 0) {
     shapes();
   } else {
+    auto besideFaces = [&] { shapes(); countDuplicates(); };
 #if !defined(__EMSCRIPTEN__)
     std::jthread side;  // (joins on the way out, an exception included)
-    if (T >= kSecondThreadTets) side = std::jthread([&] { shapes(); countDuplicates(); });
-    else shapes(), countDuplicates();
-    faces();
+    if (T >= kSecondThreadTets) side = std::jthread(besideFaces);
+    else besideFaces();
 #else
-    shapes();
-    countDuplicates();
-    faces();
+    besideFaces();
 #endif
+    faces();
   }
 
   if (r.noTets) r.findings.push_back("the mesh has no tetrahedra");
