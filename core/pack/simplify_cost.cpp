@@ -283,8 +283,12 @@ void Simplifier::neighbours(Lane& L, uint32_t v, std::vector<uint32_t>& out) {
   out.clear();
   ++L.stamp;
   L.seen[v] = L.stamp;
+  const bool onBoundary = boundary_[v];
   for (uint32_t t : star_[v]) {
     __builtin_prefetch(&kappa_[t]);
+    // prepareStar reads a boundary vertex's face neighbours next: waiting on those loads took
+    // a third of its time on the kiefer bracket, whose vertices are mostly on the boundary.
+    if (onBoundary) __builtin_prefetch(&opp_[4 * size_t(t)]);
     for (int k = 0; k < 4; ++k) {
       uint32_t w = out_.tets[4 * size_t(t) + k];
       if (L.seen[w] != L.stamp) {
