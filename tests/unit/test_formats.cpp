@@ -435,8 +435,17 @@ TEST(Degenerate, DuplicateVerticesMergedOrKeptApart) {
   const std::string pts2 = "0 0 0 1 0 0 0 1 0 0 0 1 0 0 0 1 0 0 0 -1 0 0 0 -1";
   ASSERT_TRUE(readMeshBytes(legacy(pts2, 8, "4 0 1 2 3\n4 4 5 6 7", 2, 10, "10 10"), "e.vtk", m, r));
   EXPECT_EQ(m.vertexCount(), 8u);
-  EXPECT_TRUE(hasNote(r, "found 2 vertices at the same coordinates as another; not merged")) << allNotes(r);
+  EXPECT_TRUE(hasNote(r, "found 2 vertices at the same coordinates as another; not merged, since merging would make "
+                         "1 more face or boundary edge non-manifold")) << allNotes(r);
   EXPECT_EQ(validateMesh(m).nonManifoldBoundaryEdges, 0u);
+
+  // The same, with two more tets elsewhere already sharing only an edge: the count looks only
+  // near the merged vertices, and what lies elsewhere is the same either way.
+  const std::string pts3 = pts2 + " 10 0 0 11 0 0 10 1 0 10 0 1 10 -1 0 10 0 -1";
+  ASSERT_TRUE(readMeshBytes(legacy(pts3, 14, "4 0 1 2 3\n4 4 5 6 7\n4 8 9 10 11\n4 8 9 12 13", 4, 20, "10 10 10 10"),
+                            "f.vtk", m, r));
+  EXPECT_TRUE(hasNote(r, "not merged, since merging would make 1 more face or boundary edge non-manifold")) << allNotes(r);
+  EXPECT_EQ(validateMesh(m).nonManifoldBoundaryEdges, 1u);
 }
 
 TEST(Degenerate, RepeatedVertexTetsDroppedAndUnusedVerticesDropped) {
