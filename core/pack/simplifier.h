@@ -364,6 +364,7 @@ class Simplifier {
   void runParts(uint32_t planned);
   void mergeRound(uint32_t slabs);
   void markInner(const std::vector<uint8_t>& slab);
+  static constexpr uint32_t kTwoThreadScan = 200000;  // tets: markInner() on two threads from here
 
   // ------------------------------------------------------------------ link condition
   void gatherLink(uint32_t v, std::vector<uint32_t>& verts, std::vector<uint64_t>& edges, std::vector<Tri>& tris);

@@ -219,14 +219,20 @@ void Simplifier::mergeRound(uint32_t slabs) {
 }
 
 // inner_[v]: every alive tet around v lies in v's slab.
+// Every round scans all tets: on large meshes in two halves at once (carotid, 950k tets, 25
+// scans: ~90 → ~50 ms). Both halves only ever write 0, relaxed: the result is the same.
 void Simplifier::markInner(const std::vector<uint8_t>& slab) {
   inner_.assign(V_, 1);
-  for (uint32_t t = 0; t < T_; ++t) {
-    if (!out_.tetAlive[t]) continue;
-    const uint32_t* v = &out_.tets[4 * size_t(t)];
-    if (slab[v[0]] != slab[v[1]] || slab[v[0]] != slab[v[2]] || slab[v[0]] != slab[v[3]])
-      for (int k = 0; k < 4; ++k) inner_[v[k]] = 0;
-  }
+  auto scan = [&](uint32_t begin, uint32_t end) {
+    for (uint32_t t = begin; t < end; ++t) {
+      if (!out_.tetAlive[t]) continue;
+      const uint32_t* v = &out_.tets[4 * size_t(t)];
+      if (slab[v[0]] != slab[v[1]] || slab[v[0]] != slab[v[2]] || slab[v[0]] != slab[v[3]])
+        for (int k = 0; k < 4; ++k) std::atomic_ref<uint8_t>(inner_[v[k]]).store(0, std::memory_order_relaxed);
+    }
+  };
+  if (T_ < kTwoThreadScan) return scan(0, T_);
+  onBoth([&](int part) { scan(part ? T_ / 2 : 0, part ? T_ : T_ / 2); });
 }
 
 }  // namespace tetstream::simplify_detail
