@@ -220,7 +220,7 @@ void Simplifier::mergeRound(uint32_t slabs) {
 
 // inner_[v]: every alive tet around v lies in v's slab.
 // Every round scans all tets: on large meshes in two halves at once (carotid, 950k tets, 25
-// scans: ~90 → ~50 ms). Both halves only ever write 0, relaxed: the result is the same.
+// scans: ~90 → 60-70 ms). Both halves only ever write 0, relaxed: the result is the same.
 void Simplifier::markInner(const std::vector<uint8_t>& slab) {
   inner_.assign(V_, 1);
   auto scan = [&](uint32_t begin, uint32_t end) {
