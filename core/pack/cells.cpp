@@ -254,7 +254,9 @@ uint64_t nonManifoldCount(const std::vector<uint32_t>& tets, uint32_t nv) {
 // counting on the tets with a vertex in R, merged and apart, gives the same difference as counting
 // on the whole mesh twice: what lies outside them is the same either way, and what the cut makes
 // look like boundary there is too. (Blunt Fin, 39 merged vertices: 24 → 1.5 ms; post.vtk 2.2 → 0.7 ms.)
-int64_t mergeDamage(const CellSoup& soup, const std::vector<uint32_t>& remap, const float* pos, uint32_t nv) {
+// `mergedTets`: the whole mesh merged, counted instead when most cells are near a merged vertex.
+int64_t mergeDamage(const CellSoup& soup, const std::vector<uint32_t>& remap, const float* pos, uint32_t nv,
+                    const std::vector<uint32_t>& mergedTets) {
   enum : uint8_t { kMerged = 1, kNear = 2 };
   std::vector<uint8_t> mark(nv, 0);
   for (uint32_t v = 0; v < nv; ++v)
@@ -271,10 +273,23 @@ int64_t mergeDamage(const CellSoup& soup, const std::vector<uint32_t>& remap, co
     if (std::any_of(ids, ids + nc, [&](uint32_t v) { return mark[v] & kMerged; }))
       for (int k = 0; k < nc; ++k) mark[ids[k]] |= kNear;
   });
+  auto isNear = [&](const uint32_t* ids, int nc) {
+    return std::any_of(ids, ids + nc, [&](uint32_t v) { return mark[v] & kNear; });
+  };
+  size_t nearCells = 0;
+  forCells([&](size_t, const uint32_t* ids, int nc) { nearCells += isNear(ids, nc); });
+  if (4 * nearCells > soup.shapes.size()) {
+    // Most of the mesh is near a merged vertex (as in a file that writes every cell with its own
+    // copies of its points): the whole mesh is counted, without copying most of it again.
+    const int64_t merged = int64_t(nonManifoldCount(mergedTets, nv));
+    if (merged == 0) return 0;  // merging cannot do worse
+    Split apart;
+    splitAll(soup, nullptr, pos, false, apart);
+    return merged - int64_t(nonManifoldCount(apart.tets, nv));
+  }
   CellSoup near;  // the cells with a corner in R: the only ones that can make a tet with one
   forCells([&](size_t c, const uint32_t* ids, int nc) {
-    if (std::any_of(ids, ids + nc, [&](uint32_t v) { return mark[v] & kNear; }))
-      near.add(CellShape(soup.shapes[c]), ids, c);
+    if (isNear(ids, nc)) near.add(CellShape(soup.shapes[c]), ids, c);
   });
   auto count = [&](const uint32_t* map) {
     Split split;
@@ -467,7 +482,7 @@ Result finishMesh(const std::string& label, TetMesh& mesh, CellSoup& soup, std::
       // mesh only touches itself (two boundary sheets meeting along a line), it would make the
       // boundary non-manifold. Merge unless it leaves more non-manifold faces and boundary edges
       // than keeping the copies apart; the split without merging is made only then.
-      if (const int64_t damage = mergeDamage(soup, remap, mesh.positions.data(), nv); damage > 0) {
+      if (const int64_t damage = mergeDamage(soup, remap, mesh.positions.data(), nv, split.tets); damage > 0) {
         Split apart;
         splitAll(soup, nullptr, mesh.positions.data(), wantVolumes, apart);
         report.notes.push_back("found " + plural(coincident, "vertex", "vertices") +

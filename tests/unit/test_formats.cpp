@@ -439,12 +439,23 @@ TEST(Degenerate, DuplicateVerticesMergedOrKeptApart) {
                          "1 more face or boundary edge non-manifold")) << allNotes(r);
   EXPECT_EQ(validateMesh(m).nonManifoldBoundaryEdges, 0u);
 
-  // The same, with two more tets elsewhere already sharing only an edge: the count looks only
-  // near the merged vertices, and what lies elsewhere is the same either way.
-  const std::string pts3 = pts2 + " 10 0 0 11 0 0 10 1 0 10 0 1 10 -1 0 10 0 -1";
-  ASSERT_TRUE(readMeshBytes(legacy(pts3, 14, "4 0 1 2 3\n4 4 5 6 7\n4 8 9 10 11\n4 8 9 12 13", 4, 20, "10 10 10 10"),
+  // The same, with more tets elsewhere, two of them already sharing only an edge. With few cells
+  // near the merged vertices the count looks only there (the cases above count the whole mesh),
+  // and what lies elsewhere is the same either way.
+  std::string pts3 = pts2 + " 10 0 0 11 0 0 10 1 0 10 0 1 10 -1 0 10 0 -1";
+  std::string cells3 = "4 0 1 2 3\n4 4 5 6 7\n4 8 9 10 11\n4 8 9 12 13";
+  const int apartTets = 6;  // alone, far away: 2 of 10 cells are near a merged vertex
+  for (int k = 0; k < apartTets; ++k) {
+    const std::string x = std::to_string(20 + 2 * k), x1 = std::to_string(21 + 2 * k);
+    pts3 += " " + x + " 0 0 " + x1 + " 0 0 " + x + " 1 0 " + x + " 0 1";
+    const int b = 14 + 4 * k;
+    cells3 += "\n4 " + std::to_string(b) + " " + std::to_string(b + 1) + " " + std::to_string(b + 2) + " " + std::to_string(b + 3);
+  }
+  ASSERT_TRUE(readMeshBytes(legacy(pts3, 14 + 4 * apartTets, cells3, 4 + apartTets, 5 * (4 + apartTets),
+                                   "10 10 10 10 10 10 10 10 10 10"),
                             "f.vtk", m, r));
   EXPECT_TRUE(hasNote(r, "not merged, since merging would make 1 more face or boundary edge non-manifold")) << allNotes(r);
+  EXPECT_EQ(m.tetCount(), 10u);
   EXPECT_EQ(validateMesh(m).nonManifoldBoundaryEdges, 1u);
 }
 
