@@ -254,9 +254,10 @@ uint64_t nonManifoldCount(const std::vector<uint32_t>& tets, uint32_t nv) {
 // counting on the tets with a vertex in R, merged and apart, gives the same difference as counting
 // on the whole mesh twice: what lies outside them is the same either way, and what the cut makes
 // look like boundary there is too. (Blunt Fin, 39 merged vertices: 24 → 1.5 ms; post.vtk 2.2 → 0.7 ms.)
-// `mergedTets`: the whole mesh merged, counted instead when most cells are near a merged vertex.
+// `mergedTets`: the whole mesh merged, counted instead when most cells are near a merged vertex;
+// the whole mesh apart is then left in `apart` (for the caller, when it does not merge).
 int64_t mergeDamage(const CellSoup& soup, const std::vector<uint32_t>& remap, const float* pos, uint32_t nv,
-                    const std::vector<uint32_t>& mergedTets) {
+                    const std::vector<uint32_t>& mergedTets, bool wantVolumes, Split& apart) {
   enum : uint8_t { kMerged = 1, kNear = 2 };
   std::vector<uint8_t> mark(nv, 0);
   for (uint32_t v = 0; v < nv; ++v)
@@ -283,8 +284,7 @@ int64_t mergeDamage(const CellSoup& soup, const std::vector<uint32_t>& remap, co
     // copies of its points): the whole mesh is counted, without copying most of it again.
     const int64_t merged = int64_t(nonManifoldCount(mergedTets, nv));
     if (merged == 0) return 0;  // merging cannot do worse
-    Split apart;
-    splitAll(soup, nullptr, pos, false, apart);
+    splitAll(soup, nullptr, pos, wantVolumes, apart);
     return merged - int64_t(nonManifoldCount(apart.tets, nv));
   }
   CellSoup near;  // the cells with a corner in R: the only ones that can make a tet with one
@@ -482,9 +482,10 @@ Result finishMesh(const std::string& label, TetMesh& mesh, CellSoup& soup, std::
       // mesh only touches itself (two boundary sheets meeting along a line), it would make the
       // boundary non-manifold. Merge unless it leaves more non-manifold faces and boundary edges
       // than keeping the copies apart; the split without merging is made only then.
-      if (const int64_t damage = mergeDamage(soup, remap, mesh.positions.data(), nv, split.tets); damage > 0) {
-        Split apart;
-        splitAll(soup, nullptr, mesh.positions.data(), wantVolumes, apart);
+      Split apart;  // (made by mergeDamage() when it counted the whole mesh)
+      if (const int64_t damage = mergeDamage(soup, remap, mesh.positions.data(), nv, split.tets, wantVolumes, apart);
+          damage > 0) {
+        if (apart.tets.empty()) splitAll(soup, nullptr, mesh.positions.data(), wantVolumes, apart);
         report.notes.push_back("found " + plural(coincident, "vertex", "vertices") +
                                " at the same coordinates as another; not merged, since merging would make " +
                                plural(damage, "more face or boundary edge", "more faces or boundary edges") +
