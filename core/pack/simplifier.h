@@ -161,6 +161,7 @@ class Simplifier {
     double cost;     // exact, or a lower bound until stage Exact
     double base;     // the cost without the shape term
     double sj, region, eg, weight, shapeBound;  // parts of the cost (boundTerms)
+    double perTets;  // the factor for the tets it removes (SimplifyOptions::removedTetsExponent)
     uint32_t j;
     uint64_t bit;    // bitOf(j's place in Lane::nbr)
     float fieldErr;  // E_f (from stage Local on)

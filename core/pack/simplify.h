@@ -20,6 +20,11 @@
 //        [0, 1), averaged over the tets around p_j after the collapse (0: all equilateral).
 //        The paper's unbounded κ − 3 let the shape term outweigh the field wherever a mesh is
 //        anisotropic: on the Blunt Fin CFD grid it made the density error 6.6× larger.
+// The whole cost is then divided by sqrt(r), r the number of tets the collapse removes (the
+// tets around the edge): a level is as large as its tets (the base's bytes, the viewer's work
+// and the benchmarks' levels go by tets), so a collapse that removes six tets may cost more than
+// one that removes three. The root, not r itself: a split's bytes go by its vertex as well as by
+// its tets (session 33: r itself gave a 5-15% higher error at the same bytes received).
 // Defaults (100, 1, 0.005) keep the boundary first, then the field; tet shape is a
 // tie-breaker; all terms are scale free, so they work for any mesh size and field range.
 // (Shape weight chosen on Harmonic 64³ and Blunt Fin: 0.002 to 0.02 trade the field error at the
@@ -85,6 +90,9 @@ struct SimplifyOptions {
   // interior vertex's mean volume), or (false) the vertices alone, as before session 25 (tests
   // compare the two).
   bool weighByVolume = true;
+  // Each cost divided by (tets the collapse removes)^this (see the cost above); 0: not at all,
+  // as before session 33 (tests compare the two).
+  double removedTetsExponent = 0.5;
   std::function<void(uint32_t done, uint32_t planned)> progress;  // called now and then
   // Keep in the log what each split reads (CollapseLog::star), for StreamOptions::orderSplits.
   bool recordReadSets = false;

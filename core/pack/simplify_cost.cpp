@@ -151,6 +151,9 @@ Simplifier::Candidate Simplifier::boundTerms(Lane& L, uint32_t i, uint32_t j, ui
   // little so that round-off (its sums run in another order) never lifts it above E_s.
   const double moved = double(L.star.size()) - removed, after = double(star_[j].size()) - removed + moved;
   c.shapeBound = after > 0 ? std::max(0.0, 1.0 - (qualitySum_[j] - removedQuality + moved) / after) : 0.0;
+  // Per tet removed (simplify.h); legal() counted them (at least the one tet of the edge).
+  c.perTets = opt_.removedTetsExponent == 0.5 ? 1.0 / std::sqrt(double(std::max(removed, 1)))
+                                              : std::pow(double(std::max(removed, 1)), -opt_.removedTetsExponent);
   setCost(c, 0.0);  // a lower bound: the local error is at least 0 (rounding is monotone)
   c.stage = Candidate::Bound;
   return c;
@@ -161,7 +164,7 @@ void Simplifier::setCost(Candidate& c, double local) const {
   const double ef = local + c.region;
   c.fieldErr = float(ef);
   c.base = c.weight * (opt_.weightGeometry * c.eg + opt_.weightField * ef);
-  c.cost = c.base + opt_.weightShape * c.shapeBound * (1 - 1e-9);
+  c.cost = c.perTets * (c.base + opt_.weightShape * c.shapeBound * (1 - 1e-9));
 }
 
 // Adds the paper's local field error (eq. 6) to a candidate of boundTerms():
@@ -226,7 +229,7 @@ bool Simplifier::finishCost(Lane& L, Candidate& c, CollapseVerdict* verdict) {
   // Mean of (κ − 3)/κ = 1 − 3/κ: the paper's κ − 3, mapped onto [0, 1) so that one sliver
   // cannot outweigh the field error (see simplify.h).
   double es = count > 0 ? std::max(0.0, 1.0 - qualitySum / double(count)) : 0.0;
-  c.cost = c.base + opt_.weightShape * es;
+  c.cost = c.perTets * (c.base + opt_.weightShape * es);
   c.stage = Candidate::Exact;
   return true;
 }
