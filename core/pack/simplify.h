@@ -22,9 +22,10 @@
 //        anisotropic: on the Blunt Fin CFD grid it made the density error 6.6× larger.
 // The whole cost is then divided by sqrt(r), r the number of tets the collapse removes (the
 // tets around the edge): a level is as large as its tets (the base's bytes, the viewer's work
-// and the benchmarks' levels go by tets), so a collapse that removes six tets may cost more than
-// one that removes three. The root, not r itself: a split's bytes go by its vertex as well as by
-// its tets (session 33: r itself gave a 5-15% higher error at the same bytes received).
+// and the benchmarks' levels go by tets), so a collapse that removes six tets may err more
+// than one that removes three and still go first. The root, not r itself: a split's bytes go
+// by its vertex as well as by its tets (session 33: r itself gave a 5-15% higher error at the
+// same bytes received).
 // Defaults (100, 1, 0.005) keep the boundary first, then the field; tet shape is a
 // tie-breaker; all terms are scale free, so they work for any mesh size and field range.
 // (Shape weight chosen on Harmonic 64³ and Blunt Fin: 0.002 to 0.02 trade the field error at the
