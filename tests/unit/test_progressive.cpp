@@ -852,30 +852,30 @@ TEST(Progressive, GradedMeshKeepsTheFarFieldWhereIsosurfacesAre) {
 // Each cost is divided by the root of the tets the collapse removes (simplify.h): at the same
 // count of tets, the coarse mesh then keeps the field better than when every collapse counts
 // alike (Harmonic 64³ at 5% of its tets: RMS 0.00107 -> 0.00100; carotid 0.0145 -> 0.0140).
+// One level of one small grid can go either way (Harmonic 20³ at 20% of its tets: 0.6% higher),
+// so three levels are compared.
 TEST(Progressive, CostPerRemovedTetGivesALowerErrorAtTheSameTets) {
-  TetMesh m = makeGridMesh(12);
-  ScalarField f{"harmonic", {}};
-  for (size_t v = 0; v < m.vertexCount(); ++v) {
-    const float* p = &m.positions[3 * v];
-    const double r = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-    f.values.push_back(float((2 * p[2] * p[2] - p[0] * p[0] - p[1] * p[1]) * std::exp(-3 * r)));
+  const TetMesh m = harmonic(16);
+  double product = 1;
+  for (uint32_t share : {5u, 10u, 20u}) {  // 1/share of the tets: 20%, 10%, 5%
+    SimplifyOptions so;
+    so.targetTets = m.tetCount() / share;
+    SimplifyResult perTet, alike;
+    ASSERT_TRUE(simplifyMesh(m, so, perTet));
+    so.removedTetsExponent = 0;
+    ASSERT_TRUE(simplifyMesh(m, so, alike));
+    const TetMesh a = coarseMesh(m, perTet), b = coarseMesh(m, alike);
+    const double ra = fieldRms(m, a, 0), rb = fieldRms(m, b, 0);
+    std::printf("RMS at %u / %u tets: %.5f per removed tet, %.5f alike (%u / %u vertices)\n", a.tetCount(),
+                b.tetCount(), ra, rb, a.vertexCount(), b.vertexCount());
+    EXPECT_LE(a.tetCount(), so.targetTets);
+    EXPECT_LE(b.tetCount(), so.targetTets);
+    EXPECT_LT(ra, rb) << "at 1/" << share << " of the tets";
+    product *= ra / rb;
   }
-  m.fields.push_back(f);
-  SimplifyOptions so;
-  so.targetVertices = 0;
-  so.targetTets = m.tetCount() / 10;
-  SimplifyResult perTet, alike;
-  ASSERT_TRUE(simplifyMesh(m, so, perTet));
-  so.removedTetsExponent = 0;
-  ASSERT_TRUE(simplifyMesh(m, so, alike));
-  const TetMesh a = coarseMesh(m, perTet), b = coarseMesh(m, alike);
-  const double ra = fieldRms(m, a, 0), rb = fieldRms(m, b, 0);
-  std::printf("RMS at %u / %u tets: %.5f per removed tet, %.5f alike (%u / %u vertices)\n", a.tetCount(),
-              b.tetCount(), ra, rb, a.vertexCount(), b.vertexCount());
-  EXPECT_LE(a.tetCount(), so.targetTets);
-  EXPECT_LE(b.tetCount(), so.targetTets);
-  EXPECT_LT(ra, 0.95 * rb);  // (measured: 0.00353 against 0.00397; grids of 16³ and 20³ at 5-20%
-                             // of the tets: 2-10% lower)
+  // (measured: 0.965, 0.942 and 0.952; Harmonic 12³, 20³ and 24³ at the same levels: 1-22% lower
+  // at 8 of 9)
+  EXPECT_LT(std::cbrt(product), 0.97);
 }
 
 // The cost is scale free: a mesh and the same mesh 1024 times larger (exact in floats) collapse
