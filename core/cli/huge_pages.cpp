@@ -54,14 +54,15 @@ std::string smallInputTunables(const char* userTunables) {
 // cannot set it for itself: so the program starts itself again, once, with it set. Measured
 // (medians, the two settings taking turns): Harmonic 64³ to 5% 6.8 -> 5.5 s (reading 0.82 ->
 // 0.40 s, checks 0.37 -> 0.17 s), carotid 4.5 -> 3.7 s, Harmonic 24³ 491 -> 432 ms, peak memory
-// +3%; the output is the same. The second start costs ~6 ms here (post.vtk, 8,750 tets, gains about
-// as much); a file's size does not tell a small mesh from a large one (ironProt.vtk's 314 KB hold
-// 1.8M tets), so every command that reads an input does it (all but gen). Not done when the kernel gives huge
-// pages to every program anyway ("always") or to none ("never"), when the tunable is set already,
-// under valgrind (its tools would lose the program) or with TETSTREAM_HUGE_PAGES=0. Nor where a
-// first touch is cheap (under 2 µs a page), as there fewer faults can gain little, and huge pages
-// have been seen to cost: on session 16's machine the simplifier was no faster with them and
-// reading 2.3× slower.
+// +3%; the output is the same. The second start costs ~0.3 ms since the CLI is linked statically
+// (~6 ms before, mostly the dynamic loader; cmake/static_cli.cmake), and post.vtk's pack (8,750
+// tets) gains ~2 ms. A file's size does not tell a small mesh from a large one (ironProt.vtk's
+// 314 KB hold 1.8M tets), so every command that reads an input does it (all but gen). Not done
+// when the kernel gives huge pages to every program anyway ("always") or to none ("never"), when
+// the tunable is set already, under valgrind (its tools would lose the program) or with
+// TETSTREAM_HUGE_PAGES=0. Nor where a first touch is cheap (under 2 µs a page), as there fewer
+// faults can gain little, and huge pages have been seen to cost: on session 16's machine the
+// simplifier was no faster with them and reading 2.3× slower.
 //
 // A small input (a file under 4 MB) also gets a heap that grows 32 MB at a time, every block up
 // to 32 MB taken from it (glibc's top_pad and mmap_threshold). glibc advises huge pages on each
