@@ -2,12 +2,12 @@
 # TETSTREAM_ZLIB, and tetstream_static_cli(target), which links a program statically.
 #
 # Why the CLI is one static executable: it starts in about half the time (a pack of 48 tets took
-# 10.6 ms, 6.1 ms static, medians of 30: the dynamic loader bound libstdc++'s symbols at each
-# start, and the CLI starts twice when it restarts itself for huge pages), and the one file runs
-# on any x86-64 Linux, with no libzstd or pugixml installed and an older glibc, so it can be
-# copied to the cluster where a simulation's results are and pack them there. It reads files and
-# starts threads only: nothing of glibc that needs shared objects at run time (name services,
-# iconv, dlopen).
+# 10.6-11.1 ms, 5.8-6.1 ms static, medians of 30 in two series: the dynamic loader bound
+# libstdc++'s symbols at each start, and the CLI starts twice when it restarts itself for huge
+# pages), and the one file runs on any x86-64 Linux, with no libzstd or pugixml installed and an
+# older glibc, so it can be copied to the cluster where a simulation's results are and pack them
+# there. It reads files and starts threads only: nothing of glibc that needs shared objects at
+# run time (name services, iconv, dlopen).
 #
 # Only the CLI links the archives: the tests and benchmarks keep the shared libraries, as do the
 # sanitizer and fuzzing builds. Each library below is a generator expression that the linking
