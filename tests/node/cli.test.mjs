@@ -4,7 +4,7 @@ import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import path from 'node:path';
 import { spawnSync } from 'node:child_process';
-import { cli, cliPath, root, tempDir, packedHarmonic } from './helpers.mjs';
+import { cli, cliWithEnv, cliPath, root, tempDir, packedHarmonic } from './helpers.mjs';
 
 test('--help on the tool and every subcommand', () => {
   const top = cli('--help');
@@ -142,10 +142,9 @@ test('huge pages on, off or with the user\'s own glibc tunables: the same pack',
   for (const [name, env] of [['default', {}], ['off', { TETSTREAM_HUGE_PAGES: '0' }],
     ['own tunables', { GLIBC_TUNABLES: 'glibc.malloc.check=0' }], ['own heap tunables', { GLIBC_TUNABLES: 'glibc.malloc.top_pad=0' }]]) {
     const out = path.join(dir, name.replace(/ /g, '-'));
-    const r = spawnSync(cliPath, ['pack', vtu, '-o', out, '--json'],
-      { encoding: 'utf8', timeout: 60000, env: { ...process.env, ...env } });
+    const r = cliWithEnv({ ...process.env, ...env }, 'pack', vtu, '-o', out, '--json');
     assert.equal(r.status, 0, `${name}: ${r.stderr}`);
-    assert.equal(JSON.parse(r.stdout).tets, 9 ** 3 * 6, name);
+    assert.equal(r.json.tets, 9 ** 3 * 6, name);
     manifests.push(fs.readFileSync(path.join(out, 'manifest.json'), 'utf8'));
   }
   assert.equal(manifests[1], manifests[0], 'without huge pages');
@@ -165,9 +164,9 @@ test('the CLI is one static file: it needs no shared library where it runs', (t)
   // And it runs with nothing from the environment (no PATH, no library path).
   const dir = tempDir('static-cli');
   const vtu = path.join(dir, 'h.vtu');
-  const gen = spawnSync(cliPath, ['gen', 'harmonic', '--n', '6', '-o', vtu, '--json'], { encoding: 'utf8', env: {} });
+  const gen = cliWithEnv({}, 'gen', 'harmonic', '--n', '6', '-o', vtu, '--json');
   assert.equal(gen.status, 0, gen.stderr);
-  const pack = spawnSync(cliPath, ['pack', vtu, '-o', path.join(dir, 'p'), '--json'], { encoding: 'utf8', env: {} });
+  const pack = cliWithEnv({}, 'pack', vtu, '-o', path.join(dir, 'p'), '--json');
   assert.equal(pack.status, 0, pack.stderr);
-  assert.equal(JSON.parse(pack.stdout).tets, 5 ** 3 * 6);
+  assert.equal(pack.json.tets, 5 ** 3 * 6);
 });

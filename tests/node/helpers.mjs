@@ -14,7 +14,12 @@ export function tempDir(name) {
 
 // Runs the CLI; returns {status, stdout, stderr, json} (json parsed when stdout is JSON).
 export function cli(...args) {
-  const r = spawnSync(cliPath, args, { encoding: 'utf8', timeout: 120000 });
+  return cliWithEnv(process.env, ...args);
+}
+
+// The same with the given environment in place of the test's own.
+export function cliWithEnv(env, ...args) {
+  const r = spawnSync(cliPath, args, { encoding: 'utf8', timeout: 120000, env });
   let json;
   try { json = JSON.parse(r.stdout); } catch { json = undefined; }
   return { status: r.status, signal: r.signal, stdout: r.stdout, stderr: r.stderr, json };
