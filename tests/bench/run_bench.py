@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
-"""Progressive-engine benchmarks (issue 3 figures), side by side with VTK where it is installed.
+"""Progressive-engine benchmarks, side by side with VTK where it is installed (docs/benchmarks.md).
 
    python3 tests/bench/run_bench.py [--n 64] [--quick] [--repeat 5] [--large] [--huge] [--only TEXT]
    (scripts/bench.sh builds first; --only: the cases whose name contains TEXT)
 
-For Harmonic N³ and for the real meshes in ../shared/datasets that have a point field (post.vtk,
+For Harmonic N³ and for the real meshes in DATASETS (when present) that have a point field (post.vtk,
 Blunt Fin, the kiefer bracket, and without --quick the carotid data; with --large also ironProt.vtk, 1.8M tets, for
 the pack time and field error only, as each VTK run on it takes ~25 s; with --huge also Harmonic
 128³, 12.3M tets, for the pack time, memory and the field error at 5%, one run each, as each takes
@@ -21,8 +21,8 @@ about a minute):
     chunk boundary of the default pack, and VTK's decimation at the same tet counts (its size:
     zstd -19 of the decimated mesh's raw arrays); plotted to build/bench/rate_distortion.png
 Writes build/bench/results.json and build/bench/results.md. Times are medians of --repeat runs
-(default 5: our runs vary by 10–25% from minute to minute) on this machine (noted in the
-output); nothing here is asserted.
+(default 5: two-thread packs vary from minute to minute), with the machine noted in the
+output; nothing here is asserted.
 """
 import json
 import os
@@ -101,9 +101,8 @@ def rate_distortion(mesh, field, iso, full, tmp, with_vtk, points):
 
 def as_vtu(mesh, tmp, name):
     """The mesh as our reader sees it (hexahedra and grids split into tets) as .vtu, in the order
-    read, so that VTK's decimation gets the very same tetrahedra. (Until session 14 this was a
-    lossless pack unpacked, whose stream order scatters neighbours: both tools ran slower on it,
-    ours 1.4x on ironProt.vtk.)"""
+    read, so that VTK's decimation gets the very same tetrahedra. Not a lossless pack unpacked:
+    its stream order scatters neighbours and slows both tools, which no user's input does."""
     out = os.path.join(tmp, f"{name}.vtu")
     run([BENCH, "vtu", mesh, out])
     return out
@@ -124,8 +123,8 @@ def bench_mesh(name, mesh, field, iso, tmp, with_vtk, quick, repeat, light=False
     tets = info["tets"]
     res = {"name": name, "vertices": info["vertices"], "tets": tets, "field": field, "repeat": repeat}
     # Pack time to 5% of the tets (median of `repeat` packs), and VTK's decimation to the same
-    # count, the runs alternating so that both tools meet the machine at the same speed (it drifts
-    # by 10-30% from hour to hour, and our runs by 10-25% from minute to minute).
+    # count, the runs alternating so that both tools meet the machine at the same speed (a shared
+    # machine's speed drifts from hour to hour).
     target = int(0.05 * tets)
     packs, vtk5 = [], []
     for _ in range(repeat):

@@ -1,11 +1,11 @@
 #!/usr/bin/env node
-// Streaming figures over a simulated slow link (issue 4): the project's server with a bandwidth
-// cap shared by all responses and a latency before each response, the viewer in headless
+// Streaming figures over a simulated slow link (docs/benchmarks.md): the project's server with a
+// bandwidth cap shared by all responses and a latency before each response, the viewer in headless
 // Chromium (SwiftShader: software WebGL, so frame times are those of a machine without a GPU).
 //
 //   node tests/bench/stream_bench.mjs [--rate 10mbit] [--latency 50] [--n 64] [--runs 1] [--timeline]
 //
-// For Harmonic N³ and the real post.vtk (../shared/datasets/vtk-data, when present) it reports:
+// For Harmonic N³ and the real post.vtk (postVtk below, when present) it reports:
 //   first surface   ms from navigation start to the first frame drawn with an isosurface,
 //                   everything included (html, scripts, wasm download and compile, manifest,
 //                   base chunk, WebGL set-up)
