@@ -1,4 +1,4 @@
-// Measurements behind the README's figures for the progressive engine (never run as a test):
+// Measurements behind docs/benchmarks.md for the progressive engine (never run as a test):
 //   tetstream_bench error ORIGINAL.vtu APPROX.vtu --field F
 //       field error of APPROX sampled at ORIGINAL's vertices (RMS, max, relative to the range),
 //       and boundary preservation (volume ratio, bounding box)
