@@ -12,7 +12,7 @@
 namespace tetstream {
 
 inline constexpr uint32_t kFormatVersion = 1;
-inline constexpr const char* kLibraryVersion = "0.2.0";
+inline constexpr const char* kLibraryVersion = "0.3.0";
 
 // The most a chunk of `bytes` compressed bytes may declare after decompression: zstd on mesh
 // data gives 2-5x, so 64x (+1 MiB for tiny chunks), and never more than 1 GiB. Guards the

@@ -15,7 +15,7 @@ done
 # The browser over a simulated 10 Mbit/s, 50 ms link (medians of 3 loads), and its timeline plot.
 node tests/bench/stream_bench.mjs --runs 3
 /usr/bin/python3 tests/bench/plot_timeline.py
-# The README shows the latest plots.
+# docs/benchmarks.md shows the latest plots.
 mkdir -p docs/bench
 cp build/bench/rate_distortion.png build/bench/timeline.png docs/bench/
 echo "bench: results in build/bench/ (results.md, results.json, stream.json); plots copied to docs/bench/"

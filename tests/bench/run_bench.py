@@ -39,7 +39,8 @@ CHECK = os.path.join(ROOT, "build/native/tetstream_core_check")
 CHECK_WASM = os.path.join(ROOT, "build/wasm/tetstream_core_check.js")
 VTK_SCRIPT = os.path.join(ROOT, "tests/bench/vtk_decimate.py")
 VTK_CONTOUR = os.path.join(ROOT, "tests/bench/vtk_contour.py")
-DATASETS = os.path.join(ROOT, "..", "shared", "datasets", "vtk-data")
+# The real meshes (post.vtk, carotid.vtk, ...): a folder named by TETSTREAM_DATASETS; skipped when absent.
+DATASETS = os.environ.get("TETSTREAM_DATASETS", os.path.join(ROOT, "datasets"))
 OUT = os.path.join(ROOT, "build", "bench")
 
 

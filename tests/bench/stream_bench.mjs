@@ -34,7 +34,8 @@ const latencyMs = parseMs(opt('latency', '50'));
 const n = Number(opt('n', '64'));
 const runs = Number(opt('runs', '1'));
 const outDir = path.join(root, 'build/bench/stream');
-const postVtk = path.join(root, '..', 'shared', 'datasets', 'vtk-data', 'post.vtk');
+// The real meshes live in the folder named by TETSTREAM_DATASETS (skipped when absent).
+const postVtk = path.join(process.env.TETSTREAM_DATASETS || path.join(root, 'datasets'), 'post.vtk');
 
 // Packs once into build/bench/stream/NAME (kept between runs: packing Harmonic 64 takes ~10 s).
 function packed(name, makeInput, packArgs = []) {
