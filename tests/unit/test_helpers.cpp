@@ -128,6 +128,48 @@ bool haveMeshioPython() {
   return have;
 }
 
+// ------------------------------------------------------------------ cells
+
+double totalVolume(const TetMesh& m) {
+  double v = 0;
+  for (uint32_t t = 0; t < m.tetCount(); ++t) v += std::abs(tetVolume(m, t));
+  return v;
+}
+
+double boundaryArea(const TetMesh& m) {
+  FaceAdjacency adj;
+  buildFaceAdjacency(m.tets, m.vertexCount(), adj);
+  std::vector<uint32_t> tris;
+  extractBoundary(m.tets, adj, tris);
+  double area = 0;
+  for (size_t i = 0; i < tris.size(); i += 3) {
+    const float* a = &m.positions[3 * size_t(tris[i])];
+    const float* b = &m.positions[3 * size_t(tris[i + 1])];
+    const float* c = &m.positions[3 * size_t(tris[i + 2])];
+    double u[3], v[3];
+    for (int k = 0; k < 3; ++k) {
+      u[k] = double(b[k]) - a[k];
+      v[k] = double(c[k]) - a[k];
+    }
+    double x = u[1] * v[2] - u[2] * v[1], y = u[2] * v[0] - u[0] * v[2], z = u[0] * v[1] - u[1] * v[0];
+    area += 0.5 * std::sqrt(x * x + y * y + z * z);
+  }
+  return area;
+}
+
+// A conforming, valid mesh: every inner face shared by exactly two tets, a closed manifold
+// boundary, one orientation, no flat or duplicate tets, no unused vertices.
+void expectValid(const TetMesh& m, const std::string& what) {
+  ValidationReport v = validateMesh(m);
+  EXPECT_FALSE(v.fatal()) << what;
+  EXPECT_EQ(v.invertedTets, 0u) << what;
+  EXPECT_EQ(v.zeroVolumeTets, 0u) << what;
+  EXPECT_EQ(v.duplicateTets, 0u) << what;
+  EXPECT_EQ(v.unusedVertices, 0u) << what;
+  EXPECT_EQ(v.nonManifoldFaces, 0u) << what;
+  EXPECT_EQ(v.nonManifoldBoundaryEdges, 0u) << what;
+}
+
 // ------------------------------------------------------------------ packs and levels
 
 std::string tempDir(const std::string& name) { return suiteDir("progressive", name); }

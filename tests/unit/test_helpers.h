@@ -93,6 +93,16 @@ inline std::vector<uint8_t> loadBytes(const std::string& path) {
   return std::vector<uint8_t>(s.begin(), s.end());
 }
 
+// ------------------------------------------------------------------ cells (test_formats.cpp, test_cells.cpp)
+
+// Sum of the tets' unsigned volumes.
+double totalVolume(const TetMesh& m);
+// Area of the boundary surface (a split that does not conform leaves inner faces on it).
+double boundaryArea(const TetMesh& m);
+// A conforming, valid mesh: every inner face shared by exactly two tets, a closed manifold
+// boundary, one orientation, no flat or duplicate tets, no unused vertices.
+void expectValid(const TetMesh& m, const std::string& what);
+
 // ------------------------------------------------------------------ packs and levels
 // (test_pack_roundtrip.cpp, test_simplify*.cpp, test_split_stream.cpp, test_level_error.cpp,
 // test_renumber.cpp, test_dataset_level.cpp)
