@@ -5,7 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh
 
-echo "test: native unit tests"
+echo "test: native unit tests (labels fast and slow; npm run test:fast runs the fast ones only)"
 ctest --test-dir build/native --output-on-failure -j2
 
 # The same unit tests (fuzz corpus replay included) under AddressSanitizer + UBSan (the "asan"
