@@ -144,8 +144,8 @@ TEST(Simplify, BoundaryIsPreserved) {
 
 // The slabs' logs are merged into one: every prefix must still be a valid mesh, the last level
 // the input, and the coarse field no worse than with one queue for the whole mesh, at 5% of the
-// tets as the benchmarks compare. (Coarser, at 2.5% of the tets, one queue is 9% better since
-// the cost per removed tet of session 33; both are better than before it at either level.)
+// tets as the benchmarks compare. (Coarser, at 2.5% of the tets, one queue is 9% better with
+// the cost per removed tet; both are better with that cost than without it at either level.)
 TEST(Simplify, SlabsGiveValidLevelsAndTheSameQuality) {
   TetMesh m = harmonic(20);
   PackOptions o;
@@ -183,7 +183,7 @@ TEST(Simplify, GradedMeshKeepsTheFarFieldWhereIsosurfacesAre) {
   // Without the cost per removed tet (simplify.h): with it, this synthetic grid's vertices alone
   // keep its far field too (volume RMS 0.31 against 0.43 with the volume), but on Blunt Fin, the
   // real graded grid, the volume still keeps the isosurfaces 3.4× closer at 30% of its tets
-  // (session 33: 2.9e-5 against 9.6e-5 of the diagonal, mean over five isovalues).
+  // (2.9e-5 against 9.6e-5 of the diagonal, mean over five isovalues).
   so.removedTetsExponent = 0;
   SimplifyResult volume, count;
   ASSERT_TRUE(simplifyMesh(m, so, volume));
