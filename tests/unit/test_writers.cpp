@@ -107,7 +107,8 @@ TEST(VtuWriter, MeshioAndVtkReadOurFile) {
   EXPECT_EQ(nf, 2u);
 }
 
-// The paper-scale mesh (64^3 grid, 1.5M tets) writes and reads in a few seconds at most.
+// The paper-scale mesh (64^3 grid, 1.5M tets) writes and reads back exactly. The times are
+// recorded as test properties, not asserted: a busy machine must not fail the suite.
 TEST(VtuWriter, LargeMeshRoundTrip) {
   test::ScratchDir scratch("vtu-large");
   const std::string& dir = scratch.path;
@@ -126,8 +127,6 @@ TEST(VtuWriter, LargeMeshRoundTrip) {
   RecordProperty("write_ms", int(ms(t0, t1)));
   RecordProperty("read_ms", int(ms(t1, t2)));
   std::printf("[   info   ] 1.5M tets: write %.0f ms, read %.0f ms\n", ms(t0, t1), ms(t1, t2));
-  EXPECT_LT(ms(t0, t1), 10000);
-  EXPECT_LT(ms(t1, t2), 10000);
 }
 
 TEST(PlyWriter, WritesBinaryPlyWithNormals) {
