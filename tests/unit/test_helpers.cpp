@@ -30,7 +30,7 @@
 
 namespace tetstream::test {
 
-// ------------------------------------------------------------------ readers (test_readers.cpp)
+// ------------------------------------------------------------------ files and fixtures
 
 std::string fixturePath(const std::string& name) { return std::string(TETSTREAM_FIXTURES) + "/" + name; }
 

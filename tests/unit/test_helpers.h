@@ -14,7 +14,7 @@
 
 namespace tetstream::test {
 
-// ------------------------------------------------------------------ readers (test_readers.cpp)
+// ------------------------------------------------------------------ files and fixtures
 
 // Absolute path of a file in tests/fixtures (TETSTREAM_FIXTURES).
 std::string fixturePath(const std::string& name);
