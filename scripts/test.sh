@@ -5,15 +5,15 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh
 
-echo "test: native unit tests"
+echo "test: native unit tests (labels fast and slow; npm run test:fast runs the fast ones only)"
 ctest --test-dir build/native --output-on-failure -j2
 
-# The same unit tests (fuzz corpus replay included) under AddressSanitizer + UBSan (the "asan"
-# preset). TETSTREAM_SKIP_ASAN=1 skips it for quick local runs; CI always runs it.
+# The same tests (fuzz corpus replay and the golden pack included) under AddressSanitizer + UBSan
+# (the "asan" preset). TETSTREAM_SKIP_ASAN=1 skips it for quick local runs; CI always runs it.
 if [ "${TETSTREAM_SKIP_ASAN:-0}" != 1 ]; then
   echo "test: native unit tests under ASan + UBSan"
   cmake --preset asan >/dev/null
-  cmake --build build/asan -j"${JOBS:-2}" --target tetstream_tests
+  cmake --build build/asan -j"${JOBS:-2}" --target tetstream_tests tetstream
   ctest --preset asan -j2
 fi
 

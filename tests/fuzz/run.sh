@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (clang, ASan + UBSan) and fuzzes each for SECONDS (default 300),
 # starting from real inputs, then merges what raised coverage into tests/fuzz/corpus/TARGET
-# (committed; tests/unit/test_fuzz_corpus.cpp replays it on every npm test).
+# (committed; tests/unit/test_fuzz_corpus.cpp replays it on every npm test). Nothing else in the
+# tree is written: logs, work folders and findings stay in build/fuzz.
 #   bash tests/fuzz/run.sh [SECONDS] [TARGET ...]
 # Findings are written to build/fuzz/findings/TARGET/; fix them, then copy each input into the
 # target's corpus folder as a regression input (name it regress-WHAT).
@@ -53,14 +54,16 @@ for t in "${TARGETS[@]}"; do
     fi
   done
   ls "$found" | sed "s/^/  finding: /"
-  # The ledger adds up executions across sessions (the goal is counted over all the work).
-  execs=$(awk '/stat::number_of_executed_units/ {print $2}' build/fuzz/$t.log)
-  ran=$(grep -oE 'Done [0-9]+ runs in [0-9]+ second' build/fuzz/$t.log | awk '{print $5}' | tail -1)
-  printf '%s\t%s\t%s\t%s\t%s\n' "$(date -u +%FT%TZ)" "$t" "${ran:-$SECONDS_EACH}" "${execs:-0}" "$(ls "$found" | wc -l)" >> tests/fuzz/executions.tsv
-  # Keep a minimal set that covers what the whole work folder covers.
+  # Keep a minimal set that covers every edge the whole work folder covers. Edges only
+  # (-use_counters=0): with hit counts as features the merge keeps nearly every input. The work
+  # folder, with all of them, stays in build/fuzz for the next run.
   mkdir -p "$corpus.new"
-  build/fuzz/fuzz-"$t" -merge=1 "$corpus.new" "$corpus" "$work" "$seeds" 2>/dev/null >/dev/null
-  cp "$corpus"/regress-* "$corpus.new"/ 2>/dev/null || true  # past findings stay, whatever they cover
+  build/fuzz/fuzz-"$t" -merge=1 -use_counters=0 "$corpus.new" "$corpus" "$work" "$seeds" 2>/dev/null >/dev/null
+  for f in "$corpus"/regress-*; do  # past findings stay, whatever they cover, once, by name
+    [ -e "$f" ] || continue
+    rm -f "$corpus.new/$(sha1sum "$f" | cut -c1-40)"
+    cp "$f" "$corpus.new"/
+  done
   rm -rf "$corpus" && mv "$corpus.new" "$corpus"
   # The corpus is committed: keep the smallest inputs up to CORPUS_KB (regression inputs always).
   budget=$(( ${CORPUS_KB:-400} * 1024 )) used=0

@@ -22,7 +22,7 @@ std::string tempDir(const std::string& name) { return test::suiteDir("format", n
 TetMesh harmonic(uint32_t n) { return test::harmonicMesh(n); }
 
 // The whole mesh as one exact base chunk (no simplification, no quantization): the tests here
-// are about the container; test_progressive.cpp covers the split stream.
+// are about the container; test_pack_roundtrip.cpp and test_split_stream.cpp cover the split stream.
 PackOptions wholeMesh() {
   PackOptions o;
   o.baseFraction = 1.0;

@@ -8,10 +8,13 @@
 #include "manifest.h"
 #include "mesh.h"
 #include "pack/mesh_io.h"
+#include "pack/packer.h"
+#include "pack/simplify.h"
+#include "quantize.h"
 
 namespace tetstream::test {
 
-// ------------------------------------------------------------------ readers (test_readers.cpp)
+// ------------------------------------------------------------------ files and fixtures
 
 // Absolute path of a file in tests/fixtures (TETSTREAM_FIXTURES).
 std::string fixturePath(const std::string& name);
@@ -89,5 +92,63 @@ inline std::vector<uint8_t> loadBytes(const std::string& path) {
   std::string s = loadFile(path);
   return std::vector<uint8_t>(s.begin(), s.end());
 }
+
+// ------------------------------------------------------------------ cells (test_formats.cpp, test_cells.cpp)
+
+// Sum of the tets' unsigned volumes.
+double totalVolume(const TetMesh& m);
+// Area of the boundary surface (a split that does not conform leaves inner faces on it).
+double boundaryArea(const TetMesh& m);
+// A conforming, valid mesh: every inner face shared by exactly two tets, a closed manifold
+// boundary, one orientation, no flat or duplicate tets, no unused vertices.
+void expectValid(const TetMesh& m, const std::string& what);
+
+// ------------------------------------------------------------------ packs and levels
+// (test_pack_roundtrip.cpp, test_simplify*.cpp, test_split_stream.cpp, test_level_error.cpp,
+// test_renumber.cpp, test_dataset_level.cpp)
+
+// A fresh folder `name` in the scratch folder of the packing tests.
+std::string tempDir(const std::string& name);
+inline TetMesh harmonic(uint32_t n) { return harmonicMesh(n); }
+inline uint32_t gridVertex(uint32_t n, uint32_t i, uint32_t j, uint32_t k) { return i + n * (j + n * k); }
+
+// Chunk `info` of the pack in `dir`, decompressed (empty when that fails).
+std::vector<uint8_t> rawChunk(const std::string& dir, const ChunkInfo& info);
+
+// Harmonic n³ without the tets whose centroid `drop` selects, and without the vertices no
+// tet uses any more.
+TetMesh carved(uint32_t n, bool (*drop)(const float* centroid));
+// The octant x, y, z > 0 removed: a non-convex domain with concave creases.
+TetMesh lShape(uint32_t n);
+
+// The simplifier's result as a mesh (all input vertices kept, the surviving tets).
+TetMesh baseMeshOf(const TetMesh& m, const SimplifyResult& r);
+// The coarsest level as the simplifier leaves it: alive vertices and tets, the steering field's
+// values as fitted.
+TetMesh coarseMesh(const TetMesh& in, const SimplifyResult& r);
+
+// V − E + F of the boundary surface: 2 for a ball-shaped domain, 0 for one with a tunnel.
+long boundaryEuler(const TetMesh& m);
+double meshVolume(const TetMesh& m);
+
+// Packs m into tempDir(name) at zstd level 3 (expects success); returns the folder.
+std::string pack(const std::string& name, const TetMesh& m, PackOptions o, PackSummary* summary = nullptr);
+
+// Asserts what FORMAT.md promises for every level.
+void expectValidLevel(const TetMesh& m, const std::string& what);
+// Compares the fully refined mesh with the input: same vertex set (positions to within half a
+// grid step per coordinate, or bit-exact) and the same tets with the same orientation.
+void expectSameMesh(const TetMesh& in, const TetMesh& out, const Quantizer& q, bool exact);
+// Two packed folders hold the same bytes: manifest and every chunk file.
+void expectSamePack(const std::string& a, const std::string& b);
+// Packs m in small chunks, simplified all the way, and checks every prefix: valid, counts as
+// the manifest says, field error not growing; the last level is the input.
+void roundTrip(const std::string& name, const TetMesh& m, PackOptions o);
+
+// By brute force, the coarse tet that holds p best (largest smallest barycentric coordinate,
+// returned) and p's barycentric coordinates in it.
+double bestTet(const TetMesh& coarse, const float* p, uint32_t& tet, double w[4]);
+// RMS over the input's vertices of (coarse field interpolated there − input value).
+double fieldRms(const TetMesh& in, const TetMesh& coarse, int field);
 
 }  // namespace tetstream::test
