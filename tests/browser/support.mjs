@@ -133,7 +133,7 @@ export async function waitForLevel(page, timeout = 120000) {
   return page.evaluate(() => window.tetstream.stats());
 }
 
-// Refinement and interval tree work run in slices of 8 ms (4 while the user drags: wasm/main.cpp);
+// Refinement and interval tree work run in slices of 8 ms (4 while the user drags: wasm/platform.cpp);
 // issue 3 allows a frame no more than ~30 ms of it. A single slice over that is the OS or the
 // browser taking the core on a busy machine, which no budget prevents: one was 70 ms in a run
 // whose other slices were 8-27 ms. A budget that does not hold shows in many slices.
