@@ -74,7 +74,7 @@ class HullTracker {
   SurfaceVertexMap lineOfEdge_;
 
   std::vector<uint64_t> dirtyEdges_;
-  std::vector<FaceEntry> entries_;        // recount scratch
+  std::vector<FaceEntry> entries_;                               // recount scratch
   std::vector<uint32_t> vertexScratch_, dropScratch_, touched_;  // update scratch
   std::vector<uint32_t> changedTriangles_, changedLines_;
   bool fullUpload_ = false;

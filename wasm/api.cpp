@@ -51,7 +51,7 @@ EMSCRIPTEN_KEEPALIVE void ts_set_memory_limit(double megabytes) {
 EMSCRIPTEN_KEEPALIVE int ts_open_manifest(const char* json, int len) {
   requestRedraw();
   if (!g_app.canvas.platformError.empty()) return 0;  // nothing could be shown; keep that error visible
-  g_app.view.pinned = false;  // a new dataset is framed unless the page sets a view again
+  g_app.view.pinned = false;                          // a new dataset is framed unless the page sets a view again
   if (!json || len < 0) return 0;
   ViewerState& s = g_app.state;
   if (!s.memory.limitBytes) ts_set_memory_limit(0);
@@ -85,10 +85,14 @@ EMSCRIPTEN_KEEPALIVE int ts_offer_chunk(int index, uint8_t* bytes, int len) {
   const ChunkCheck c = offerChunk(g_app.state, uint32_t(index), bytes, size_t(len));
   workOnChange();
   switch (c) {
-    case ChunkCheck::Ok: return 1;
-    case ChunkCheck::WrongSize: return 2;
-    case ChunkCheck::WrongHash: return 3;
-    case ChunkCheck::NoSuchChunk: return 0;
+    case ChunkCheck::Ok:
+      return 1;
+    case ChunkCheck::WrongSize:
+      return 2;
+    case ChunkCheck::WrongHash:
+      return 3;
+    case ChunkCheck::NoSuchChunk:
+      return 0;
   }
   return 0;
 }

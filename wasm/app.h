@@ -40,8 +40,8 @@ struct Drag {
 
 // When to draw, and the work slices between frames.
 struct FramePacing {
-  int redrawFrames = 2;           // frames still to draw; 0 = idle, nothing changed
-  GLsync gpuFence = nullptr;      // after the last drawn frame: signalled once the GPU has done it
+  int redrawFrames = 2;       // frames still to draw; 0 = idle, nothing changed
+  GLsync gpuFence = nullptr;  // after the last drawn frame: signalled once the GPU has done it
   double fenceSince = 0;
   double lastFrameStart = -1;     // emscripten_get_now() of the previous frame callback
   double lastDrawStart = -1;      // ... of the previous frame that drew

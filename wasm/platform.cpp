@@ -16,6 +16,7 @@
 #include <string>
 
 #include "app.h"
+#include "frame_policy.h"
 #include "backends/imgui_impl_glfw.h"
 #include "backends/imgui_impl_opengl3.h"
 #include "imgui.h"
@@ -41,12 +42,9 @@ constexpr double kProgressRedrawMs = 250.0;
 // on (~100 ms a frame for Harmonic 64 in SwiftShader), so a level that is only refining, with
 // nobody touching the view, is redrawn at most this often; input still redraws at once.
 constexpr double kSoftwareRefineRedrawMs = 200.0;
-// ... and such a frame, or one while the user drags, draws its scene with at most this many
-// pixels, scaled up to the canvas (as ParaView renders while interacting); the first frame after
-// is drawn at full resolution. The GPU process's fragment work is what competes with refinement
-// for the CPU: Harmonic 64 over 10 Mbit/s in SwiftShader refined at 73-91k splits/s in a
-// 1280x800 window, 126-131k in a 640x400 one.
-constexpr double kReducedPixels = 640.0 * 400.0;
+// ... and such a frame, or one while the user drags, draws its scene smaller (frame_policy.h).
+// Harmonic 64 over 10 Mbit/s in SwiftShader refined at 73-91k splits/s in a 1280x800 window,
+// 126-131k in a 640x400 one.
 
 }  // namespace
 
@@ -216,7 +214,7 @@ namespace {
 // ---------------------------------------------------------------- drawing
 bool interacting();  // below, with the refinement slices
 
-// Whether a software GL draws this frame's scene at reduced resolution (see kReducedPixels).
+// Whether a software GL draws this frame's scene at reduced resolution (frame_policy.h).
 bool reducedWanted(const ViewerState& s) { return g_app.canvas.softwareGl && (refining(s) || interacting()); }
 
 void drawFrame() {
@@ -282,12 +280,12 @@ void drawFrame() {
   p.colourMax = s.colour.max;
   p.showSlice = s.sliceOn;
   setColourMap(a.renderer, s.colour.map);
-  float scale = 1.f;
-  if (!a.pacing.captureRequested && reducedWanted(s))
-    scale = float(std::min(1.0, std::sqrt(kReducedPixels / (double(a.canvas.width) * a.canvas.height))));
+  const bool busy = refining(s) || interacting();
+  const float scale = sceneScale(a.canvas.softwareGl, busy, a.pacing.captureRequested, a.canvas.width, a.canvas.height);
   drawSceneScaled(a.renderer, p, scale);
   a.pacing.reducedShown = scale < 1.f;
   s.telemetry.reducedFrames += a.pacing.reducedShown ? 1 : 0;
+  s.telemetry.busyFrames += busy && !a.pacing.captureRequested ? 1 : 0;
   ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
   if (a.pacing.captureRequested) {
     // Read back in the same task as the drawing (the drawing buffer is not preserved after).

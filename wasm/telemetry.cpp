@@ -1,7 +1,6 @@
 #include "telemetry.h"
 
 #include <algorithm>
-
 #include <nlohmann/json.hpp>
 
 #include "viewer_state.h"
@@ -13,7 +12,8 @@ std::string statsJson(const ViewerState& s) {
   const Dataset& ds = s.dataset;
   const Manifest& m = ds.manifest;
   json fields = json::array();
-  for (const FieldInfo& f : m.fields) fields.push_back(json{{"name", f.name}, {"min", f.range.min}, {"max", f.range.max}});
+  for (const FieldInfo& f : m.fields)
+    fields.push_back(json{{"name", f.name}, {"min", f.range.min}, {"max", f.range.max}});
   auto rect = [](const Rect& r) { return json{{"x", r.x}, {"y", r.y}, {"w", r.w}, {"h", r.h}}; };
   auto time = [](double t) { return t >= 0 ? json(t) : json(nullptr); };
   uint32_t splitsTotal = 0;
@@ -33,11 +33,12 @@ std::string statsJson(const ViewerState& s) {
       {"colourField", s.colour.field >= 0 ? json(m.fields[size_t(s.colour.field)].name) : json(nullptr)},
       {"colourMap", colourMapName(s.colour.map)},
       {"colourRange", json::array({s.colour.min, s.colour.max})},
-      {"slice", {{"on", s.sliceOn},
-                 {"normal", json::array({s.slice.normal()[0], s.slice.normal()[1], s.slice.normal()[2]})},
-                 {"offset", s.slice.offset()},
-                 {"triangles", s.slice.surface().triangleCount()},
-                 {"area", s.slice.surface().area()}}},
+      {"slice",
+       {{"on", s.sliceOn},
+        {"normal", json::array({s.slice.normal()[0], s.slice.normal()[1], s.slice.normal()[2]})},
+        {"offset", s.slice.offset()},
+        {"triangles", s.slice.surface().triangleCount()},
+        {"area", s.slice.surface().area()}}},
       {"fields", std::move(fields)},
       {"chunksReceived", ds.chunksReceived},
       {"chunksApplied", ds.chunksApplied()},
@@ -76,6 +77,7 @@ std::string statsJson(const ViewerState& s) {
       {"maxDrawMs", s.telemetry.maxDrawMs},
       {"drawTotalMs", s.telemetry.drawTotalMs},
       {"reducedFrames", s.telemetry.reducedFrames},
+      {"busyFrames", s.telemetry.busyFrames},
       {"softwareGl", s.telemetry.softwareGl},
       {"samples", s.telemetry.samples},
       {"contextLost", s.contextLost},
@@ -93,7 +95,8 @@ std::string statsJson(const ViewerState& s) {
         {"gpuBytes", s.memory.gpuBytes},
         {"limitBytes", s.memory.limitBytes ? json(s.memory.limitBytes) : json(nullptr)},
         {"neededBytes", s.memory.neededBytes},
-        {"allowedBytes", s.memory.chunksAllowed ? s.memory.baseBytes + estimateLevelBytes(m, s.memory.chunksAllowed) : 0}}},
+        {"allowedBytes",
+         s.memory.chunksAllowed ? s.memory.baseBytes + estimateLevelBytes(m, s.memory.chunksAllowed) : 0}}},
       {"sliderRect", rect(s.telemetry.screen.slider)},
       {"levelSliderRect", rect(s.telemetry.screen.levelSlider)},
       {"pauseButtonRect", rect(s.telemetry.screen.pauseButton)},

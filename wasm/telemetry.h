@@ -44,12 +44,13 @@ struct Telemetry {
 
   // Set by the frame loop, counted from the first surface on (before it, start-up work such as
   // WebGL and ImGui set-up is not the viewer's frame rate).
-  double frameMs = 0;        // smoothed interval between frame callbacks
-  double maxFrameMs = 0;     // longest frame callback (uploads, drawing, UI)
-  double maxFrameGapMs = 0;  // longest interval between two frame callbacks (browser included)
+  double frameMs = 0;                // smoothed interval between frame callbacks
+  double maxFrameMs = 0;             // longest frame callback (uploads, drawing, UI)
+  double maxFrameGapMs = 0;          // longest interval between two frame callbacks (browser included)
   double drawMs = 0, maxDrawMs = 0;  // the last / longest drawn frame's callback
   double drawTotalMs = 0;            // all drawn frames' callbacks so far
   uint32_t reducedFrames = 0;        // frames whose scene was drawn at reduced resolution (software GL)
+  uint32_t busyFrames = 0;           // frames drawn while refining or interacting (screenshots aside)
   bool softwareGl = false;           // SwiftShader & co
   int samples = 0;                   // multisampling of the scene (0: none)
   uint64_t uploadBytes = 0;          // GPU bytes uploaded in all (renderer)

@@ -18,6 +18,7 @@
 
 #include "adjacency.h"
 #include "camera.h"
+#include "frame_policy.h"
 #include "pack/chunk_encode.h"
 #include "pack/generators.h"
 #include "pack/packer.h"
@@ -656,6 +657,17 @@ TEST(ViewerState, ChunksAreCheckedWithoutSideEffects) {
   EXPECT_EQ(s.dataset.chunksReceived, 0u);
   setNetwork(s, {.notice = "connection lost, retrying part 2 in 4 s"});
   EXPECT_EQ(stats(s)["notice"], "connection lost, retrying part 2 in 4 s");
+}
+
+// A software GL draws the scene smaller while the level refines or the user interacts (never a
+// screenshot), at most kReducedPixels, and at full size otherwise.
+TEST(ViewerState, SceneIsReducedOnASoftwareGlWhileBusy) {
+  EXPECT_FLOAT_EQ(sceneScale(true, true, false, 1280, 800), 0.5f);
+  EXPECT_EQ(sceneScale(false, true, false, 1280, 800), 1.f) << "a GPU draws full size";
+  EXPECT_EQ(sceneScale(true, false, false, 1280, 800), 1.f) << "the still frame";
+  EXPECT_EQ(sceneScale(true, true, true, 1280, 800), 1.f) << "a screenshot";
+  EXPECT_EQ(sceneScale(true, true, false, 640, 400), 1.f) << "small enough already";
+  EXPECT_EQ(sceneScale(true, true, false, 0, 0), 1.f);
 }
 
 TEST(ViewerState, CameraFramesTheBoundingBox) {
