@@ -16,9 +16,9 @@
 #include <string>
 
 #include "app.h"
-#include "frame_policy.h"
 #include "backends/imgui_impl_glfw.h"
 #include "backends/imgui_impl_opengl3.h"
+#include "frame_policy.h"
 #include "imgui.h"
 #include "panel.h"
 

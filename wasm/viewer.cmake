@@ -1,7 +1,9 @@
 # Browser viewer (Emscripten only; included from the root CMakeLists.txt).
 #   tetstream_imgui   Dear ImGui 1.86 + GLFW and OpenGL3 backends (sources in build/_deps/imgui)
 #   tetstream_viewer  tetstream.js + tetstream.wasm in ${TETSTREAM_WEB_DIR}, plus every file of web/
-# The viewer's model (viewer_state, camera) has no GL and no Emscripten and also compiles natively.
+# platform.cpp and api.cpp are the only viewer files with Emscripten (and imgui_gl_queries.cpp);
+# the model (viewer_state, viewer_memory, telemetry, colourmap, camera, frame_policy.h) has no GL
+# and no Emscripten and also compiles natively, for the unit tests.
 
 set(TETSTREAM_IMGUI_DIR "${TETSTREAM_DEPS_DIR}/imgui")
 if(NOT EXISTS "${TETSTREAM_IMGUI_DIR}/imgui.cpp")
