@@ -31,8 +31,10 @@ struct ChunkDecoder {
 
 // Checks size and hash against `info`, decompresses, checks the chunk header (magic, version,
 // kind, index). On success `payload` views the bytes after the header inside `dec.raw`.
+// hashChecked: the caller has compared these bytes' content hash already (hashing is the
+// costliest check, and the viewer checks a chunk as it arrives).
 Result openChunk(ChunkDecoder& dec, const ChunkInfo& info, uint32_t index, std::span<const uint8_t> file,
-                 std::span<const uint8_t>& payload);
+                 std::span<const uint8_t>& payload, bool hashChecked = false);
 
 // Parses a base-mesh payload into `out` (replacing its contents) and checks every rule of
 // FORMAT.md §3 against the manifest. On failure `out` is left empty.

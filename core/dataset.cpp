@@ -57,13 +57,13 @@ Result openDataset(Dataset& ds, std::string_view manifestJson) {
   return Result::success();
 }
 
-Result receiveChunk(Dataset& ds, uint32_t index, std::span<const uint8_t> file) {
+Result receiveChunk(Dataset& ds, uint32_t index, std::span<const uint8_t> file, bool hashChecked) {
   if (index != ds.chunksReceived || index >= ds.manifest.chunks.size())
     return fail(Status::BadArgument, "chunk " + std::to_string(index) + " received out of order (next is " +
                                          std::to_string(ds.chunksReceived) + ")");
   const ChunkInfo& info = ds.manifest.chunks[index];
   std::span<const uint8_t> payload;
-  if (Result r = openChunk(ds.decoder, info, index, file, payload); !r) return r;
+  if (Result r = openChunk(ds.decoder, info, index, file, payload, hashChecked); !r) return r;
   if (info.kind == ChunkKind::Base) {
     TetMesh mesh;
     if (Result r = decodeBaseMesh(payload, ds.manifest, mesh); !r) return r;

@@ -49,7 +49,8 @@ Result openDataset(Dataset& ds, std::string_view manifestJson);
 
 // Verifies chunk `index`, which must be the next one (ds.chunksReceived). The base chunk is
 // applied at once; a split chunk is kept for stepTowards. On failure nothing changes.
-Result receiveChunk(Dataset& ds, uint32_t index, std::span<const uint8_t> file);
+// hashChecked: as openChunk's.
+Result receiveChunk(Dataset& ds, uint32_t index, std::span<const uint8_t> file, bool hashChecked = false);
 
 // Applies (or undoes) up to `maxSteps` splits toward `targetSplits` (clamped to the splits
 // received). Appends the ids of changed tets (see progressive.h; removed tets are those with

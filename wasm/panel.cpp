@@ -19,21 +19,6 @@ std::string grouped(uint64_t n) {
   return s;
 }
 
-std::string megabytes(uint64_t bytes) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, bytes < 10u << 20 ? "%.2f MB" : "%.1f MB", double(bytes) / (1 << 20));
-  return buf;
-}
-
-std::string rate(double bytesPerSec) {
-  char buf[32];
-  if (bytesPerSec >= 1 << 20)
-    std::snprintf(buf, sizeof buf, "%.1f MB/s", bytesPerSec / (1 << 20));
-  else
-    std::snprintf(buf, sizeof buf, "%.0f KB/s", bytesPerSec / 1024);
-  return buf;
-}
-
 std::string duration(double seconds) {
   char buf[32];
   if (seconds < 90)
@@ -76,38 +61,39 @@ void downloadSection(ViewerState& s, float width, float pixelsPerCssPixel) {
   const uint64_t total = ds.manifest.totalBytes();
   const bool allReceived = ds.chunksReceived == s.chunksTotal;
   section("download");
-  if (s.state == LoadState::Loading && !s.paused)
+  const NetworkStatus& net = s.network;
+  if (s.state == LoadState::Loading && !net.paused)
     ImGui::TextUnformatted("loading the base mesh...");
   else if (allReceived)
     ImGui::Text("all %u parts received", s.chunksTotal);
   else
     ImGui::Text("%u of %u parts received", ds.chunksReceived, s.chunksTotal);
 
-  const uint64_t have = allReceived ? ds.bytesReceived : std::max(s.datasetBytes, ds.bytesReceived);
-  std::string label = megabytes(have) + " of " + megabytes(total);
+  const uint64_t have = allReceived ? ds.bytesReceived : std::max(net.receivedBytes, ds.bytesReceived);
+  std::string label = formatBytes(have) + " of " + formatBytes(total);
   ImGui::ProgressBar(total ? float(double(have) / double(total)) : 0.f, ImVec2(width, 0), label.c_str());
 
-  s.pauseButtonRect = {};
-  if (!s.notice.empty() && s.state != LoadState::Error) coloredWrapped(kWarning, s.notice);
+  s.telemetry.screen.pauseButton = {};
+  if (!net.notice.empty() && s.state != LoadState::Error) coloredWrapped(kWarning, net.notice);
   if (allReceived || s.state == LoadState::Error) return;
   // One line that is always there, so the button below does not move under the mouse.
-  if (s.paused) {
+  if (net.paused) {
     ImGui::TextUnformatted("download paused");
   } else {
-    double left = secondsLeft(s);
-    std::string line = s.rateBytesPerSec > 0 ? rate(s.rateBytesPerSec) : std::string("waiting for data");
+    const double left = net.secondsLeft;
+    std::string line = net.bytesPerSecond > 0 ? formatBytes(uint64_t(net.bytesPerSecond)) + "/s" : std::string("waiting for data");
     if (left >= 1)
       line += ", about " + duration(left) + " left";
     else if (left >= 0)
       line += ", less than a second left";
     ImGui::TextUnformatted(line.c_str());
   }
-  if (ImGui::Button(s.paused ? "resume download" : "pause download")) setPaused(s, !s.paused);
+  if (ImGui::Button(net.paused ? "resume download" : "pause download")) requestPauseToggle(s);
   ImVec2 lo = ImGui::GetItemRectMin(), hi = ImGui::GetItemRectMax();
   const float k = 1.f / pixelsPerCssPixel;
-  s.pauseButtonRect = {lo.x * k, lo.y * k, (hi.x - lo.x) * k, (hi.y - lo.y) * k};
+  s.telemetry.screen.pauseButton = {lo.x * k, lo.y * k, (hi.x - lo.x) * k, (hi.y - lo.y) * k};
   if (ImGui::IsItemHovered())
-    ImGui::SetTooltip(s.paused ? "Downloads the remaining parts."
+    ImGui::SetTooltip(net.paused ? "Downloads the remaining parts."
                                : "Stops downloading at once. What has arrived is still applied\n"
                                  "up to the level chosen below.");
 }
@@ -118,7 +104,7 @@ void levelSection(ViewerState& s, float width, float pixelsPerCssPixel) {
   section("level of detail");
   // The slider sets the target in splits, from the base (0) to the newest split received.
   const uint32_t received = ds.splitsReceived();
-  uint32_t target = std::min(s.targetSplits, received);
+  uint32_t target = std::min(s.level.targetSplits, received);
   const uint32_t zero = 0;
   const double targetFraction = m.vertices ? double(ds.pm.baseVertices + target) / m.vertices : 0;
   char format[64];
@@ -130,20 +116,20 @@ void levelSection(ViewerState& s, float width, float pixelsPerCssPixel) {
                           ImGuiSliderFlags_AlwaysClamp | ImGuiSliderFlags_NoInput))
     setLevel(s, target);
   ImGui::EndDisabled();
-  s.levelSliderRect = cssRect(pixelsPerCssPixel);
+  s.telemetry.screen.levelSlider = cssRect(pixelsPerCssPixel);
   ImGui::PopItemWidth();
 
   const uint32_t applied = ds.splitsApplied();
-  if (applied < std::min(s.targetSplits, received))
-    ImGui::Text("refining: %s splits to go", grouped(std::min(s.targetSplits, received) - applied).c_str());
-  else if (applied > s.targetSplits)
-    ImGui::Text("coarsening: %s splits to undo", grouped(applied - s.targetSplits).c_str());
-  else if (!s.live && ds.chunksReceived < s.chunksTotal && s.state != LoadState::Error)
+  if (applied < std::min(s.level.targetSplits, received))
+    ImGui::Text("refining: %s splits to go", grouped(std::min(s.level.targetSplits, received) - applied).c_str());
+  else if (applied > s.level.targetSplits)
+    ImGui::Text("coarsening: %s splits to undo", grouped(applied - s.level.targetSplits).c_str());
+  else if (!s.level.live && ds.chunksReceived < s.chunksTotal && s.state != LoadState::Error)
     ImGui::TextDisabled("held here; move to the right end to follow new data");
-  else if (!s.live)
+  else if (!s.level.live)
     ImGui::TextDisabled("held here");
   else if (ds.chunksReceived < s.chunksTotal && s.state != LoadState::Error)
-    ImGui::TextDisabled(s.paused ? "follows new data once the download resumes" : "follows new data as it arrives");
+    ImGui::TextDisabled(s.network.paused ? "follows new data once the download resumes" : "follows new data as it arrives");
 
   const uint32_t nv = ds.pm.mesh.vertexCount(), nt = ds.pm.mesh.tetCount();
   char pct[32];
@@ -187,18 +173,18 @@ void memorySection(const ViewerState& s) {
   lastSliceOn = int(s.sliceOn);
   ImGui::Spacing();
   if (!ImGui::TreeNodeEx("memory", ImGuiTreeNodeFlags_NoTreePushOnOpen)) return;
-  row("in use", formatBytes(memoryInUse(s)) + " (page heap " + formatBytes(s.heapBytes) + ")");
-  row("on the GPU", formatBytes(s.gpuBytes));
+  row("in use", formatBytes(memoryInUse(s)) + " (page heap " + formatBytes(s.memory.heapBytes) + ")");
+  row("on the GPU", formatBytes(s.memory.gpuBytes));
   if (s.chunksTotal == 0) return;
-  std::string need = "about " + formatBytes(s.memoryNeededBytes);
-  if (s.memoryLimitBytes) need += ", limit " + formatBytes(s.memoryLimitBytes);
+  std::string need = "about " + formatBytes(s.memory.neededBytes);
+  if (s.memory.limitBytes) need += ", limit " + formatBytes(s.memory.limitBytes);
   row("full dataset", need);
-  if (s.chunksAllowed < s.chunksTotal && s.state != LoadState::Error && s.chunksAllowed > 0) {
+  if (s.memory.chunksAllowed < s.chunksTotal && s.state != LoadState::Error && s.memory.chunksAllowed > 0) {
     const Manifest& m = s.dataset.manifest;
     char buf[160];
     std::snprintf(buf, sizeof buf, "Too big for this page: streaming will stop after part %u of %u (%.1f%% of the vertices).",
-                  s.chunksAllowed, s.chunksTotal,
-                  m.vertices ? 100.0 * m.chunks[s.chunksAllowed - 1].vertices / m.vertices : 0.0);
+                  s.memory.chunksAllowed, s.chunksTotal,
+                  m.vertices ? 100.0 * m.chunks[s.memory.chunksAllowed - 1].vertices / m.vertices : 0.0);
     coloredWrapped(kWarning, buf);
   }
 }
@@ -212,8 +198,8 @@ void colourBar(const ViewerState& s, float width, float pixelsPerCssPixel) {
   const ImVec2 lo(p.x + inset, p.y);
   constexpr int kBands = 64;
   for (int i = 0; i < kBands; ++i) {
-    auto c0 = mapColour(s.colourMap, float(i) / kBands, 0, 1);
-    auto c1 = mapColour(s.colourMap, float(i + 1) / kBands, 0, 1);
+    auto c0 = mapColour(s.colour.map, float(i) / kBands, 0, 1);
+    auto c1 = mapColour(s.colour.map, float(i + 1) / kBands, 0, 1);
     ImU32 a = ImGui::ColorConvertFloat4ToU32(ImVec4(c0[0], c0[1], c0[2], 1));
     ImU32 b = ImGui::ColorConvertFloat4ToU32(ImVec4(c1[0], c1[1], c1[2], 1));
     dl->AddRectFilledMultiColor(ImVec2(lo.x + w * i / kBands, lo.y), ImVec2(lo.x + w * (i + 1) / kBands + 0.5f, lo.y + h), a, b, b, a);
@@ -224,7 +210,7 @@ void colourBar(const ViewerState& s, float width, float pixelsPerCssPixel) {
     const float x = lo.x + w * k / 4;
     dl->AddLine(ImVec2(x, lo.y + h), ImVec2(x, lo.y + h + 0.35f * fs), text);
     char buf[32];
-    std::snprintf(buf, sizeof buf, "%.4g", s.colourMin + (s.colourMax - s.colourMin) * k / 4.f);
+    std::snprintf(buf, sizeof buf, "%.4g", s.colour.min + (s.colour.max - s.colour.min) * k / 4.f);
     const float tw = ImGui::CalcTextSize(buf).x;
     dl->AddText(ImVec2(x - 0.5f * tw, lo.y + h + 0.4f * fs), text, buf);
   }
@@ -236,21 +222,21 @@ void colourSection(ViewerState& s, float width, float pixelsPerCssPixel) {
   const Manifest& m = s.dataset.manifest;
   section("colour");
   ImGui::PushItemWidth(width - ImGui::GetFontSize() * 5.5f);
-  const char* current = s.colourField >= 0 ? m.fields[size_t(s.colourField)].name.c_str() : "none (two-sided)";
+  const char* current = s.colour.field >= 0 ? m.fields[size_t(s.colour.field)].name.c_str() : "none (two-sided)";
   if (ImGui::BeginCombo("colour by", current)) {
-    if (ImGui::Selectable("none (two-sided)", s.colourField < 0)) setColourField(s, -1);
+    if (ImGui::Selectable("none (two-sided)", s.colour.field < 0)) setColourField(s, -1);
     for (size_t i = 0; i < m.fields.size(); ++i)
-      if (ImGui::Selectable(m.fields[i].name.c_str(), int(i) == s.colourField)) setColourField(s, int(i));
+      if (ImGui::Selectable(m.fields[i].name.c_str(), int(i) == s.colour.field)) setColourField(s, int(i));
     ImGui::EndCombo();
   }
-  if (s.colourField >= 0) {
-    if (ImGui::BeginCombo("colour map", colourMapName(s.colourMap))) {
+  if (s.colour.field >= 0) {
+    if (ImGui::BeginCombo("colour map", colourMapName(s.colour.map))) {
       for (int i = 0; i < kColourMapCount; ++i)
-        if (ImGui::Selectable(colourMapName(ColourMap(i)), int(s.colourMap) == i)) setColourMap(s, ColourMap(i));
+        if (ImGui::Selectable(colourMapName(ColourMap(i)), int(s.colour.map) == i)) setColourMap(s, ColourMap(i));
       ImGui::EndCombo();
     }
-    float range[2] = {s.colourMin, s.colourMax};
-    const Range fr = m.fields[size_t(s.colourField)].range;
+    float range[2] = {s.colour.min, s.colour.max};
+    const Range fr = m.fields[size_t(s.colour.field)].range;
     const float speed = float(fr.max - fr.min) / 500.f;
     if (ImGui::DragFloat2("range", range, speed > 0 ? speed : 0.01f, 0, 0, "%.4g")) setColourRange(s, range[0], range[1]);
     ImGui::SameLine();
@@ -261,7 +247,7 @@ void colourSection(ViewerState& s, float width, float pixelsPerCssPixel) {
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("the field's whole range");
   }
   ImGui::PopItemWidth();
-  if (s.colourField >= 0) colourBar(s, width, pixelsPerCssPixel);
+  if (s.colour.field >= 0) colourBar(s, width, pixelsPerCssPixel);
 }
 
 // The slice: on/off, x/y/z or free orientation (two angles), and its position.
@@ -299,7 +285,7 @@ void sliceSection(ViewerState& s, float width, float pixelsPerCssPixel) {
   }
   float offset = s.slice.offset();
   if (ImGui::SliderFloat("position", &offset, lo, hi, "%.4g")) setSlicePlane(s, s.slice.normal(), offset);
-  s.sliceSliderRect = cssRect(pixelsPerCssPixel);
+  s.telemetry.screen.sliceSlider = cssRect(pixelsPerCssPixel);
   if (ImGui::IsItemHovered()) ImGui::SetTooltip("Or shift + drag in the view, or [ and ].");
   ImGui::PopItemWidth();
   row("triangles", grouped(s.slice.surface().triangleCount()));
@@ -321,7 +307,7 @@ PanelActions drawPanel(ViewerState& s, float uiScale, float pixelsPerCssPixel) {
   ImGui::TextUnformatted(!haveDataset ? "no dataset" : m.name.empty() ? "(unnamed dataset)" : m.name.c_str());
   if (s.state == LoadState::Idle) ImGui::TextDisabled("waiting for a dataset");
   if (s.state == LoadState::Complete) ImGui::TextDisabled("complete: every part received and applied");
-  if (s.state == LoadState::Error) coloredWrapped(kError, (s.memoryLimited ? "Stopped: " : "Error: ") + s.error);
+  if (s.state == LoadState::Error) coloredWrapped(kError, (s.memory.limited ? "Stopped: " : "Error: ") + s.error);
   if (ImGui::SmallButton("copy link")) actions.copyLink = true;
   if (ImGui::IsItemHovered()) ImGui::SetTooltip("Copies a link that opens this view: dataset, fields, colours, slice,\nlevel and camera (L).");
   ImGui::SameLine();
@@ -329,9 +315,9 @@ PanelActions drawPanel(ViewerState& s, float uiScale, float pixelsPerCssPixel) {
   if (ImGui::IsItemHovered()) ImGui::SetTooltip("Saves the picture as a PNG (S).");
   ImGui::SameLine();
   if (ImGui::SmallButton("keys (?)")) actions.toggleHelp = true;
-  if (!s.linkNote.empty()) {
+  if (!s.view.linkNote.empty()) {
     ImGui::SameLine();
-    ImGui::TextDisabled("%s", s.linkNote.c_str());
+    ImGui::TextDisabled("%s", s.view.linkNote.c_str());
   }
 
   if (haveDataset) {
@@ -353,7 +339,7 @@ PanelActions drawPanel(ViewerState& s, float uiScale, float pixelsPerCssPixel) {
     const Range range = m.fields[size_t(s.field)].range;
     float iso = s.isovalue;
     if (ImGui::SliderFloat("isovalue", &iso, range.min, range.max, "%.5g")) setIsovalue(s, iso);
-    s.sliderRect = cssRect(pixelsPerCssPixel);
+    s.telemetry.screen.slider = cssRect(pixelsPerCssPixel);
     ImGui::PopItemWidth();
     if (haveDataset) {
       row("triangles", grouped(s.surface.triangleCount()));
@@ -369,7 +355,7 @@ PanelActions drawPanel(ViewerState& s, float uiScale, float pixelsPerCssPixel) {
   memorySection(s);
 
   ImGui::Spacing();
-  ImGui::Checkbox("show boundary", &s.showBoundary);
+  ImGui::Checkbox("show boundary", &s.view.showBoundary);
   ImGui::SameLine();
   if (ImGui::Button("reset view")) actions.resetView = true;
 
@@ -379,15 +365,15 @@ PanelActions drawPanel(ViewerState& s, float uiScale, float pixelsPerCssPixel) {
   if (int(s.sliceOn) != lastSliceOn) ImGui::SetNextItemOpen(!s.sliceOn);
   lastSliceOn = int(s.sliceOn);
   if (ImGui::TreeNodeEx("timings", ImGuiTreeNodeFlags_NoTreePushOnOpen)) {
-  ImGui::TextDisabled("frames every %.1f ms, longest frame %.0f ms", s.frameMs, s.maxFrameMs);
-  if (s.refineSteps)
-    ImGui::TextDisabled("last refinement %.1f ms (%u splits)", s.refineMs, s.refineSteps);
-  ImGui::TextDisabled("last full extraction %.1f ms", s.extractMs);
-  if (s.firstSurfaceMs >= 0) {
-    if (s.completeMs >= 0)
-      ImGui::TextDisabled("first surface at %.2f s, complete at %.1f s", s.firstSurfaceMs / 1000, s.completeMs / 1000);
+  ImGui::TextDisabled("frames every %.1f ms, longest frame %.0f ms", s.telemetry.frameMs, s.telemetry.maxFrameMs);
+  if (s.telemetry.refineSteps)
+    ImGui::TextDisabled("last refinement %.1f ms (%u splits)", s.telemetry.refineMs, s.telemetry.refineSteps);
+  ImGui::TextDisabled("last full extraction %.1f ms", s.telemetry.extractMs);
+  if (s.telemetry.firstSurfaceMs >= 0) {
+    if (s.telemetry.completeMs >= 0)
+      ImGui::TextDisabled("first surface at %.2f s, complete at %.1f s", s.telemetry.firstSurfaceMs / 1000, s.telemetry.completeMs / 1000);
     else
-      ImGui::TextDisabled("first surface at %.2f s", s.firstSurfaceMs / 1000);
+      ImGui::TextDisabled("first surface at %.2f s", s.telemetry.firstSurfaceMs / 1000);
   }
   }
   ImGui::TextDisabled("drag rotates, right-drag pans, wheel zooms; ? for keys");
@@ -399,7 +385,7 @@ PanelActions drawPanel(ViewerState& s, float uiScale, float pixelsPerCssPixel) {
   {
     const ImVec2 pos = ImGui::GetWindowPos();
     const float k = 1.f / pixelsPerCssPixel;
-    s.panelRect = {pos.x * k, pos.y * k, size.x * k, size.y * k};
+    s.telemetry.screen.panel = {pos.x * k, pos.y * k, size.x * k, size.y * k};
   }
   actions.layoutChanged = size.x != lastSize.x || size.y != lastSize.y;
   lastSize = size;

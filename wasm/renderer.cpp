@@ -298,25 +298,6 @@ bool initRenderer(Renderer& r, std::string& error) {
   return true;
 }
 
-void destroyRenderer(Renderer& r) {
-  glDeleteProgram(r.isoProgram);
-  glDeleteProgram(r.hullProgram);
-  glDeleteProgram(r.lineProgram);
-  glDeleteProgram(r.backgroundProgram);
-  for (GpuBuffer* b : {&r.iso.positions, &r.iso.normals, &r.iso.colours, &r.iso.indices, &r.slice.positions,
-                       &r.slice.normals, &r.slice.colours, &r.slice.indices, &r.hullPositions, &r.hullNormals, &r.lines})
-    glDeleteBuffers(1, &b->id);
-  glDeleteTextures(1, &r.colourMapTexture);
-  GLuint vaos[5] = {r.iso.vao, r.slice.vao, r.hullVao, r.lineVao, r.emptyVao};
-  glDeleteVertexArrays(5, vaos);
-  for (OffscreenTarget* t : {&r.reduced, &r.multisampled}) {
-    GLuint renderbuffers[2] = {t->colour, t->depth};
-    glDeleteRenderbuffers(2, renderbuffers);
-    glDeleteFramebuffers(1, &t->framebuffer);
-  }
-  r = Renderer{};
-}
-
 void warmUpRenderer(Renderer& r, bool reducedToo) {
   const float tri[9] = {0, 0, 2, 1, 0, 2, 0, 1, 2};  // z = 2: outside the clip volume
   const uint32_t indices[3] = {0, 1, 2};

@@ -68,7 +68,6 @@ struct Renderer {
 
 // Compiles shaders and creates buffers. On failure returns false with the GL log in `error`.
 bool initRenderer(Renderer& r, std::string& error);
-void destroyRenderer(Renderer& r);
 
 // Draws one clipped-away triangle through every program and state drawScene uses, so that the
 // GL implementation compiles its pipelines now (while the dataset downloads) and not at the

@@ -1,7 +1,9 @@
 # Browser viewer (Emscripten only; included from the root CMakeLists.txt).
 #   tetstream_imgui   Dear ImGui 1.86 + GLFW and OpenGL3 backends (sources in build/_deps/imgui)
 #   tetstream_viewer  tetstream.js + tetstream.wasm in ${TETSTREAM_WEB_DIR}, plus every file of web/
-# The viewer's model (viewer_state, camera) has no GL and no Emscripten and also compiles natively.
+# platform.cpp and api.cpp are the only viewer files with Emscripten (and imgui_gl_queries.cpp);
+# the model (viewer_state, viewer_memory, telemetry, colourmap, camera, frame_policy.h) has no GL
+# and no Emscripten and also compiles natively, for the unit tests.
 
 set(TETSTREAM_IMGUI_DIR "${TETSTREAM_DEPS_DIR}/imgui")
 if(NOT EXISTS "${TETSTREAM_IMGUI_DIR}/imgui.cpp")
@@ -26,10 +28,11 @@ set_source_files_properties(${TETSTREAM_IMGUI_DIR}/backends/imgui_impl_opengl3.c
 target_compile_definitions(tetstream_imgui PUBLIC IMGUI_USER_CONFIG="imconfig_tetstream.h")
 
 add_executable(tetstream_viewer
-  ${CMAKE_CURRENT_LIST_DIR}/main.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/platform.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/api.cpp
   ${CMAKE_CURRENT_LIST_DIR}/viewer_state.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/telemetry.cpp
   ${CMAKE_CURRENT_LIST_DIR}/colourmap.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/slice.cpp
   ${CMAKE_CURRENT_LIST_DIR}/viewer_memory.cpp
   ${CMAKE_CURRENT_LIST_DIR}/camera.cpp
   ${CMAKE_CURRENT_LIST_DIR}/renderer.cpp
@@ -40,11 +43,6 @@ tetstream_warnings(tetstream_viewer)
 # GLM 0.9.9.8 (type_half.inl) uses `volatile float f; f *= f;`, deprecated in C++20.
 target_compile_options(tetstream_viewer PRIVATE -Wno-deprecated-volatile)
 
-set(TETSTREAM_VIEWER_EXPORTS
-  _main _malloc _free
-  _ts_open_manifest _ts_chunk_file _ts_add_chunk _ts_download_progress _ts_set_paused _ts_set_level
-  _ts_set_isovalue _ts_set_field _ts_set_colour_field _ts_set_colour_map _ts_set_colour_range _ts_set_slice _ts_camera_get _ts_camera_set _ts_camera_gesture _ts_request_capture _ts_set_view_option _ts_set_link_note _ts_fail _ts_stats_json _ts_check_chunk _ts_set_memory_limit _ts_set_notice _ts_work)
-list(JOIN TETSTREAM_VIEWER_EXPORTS "," TETSTREAM_VIEWER_EXPORTS)
 target_link_options(tetstream_viewer PRIVATE
   -sUSE_GLFW=3
   -sUSE_WEBGL2=1 -sMIN_WEBGL_VERSION=2 -sMAX_WEBGL_VERSION=2
@@ -55,7 +53,8 @@ target_link_options(tetstream_viewer PRIVATE
   -sALLOW_MEMORY_GROWTH=1 -sMAXIMUM_MEMORY=4GB
   -sMODULARIZE=1 -sEXPORT_NAME=createTetstream -sINVOKE_RUN=0
   -sENVIRONMENT=web -sFILESYSTEM=0
-  -sEXPORTED_FUNCTIONS=${TETSTREAM_VIEWER_EXPORTS}
+  # The ts_* functions are exported by EMSCRIPTEN_KEEPALIVE (api.cpp); these are the rest.
+  -sEXPORTED_FUNCTIONS=_main,_malloc,_free
   -sEXPORTED_RUNTIME_METHODS=callMain,ccall,cwrap,UTF8ToString,HEAPU8
   $<$<CONFIG:Release>:-O3>
   $<$<CONFIG:Debug>:-sASSERTIONS=1>

@@ -68,6 +68,8 @@ std::string formatBytes(uint64_t bytes) {
   const double mb = double(bytes) / (1 << 20);
   if (mb >= 1024)
     std::snprintf(buf, sizeof buf, "%.1f GB", mb / 1024);
+  else if (mb < 1)
+    std::snprintf(buf, sizeof buf, "%.0f KB", double(bytes) / 1024);
   else if (mb >= 10)
     std::snprintf(buf, sizeof buf, "%.0f MB", mb);
   else

@@ -7,16 +7,30 @@
 // The estimate uses only the manifest's per-chunk counts (vertices, tets, splits, rawBytes) and
 // the viewer's per-element costs: mesh, incidence lists and undo log (progressive.h), the kept split
 // payloads (dataset.h), the isosurface with its interval tree (isosurface_incremental.h, ~49
-// bytes per tet measured on Harmonic 64), and the hull (viewer_state.h: ~110 bytes per boundary
+// bytes per tet measured on Harmonic 64), and the hull (core/hull.h: ~110 bytes per boundary
 // triangle, boundary triangles guessed from the tet count as for a cube). It is an estimate:
 // a surface far bigger than a smooth field gives (noise) or a very thin domain can need more;
 // tests/unit/test_viewer_state.cpp checks it against the measured use on Harmonic grids.
 #pragma once
 #include <cstdint>
+#include <string>
 
 #include "dataset.h"
 
 namespace tetstream::viewer {
+
+// The memory budget (bytes). The platform sets the limit (the browser's wasm maximum, or the
+// page's ?maxMemoryMB=; 0 = none), the heap in use before any dataset (code, stack, UI), the heap
+// size and the GPU buffers, and may install reserveHeap. openManifest sets the rest.
+struct MemoryBudget {
+  uint64_t limitBytes = 0, baseBytes = 0;
+  uint64_t heapBytes = 0, gpuBytes = 0;
+  uint64_t neededBytes = 0;    // estimate for the whole dataset
+  uint32_t chunksAllowed = 0;  // chunks whose level fits the limit (all of them without one)
+  bool limited = false;        // stopped short of the full dataset for lack of memory
+  // Grows the heap to at least `bytes` now; false when the browser refuses.
+  bool (*reserveHeap)(uint64_t bytes) = nullptr;
+};
 
 // Heap bytes the viewer's data takes at the level made of the first `chunks` chunks (base
 // included, clamped to the manifest), with the mesh arrays reserved for that level.
@@ -28,7 +42,7 @@ uint32_t chunksThatFit(const Manifest& m, uint64_t budgetBytes);
 // Bytes the dataset's arrays hold now (vector capacities): mesh, incidence, undo log, payloads.
 uint64_t datasetMemoryBytes(const Dataset& ds);
 
-// "12.3 MB", "1.2 GB": for messages.
+// "512 KB", "1.5 MB", "12 MB", "1.2 GB": the one byte formatter of the viewer (messages, panel).
 std::string formatBytes(uint64_t bytes);
 
 }  // namespace tetstream::viewer

@@ -1,4 +1,4 @@
-// Browser tests of the ways to look at a dataset (issue 5's viewer): colour by a second field with
+// Browser tests of the ways to look at a dataset: colour by a second field with
 // a colour bar, the slice plane (and that it follows refinement locally), the view as a URL that
 // reopens the same picture, screenshots, the help panel, opening a packed folder from the disk
 // by drag-and-drop, touch gestures, multisampling (?antialias), and that drawing makes no WebGL
@@ -442,8 +442,7 @@ test('?antialias: the scene multisampled through an offscreen target, the same p
 // WebGL calls that make the page wait for the GPU process to finish everything queued before
 // them (Chrome answers them there): once at start at most, never while frames are drawn. The
 // state the viewer and Dear ImGui read back each frame are bindings, which WebGL tracks in the
-// page. (Each wait was 0.5-3 ms on an idle GPU process here and up to the whole previous frame
-// on a busy one; 128 of them came before post.vtk's first surface until session 24.)
+// page. (Each such wait costs from a few ms to the whole previous frame on a busy GPU process.)
 test('drawing frames makes no WebGL call that waits for the GPU process; starting makes few', async () => {
   const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
   await page.addInitScript(() => {

@@ -15,14 +15,17 @@ const native = [path.join(root, 'build/native/tetstream_core_check')];
 // Emscripten 3.1.6's loader would try fetch() on a file path under node 20 without the flag.
 const wasm = [process.execPath, '--no-experimental-fetch', path.join(root, 'build/wasm/tetstream_core_check.js')];
 
-test('wasm isosurface equals native bit for bit', () => {
+test('wasm isosurface, hull and slice equal native bit for bit', () => {
   const { pack } = packedHarmonic(33);
   for (const iso of ['0', '0.25', '-0.1', '0.9']) {
     const a = coreCheck(native, [pack, iso]);
     const b = coreCheck(wasm, [pack, iso]);
-    for (const key of ['tets', 'triangles', 'vertices', 'area', 'positionsHash', 'indicesHash', 'normalsHash'])
+    for (const key of ['tets', 'triangles', 'vertices', 'area', 'positionsHash', 'indicesHash', 'normalsHash',
+      'hullTriangles', 'hullLines', 'hullHash', 'linesHash', 'sliceTriangles', 'sliceArea', 'slicePositionsHash',
+      'sliceIndicesHash'])
       assert.deepEqual(b[key], a[key], `${key} at isovalue ${iso}`);
     assert.ok(a.triangles > 0, 'a surface exists');
+    assert.ok(a.hullTriangles > 0 && a.hullLines > 0 && a.sliceTriangles > 0, 'a hull and a slice exist');
     // And the CLI agrees with both.
     const c = cli('iso', pack, '--value', iso, '--json').json;
     assert.equal(c.triangles, a.triangles);

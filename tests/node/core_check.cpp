@@ -1,8 +1,9 @@
 // The core's view side on a packed dataset, built natively and as wasm (run under node with
 // NODERAWFS) so both can be compared and timed:
 //   tetstream_core_check PACKDIR ISOVALUE [FIELD] [REPEATS]
-//       one isosurface of the full mesh: counts, area, time and hashes of the exact output
-//       arrays (tests/node/core.test.mjs checks native == wasm)
+//       one isosurface of the full mesh, its boundary hull and a slice through its middle:
+//       counts, area, time and hashes of the exact output arrays (tests/node/core.test.mjs
+//       checks native == wasm)
 //   tetstream_core_check --stream PACKDIR ISOVALUE
 //       decode + apply + local isosurface update over every split, the undo rate, and isovalue
 //       re-extraction with the interval tree against a plain scan at several levels (benchmarks)
@@ -16,8 +17,10 @@
 
 #include "dataset.h"
 #include "hash.h"
+#include "hull.h"
 #include "isosurface.h"
 #include "isosurface_incremental.h"
+#include "slice.h"
 
 using namespace tetstream;
 using Clock = std::chrono::steady_clock;
@@ -63,11 +66,24 @@ int surfaceCheck(int argc, char** argv) {
   auto bytes = [](const auto& v) {
     return std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(v.data()), v.size() * sizeof(v[0]));
   };
+  auto hash = [&](const auto& v) { return formatHash(contentHash(bytes(v))); };
+  // The viewer's hull and a slice through the middle of the bounds (core/hull.h, core/slice.h).
+  HullTracker hull;
+  hull.rebuild(ds.pm);
+  SliceTracker slice;
+  const Bounds& b = ds.manifest.bounds;
+  slice.setPlane({0, 0, 1}, 0.5f * (b.min[2] + b.max[2]));
+  slice.rebuild(mesh, {});
+  const IncrementalIsosurface& cut = slice.surface();
   std::printf(
       "{\"tets\": %u, \"triangles\": %u, \"vertices\": %u, \"area\": %.17g, \"positionsHash\": \"%s\", "
-      "\"indicesHash\": \"%s\", \"normalsHash\": \"%s\", \"loadMs\": %.3f, \"ms\": %.3f}\n",
-      mesh.tetCount(), s.triangleCount(), s.vertexCount(), surfaceArea(s), formatHash(contentHash(bytes(s.positions))).c_str(),
-      formatHash(contentHash(bytes(s.indices))).c_str(), formatHash(contentHash(bytes(s.normals))).c_str(), loadMs, best);
+      "\"indicesHash\": \"%s\", \"normalsHash\": \"%s\", \"hullTriangles\": %u, \"hullLines\": %u, "
+      "\"hullHash\": \"%s\", \"linesHash\": \"%s\", \"sliceTriangles\": %u, \"sliceArea\": %.17g, "
+      "\"slicePositionsHash\": \"%s\", \"sliceIndicesHash\": \"%s\", \"loadMs\": %.3f, \"ms\": %.3f}\n",
+      mesh.tetCount(), s.triangleCount(), s.vertexCount(), surfaceArea(s), hash(s.positions).c_str(),
+      hash(s.indices).c_str(), hash(s.normals).c_str(), hull.triangleCount(), hull.lineCount(),
+      hash(hull.trianglePositions()).c_str(), hash(hull.lineVertices()).c_str(), cut.triangleCount(), cut.area(),
+      hash(cut.positions()).c_str(), hash(cut.indices()).c_str(), loadMs, best);
   return 0;
 }
 

@@ -1,7 +1,7 @@
 // Colour by field (wasm/colourmap.h and the colour channel of IncrementalIsosurface): the colour
 // maps against their published tables (ends, middles, clamping), and the colour interpolated at
 // each surface vertex kept up to date through real vertex splits. The slice plane
-// (wasm/slice.h): exact polygons and areas of planes through a cube mesh, and the slice kept by
+// (core/slice.h): exact polygons and areas of planes through a cube mesh, and the slice kept by
 // local updates through splits and undos equal to one extracted from scratch.
 #include <gtest/gtest.h>
 

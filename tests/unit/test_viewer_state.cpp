@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <numbers>
 #include <numeric>
@@ -17,6 +18,7 @@
 
 #include "adjacency.h"
 #include "camera.h"
+#include "frame_policy.h"
 #include "pack/chunk_encode.h"
 #include "pack/generators.h"
 #include "pack/packer.h"
@@ -28,6 +30,92 @@ using namespace tetstream;
 using namespace tetstream::viewer;
 
 namespace {
+
+// The domain boundary of a mesh, built from scratch: the reference the incremental HullTracker
+// is checked against. Triangles are unshared so each carries its flat normal.
+struct BoundaryMesh {
+  std::vector<float> positions;     // 3 per corner, 9 per triangle
+  std::vector<float> normals;       // 3 per corner, outward unit normal of the triangle
+  std::vector<float> featureLines;  // 6 per segment: boundary edges whose faces meet at a crease
+  uint32_t triangleCount() const { return uint32_t(positions.size() / 9); }
+  uint32_t lineCount() const { return uint32_t(featureLines.size() / 6); }
+};
+
+// Boundary edges whose two triangles' normals differ by more than ~30 degrees are creases.
+constexpr float kCreaseCos = 0.866f;
+
+uint64_t edgeKey(uint32_t a, uint32_t b) { return a < b ? uint64_t(a) << 32 | b : uint64_t(b) << 32 | a; }
+
+// Outward unit normal of triangle (a, b, c), 0 when degenerate.
+void faceNormal(const float* p, const uint32_t tri[3], float n[3]) {
+  const float* a = p + 3 * size_t(tri[0]);
+  const float* b = p + 3 * size_t(tri[1]);
+  const float* c = p + 3 * size_t(tri[2]);
+  float u[3], v[3];
+  for (int k = 0; k < 3; ++k) u[k] = b[k] - a[k], v[k] = c[k] - a[k];
+  n[0] = u[1] * v[2] - u[2] * v[1];
+  n[1] = u[2] * v[0] - u[0] * v[2];
+  n[2] = u[0] * v[1] - u[1] * v[0];
+  float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  for (int k = 0; k < 3; ++k) n[k] = len > 0 ? n[k] / len : 0.f;
+}
+
+// Boundary triangles of a mesh and their crease edges (dihedral angle above ~30 degrees, or an
+// edge not shared by exactly two boundary triangles).
+void buildBoundary(const TetMesh& mesh, BoundaryMesh& out) {
+  out = {};
+  if (mesh.tetCount() == 0) return;
+  FaceAdjacency adj;
+  buildFaceAdjacency(mesh.tets, mesh.vertexCount(), adj);
+  std::vector<uint32_t> tris;
+  extractBoundary(mesh.tets, adj, tris);
+
+  const float* p = mesh.positions.data();
+  const size_t nt = tris.size() / 3;
+  std::vector<float> faceNormals(3 * nt);
+  out.positions.reserve(9 * nt);
+  out.normals.reserve(9 * nt);
+  for (size_t t = 0; t < nt; ++t) {
+    float n[3];
+    faceNormal(p, &tris[3 * t], n);
+    for (int k = 0; k < 3; ++k) {
+      const float* q = p + 3 * size_t(tris[3 * t + k]);
+      out.positions.insert(out.positions.end(), q, q + 3);
+      out.normals.insert(out.normals.end(), n, n + 3);
+    }
+    std::copy(n, n + 3, &faceNormals[3 * t]);
+  }
+
+  // Crease edges: group the triangles' edges by their sorted vertex pair. An edge with two
+  // triangles is drawn when their normals differ by more than ~30 degrees (box corners, sharp
+  // features); an edge with any other count is an open or non-manifold rim and always drawn.
+  struct EdgeUse {
+    uint64_t key;
+    uint32_t tri;
+  };
+  std::vector<EdgeUse> edges;
+  edges.reserve(3 * nt);
+  for (size_t t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k) edges.push_back({edgeKey(tris[3 * t + k], tris[3 * t + (k + 1) % 3]), uint32_t(t)});
+  std::sort(edges.begin(), edges.end(), [](const EdgeUse& x, const EdgeUse& y) { return x.key < y.key; });
+  for (size_t i = 0; i < edges.size();) {
+    size_t j = i;
+    while (j < edges.size() && edges[j].key == edges[i].key) ++j;
+    bool draw = j - i != 2;
+    if (!draw) {
+      const float* n0 = &faceNormals[3 * size_t(edges[i].tri)];
+      const float* n1 = &faceNormals[3 * size_t(edges[i + 1].tri)];
+      draw = n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2] < kCreaseCos;
+    }
+    if (draw) {
+      uint32_t a = uint32_t(edges[i].key >> 32), b = uint32_t(edges[i].key);
+      out.featureLines.insert(out.featureLines.end(), p + 3 * size_t(a), p + 3 * size_t(a) + 3);
+      out.featureLines.insert(out.featureLines.end(), p + 3 * size_t(b), p + 3 * size_t(b) + 3);
+    }
+    i = j;
+  }
+}
+
 
 struct Packed {
   std::string manifest;
@@ -156,7 +244,7 @@ TEST(ViewerState, LoadsExtractsAndFollowsTheControls) {
   ASSERT_TRUE(addChunk(s, 0, p.chunks[0]).ok());
   EXPECT_EQ(s.state, LoadState::Complete) << "a base-only dataset is complete at once";
   EXPECT_GT(s.surface.triangleCount(), 0u);
-  EXPECT_TRUE(s.surfaceDirty);
+  EXPECT_TRUE(s.dirty.surface);
   EXPECT_TRUE(s.surface.fullUploadNeeded());
   EXPECT_GT(s.hull.triangleCount(), 0u);
   EXPECT_EQ(s.hull.lineCount(), 12u * 23) << "the cube's 12 edges, 23 segments each";
@@ -202,17 +290,17 @@ TEST(ViewerState, StreamsSplitsUnderABudgetWithLocalUpdates) {
   // Verification only: nothing is applied until the frame loop advances.
   ASSERT_TRUE(addChunk(s, 1, p.chunks[1]).ok());
   EXPECT_EQ(s.dataset.pm.vertexCount(), baseVertices);
-  EXPECT_EQ(s.targetSplits, s.dataset.splitsReceived()) << "live: the target follows new data";
+  EXPECT_EQ(s.level.targetSplits, s.dataset.splitsReceived()) << "live: the target follows new data";
 
   // One bounded slice: some splits, not all, and only local changes for the renderer.
   ASSERT_TRUE(advance(s, g_ticks + 2, fakeNow));
-  EXPECT_GT(s.refineSteps, 0u);
-  EXPECT_LE(s.refineSteps, 2 * kStepBatch);
-  EXPECT_EQ(s.dataset.splitsApplied(), s.refineSteps);
+  EXPECT_GT(s.telemetry.refineSteps, 0u);
+  EXPECT_LE(s.telemetry.refineSteps, 2 * kStepBatch);
+  EXPECT_EQ(s.dataset.splitsApplied(), s.telemetry.refineSteps);
   // The slice is counted in the histogram of slice durations (2 ticks: the first bin).
-  EXPECT_EQ(s.refineMs, 2);
-  EXPECT_EQ(s.sliceCounts[0], 1u);
-  EXPECT_EQ(std::accumulate(s.sliceCounts.begin(), s.sliceCounts.end(), 0u), 1u);
+  EXPECT_EQ(s.telemetry.refineMs, 2);
+  EXPECT_EQ(s.telemetry.sliceCounts[0], 1u);
+  EXPECT_EQ(std::accumulate(s.telemetry.sliceCounts.begin(), s.telemetry.sliceCounts.end(), 0u), 1u);
   EXPECT_FALSE(s.surface.fullUploadNeeded()) << "splits never re-extract the whole surface";
   EXPECT_FALSE(s.hull.fullUploadNeeded());
   expectMatchesFromScratch(s, "inside chunk 1");
@@ -238,7 +326,7 @@ TEST(ViewerState, StreamsSplitsUnderABudgetWithLocalUpdates) {
   setLevel(s, 0);
   // The bins from 30 ms up: the edge 30 is kSliceEdgesMs[4], so bins 5 (30-60) and 6 (60 and over).
   ASSERT_EQ(kSliceEdgesMs[4], 30.0);
-  auto over30 = [&] { return s.sliceCounts[5] + s.sliceCounts[6]; };
+  auto over30 = [&] { return s.telemetry.sliceCounts[5] + s.telemetry.sliceCounts[6]; };
   const uint32_t before = over30();
   int slow = 0;
   while (advance(s, g_ticks + 1, [] { return g_ticks += 20; })) ++slow;
@@ -261,7 +349,7 @@ TEST(ViewerState, LevelMovesBackAndForthAndStaysWhereTheUserPutsIt) {
 
   // Back to the base: coarser, the surface following through undos.
   setLevelFraction(s, 0);
-  EXPECT_FALSE(s.live);
+  EXPECT_FALSE(s.level.live);
   settle(s);
   EXPECT_EQ(s.dataset.pm.vertexCount(), base);
   EXPECT_EQ(stats(s)["fieldError"].get<double>(), s.dataset.manifest.chunks[0].fieldError);
@@ -288,8 +376,8 @@ TEST(ViewerState, LevelMovesBackAndForthAndStaysWhereTheUserPutsIt) {
 
   // Forward to the newest level: live again, so the next chunk is followed.
   setLevelFraction(s, 1.0);
-  EXPECT_TRUE(s.live);
-  EXPECT_EQ(s.targetSplits, s.dataset.splitsReceived());
+  EXPECT_TRUE(s.level.live);
+  EXPECT_EQ(s.level.targetSplits, s.dataset.splitsReceived());
   EXPECT_GT(s.dataset.splitsReceived(), received);
   for (uint32_t c = 4; c < p.chunks.size(); ++c) ASSERT_TRUE(addChunk(s, c, p.chunks[c]).ok());
   settle(s);
@@ -342,23 +430,58 @@ TEST(ViewerState, AHostileChunkWithAValidHashEndsInErrorAtTheLastGoodLevel) {
   EXPECT_FALSE(addChunk(s, 3, p.chunks[3]).ok());
 }
 
-TEST(ViewerState, PauseAndDownloadRate) {
+// The network belongs to the page (web/rate.js measures the rate, tests/node/rate.test.mjs):
+// the viewer shows its snapshot and asks it to pause.
+TEST(ViewerState, PauseAndDownloadFiguresComeFromThePage) {
   const Packed& p = packedStream();
   ViewerState s;
   ASSERT_TRUE(openManifest(s, p.manifest).ok());
   EXPECT_TRUE(downloading(s));
-  // 100 KB/s for 3 s, reported every 50 ms.
-  for (int ms = 0; ms <= 3000; ms += 50) noteDownload(s, uint64_t(ms) * 100, uint64_t(ms), ms);
-  tick(s, 3000);
-  EXPECT_NEAR(s.rateBytesPerSec, 100000, 5000);
-  EXPECT_GT(secondsLeft(s), 0);
-  tick(s, 6000);
-  EXPECT_EQ(s.rateBytesPerSec, 0) << "no bytes for 3 s: no rate";
-  setPaused(s, true);
-  EXPECT_TRUE(s.pausedChanged);
+  setNetwork(s, {.receivedBytes = 300, .totalBytes = 1000, .bytesPerSecond = 100000, .secondsLeft = 2.5});
+  EXPECT_EQ(stats(s)["rateBytesPerSec"], 100000);
+  EXPECT_EQ(stats(s)["secondsLeft"], 2.5);
+  requestPauseToggle(s);
+  EXPECT_TRUE(s.pauseToggleRequested);
+  EXPECT_TRUE(downloading(s)) << "the page decides";
+  setNetwork(s, {.receivedBytes = 300, .totalBytes = 1000, .paused = true});
   EXPECT_FALSE(downloading(s));
   EXPECT_EQ(stats(s)["paused"], true);
-  EXPECT_LT(secondsLeft(s), 0);
+  EXPECT_TRUE(stats(s)["secondsLeft"].is_null());
+}
+
+// Malloc'd copy of a chunk, as the page hands it over (offerChunk takes ownership).
+uint8_t* mallocCopy(std::span<const uint8_t> bytes) {
+  auto* out = static_cast<uint8_t*>(std::malloc(std::max<size_t>(1, bytes.size())));
+  std::copy(bytes.begin(), bytes.end(), out);
+  return out;
+}
+
+ChunkCheck offer(ViewerState& s, uint32_t index, std::span<const uint8_t> bytes) {
+  return offerChunk(s, index, mallocCopy(bytes), bytes.size());
+}
+
+TEST(ViewerState, OfferedChunksAreCheckedOnceAndAddedInOrder) {
+  const Packed& p = packedStream();
+  ASSERT_GE(p.chunks.size(), 4u);
+  ViewerState s;
+  ASSERT_TRUE(openManifest(s, p.manifest).ok());
+  std::vector<uint8_t> flipped = p.chunks[2];
+  flipped[flipped.size() / 2] ^= 0x10;
+  EXPECT_EQ(offer(s, 2, flipped), ChunkCheck::WrongHash);
+  EXPECT_EQ(offer(s, 2, p.chunks[1]), ChunkCheck::WrongSize);
+  EXPECT_EQ(offer(s, 9999, p.chunks[1]), ChunkCheck::NoSuchChunk);
+  EXPECT_EQ(offer(s, 2, p.chunks[2]), ChunkCheck::Ok);
+  EXPECT_EQ(offer(s, 1, p.chunks[1]), ChunkCheck::Ok);
+  EXPECT_EQ(s.dataset.chunksReceived, 0u) << "waiting for the base";
+  EXPECT_EQ(s.state, LoadState::Loading);
+  EXPECT_EQ(offer(s, 0, p.chunks[0]), ChunkCheck::Ok);
+  EXPECT_EQ(s.dataset.chunksReceived, 3u) << "the base and the two kept after it";
+  EXPECT_TRUE(s.pendingChunks.empty());
+  EXPECT_EQ(offer(s, 1, p.chunks[1]), ChunkCheck::NoSuchChunk) << "already added";
+  for (uint32_t c = 3; c < p.chunks.size(); ++c) EXPECT_EQ(offer(s, c, p.chunks[c]), ChunkCheck::Ok);
+  settle(s);
+  EXPECT_EQ(s.state, LoadState::Complete);
+  expectMatchesFromScratch(s, "offered out of order");
 }
 
 // Harmonic 24³ streamed from a 1% base: the memory estimate against the measured use.
@@ -401,9 +524,9 @@ TEST(ViewerState, MemoryEstimateFollowsTheMeasuredUse) {
   EXPECT_GE(double(full), 1.0 * double(memoryInUse(s)));
   EXPECT_LE(double(full), 1.5 * double(memoryInUse(s)));
   EXPECT_EQ(s.state, LoadState::Complete);
-  EXPECT_EQ(s.memoryNeededBytes, estimateLevelBytes(m, s.chunksTotal));
+  EXPECT_EQ(s.memory.neededBytes, estimateLevelBytes(m, s.chunksTotal));
   std::printf("Harmonic 24: %u tets, estimate %.1f MB, measured %.1f MB (%.1f bytes per tet)\n", m.tets,
-              double(s.memoryNeededBytes) / (1 << 20), double(memoryInUse(s)) / (1 << 20),
+              double(s.memory.neededBytes) / (1 << 20), double(memoryInUse(s)) / (1 << 20),
               double(memoryInUse(s)) / m.tets);
   auto j = stats(s);
   EXPECT_EQ(j["memory"]["dataBytes"].get<uint64_t>(), memoryInUse(s));
@@ -417,14 +540,14 @@ TEST(ViewerState, ADatasetTooBigStopsAtTheLastLevelThatFits) {
   ASSERT_TRUE(parseManifest(p.manifest, m).ok());
   const uint32_t fit = uint32_t(m.chunks.size()) / 2;
   ViewerState s;
-  s.memoryBaseBytes = 1 << 20;
-  s.memoryLimitBytes = s.memoryBaseBytes + (estimateLevelBytes(m, fit) + estimateLevelBytes(m, fit + 1)) / 2;
+  s.memory.baseBytes = 1 << 20;
+  s.memory.limitBytes = s.memory.baseBytes + (estimateLevelBytes(m, fit) + estimateLevelBytes(m, fit + 1)) / 2;
   ASSERT_TRUE(openManifest(s, p.manifest).ok());
-  EXPECT_EQ(s.chunksAllowed, fit);
+  EXPECT_EQ(s.memory.chunksAllowed, fit);
   EXPECT_TRUE(downloading(s));
   streamAll(s, p);
   EXPECT_EQ(s.state, LoadState::Error);
-  EXPECT_TRUE(s.memoryLimited);
+  EXPECT_TRUE(s.memory.limited);
   EXPECT_EQ(s.dataset.chunksReceived, fit);
   EXPECT_EQ(s.dataset.splitsApplied(), s.dataset.splitsReceived()) << "everything that fits is applied";
   EXPECT_NE(s.error.find("Streaming stopped after part " + std::to_string(fit) + " of"), std::string::npos) << s.error;
@@ -438,7 +561,7 @@ TEST(ViewerState, ADatasetTooBigStopsAtTheLastLevelThatFits) {
 
   // Not even the base fits: refused before anything is fetched.
   ViewerState tiny;
-  tiny.memoryLimitBytes = estimateLevelBytes(m, 1) / 2;
+  tiny.memory.limitBytes = estimateLevelBytes(m, 1) / 2;
   EXPECT_FALSE(openManifest(tiny, p.manifest).ok());
   EXPECT_EQ(tiny.state, LoadState::Error);
   EXPECT_NE(tiny.error.find("even at its coarsest level"), std::string::npos) << tiny.error;
@@ -456,7 +579,7 @@ bool fakeReserveHeap(uint64_t bytes) {
 TEST(ViewerState, TheBrowserRefusingMemoryStopsWithAMessage) {
   const Packed& p = packedMemory();
   ViewerState s;
-  s.reserveHeap = fakeReserveHeap;
+  s.memory.reserveHeap = fakeReserveHeap;
   g_refuseHeap = false;
   g_heapAsked = 0;
   ASSERT_TRUE(openManifest(s, p.manifest).ok());
@@ -469,7 +592,7 @@ TEST(ViewerState, TheBrowserRefusingMemoryStopsWithAMessage) {
   g_refuseHeap = true;
   EXPECT_FALSE(addChunk(s, 2, p.chunks[2]).ok());
   EXPECT_EQ(s.state, LoadState::Error);
-  EXPECT_TRUE(s.memoryLimited);
+  EXPECT_TRUE(s.memory.limited);
   EXPECT_NE(s.error.find("did not give the viewer"), std::string::npos) << s.error;
   settle(s);
   EXPECT_EQ(s.dataset.pm.vertexCount(), vertices);
@@ -477,7 +600,7 @@ TEST(ViewerState, TheBrowserRefusingMemoryStopsWithAMessage) {
 
   // Not enough at the base for the last level's arrays at once: they grow level by level.
   ViewerState t;
-  t.reserveHeap = fakeReserveHeap;
+  t.memory.reserveHeap = fakeReserveHeap;
   g_refuseHeap = false;
   g_refusals = 1;
   ASSERT_TRUE(openManifest(t, p.manifest).ok());
@@ -532,8 +655,19 @@ TEST(ViewerState, ChunksAreCheckedWithoutSideEffects) {
   EXPECT_EQ(checkChunk(s, 9999, p.chunks[1]), ChunkCheck::NoSuchChunk);
   EXPECT_EQ(s.state, LoadState::Loading) << "checking changes nothing";
   EXPECT_EQ(s.dataset.chunksReceived, 0u);
-  setNotice(s, "connection lost, retrying part 2 in 4 s");
+  setNetwork(s, {.notice = "connection lost, retrying part 2 in 4 s"});
   EXPECT_EQ(stats(s)["notice"], "connection lost, retrying part 2 in 4 s");
+}
+
+// A software GL draws the scene smaller while the level refines or the user interacts (never a
+// screenshot), at most kReducedPixels, and at full size otherwise.
+TEST(ViewerState, SceneIsReducedOnASoftwareGlWhileBusy) {
+  EXPECT_FLOAT_EQ(sceneScale(true, true, false, 1280, 800), 0.5f);
+  EXPECT_EQ(sceneScale(false, true, false, 1280, 800), 1.f) << "a GPU draws full size";
+  EXPECT_EQ(sceneScale(true, false, false, 1280, 800), 1.f) << "the still frame";
+  EXPECT_EQ(sceneScale(true, true, true, 1280, 800), 1.f) << "a screenshot";
+  EXPECT_EQ(sceneScale(true, true, false, 640, 400), 1.f) << "small enough already";
+  EXPECT_EQ(sceneScale(true, true, false, 0, 0), 1.f);
 }
 
 TEST(ViewerState, CameraFramesTheBoundingBox) {
@@ -563,11 +697,11 @@ TEST(ViewerState, ColourFieldAndSliceFollowTheStream) {
   ASSERT_TRUE(setColourField(s, "distance"));
   EXPECT_FALSE(setColourField(s, "nonsense"));
   const Range d = s.dataset.manifest.fields[size_t(s.dataset.manifest.findField("distance"))].range;
-  EXPECT_EQ(s.colourMin, d.min);
-  EXPECT_EQ(s.colourMax, d.max);
+  EXPECT_EQ(s.colour.min, d.min);
+  EXPECT_EQ(s.colour.max, d.max);
   setColourRange(s, 0.9f, 0.2f);
-  EXPECT_EQ(s.colourMin, 0.2f);
-  EXPECT_EQ(s.colourMax, 0.9f);
+  EXPECT_EQ(s.colour.min, 0.2f);
+  EXPECT_EQ(s.colour.max, 0.9f);
   ASSERT_TRUE(addChunk(s, 0, p.chunks[0]).ok());
   setSliceEnabled(s, true);
   ASSERT_TRUE(setSlicePlane(s, {0, 0, 2}, 0.3f));
@@ -628,14 +762,14 @@ TEST(ViewerState, FitColourRangeCoversWhatIsShown) {
   float lo = 1e30f, hi = -1e30f;
   rangeOf(s.surface, lo, hi);
   ASSERT_TRUE(fitColourRange(s));
-  EXPECT_EQ(s.colourMin, lo);
-  EXPECT_EQ(s.colourMax, hi);
+  EXPECT_EQ(s.colour.min, lo);
+  EXPECT_EQ(s.colour.max, hi);
   const Range d = s.dataset.manifest.fields[size_t(s.dataset.manifest.findField("distance"))].range;
-  EXPECT_GT(s.colourMin, d.min) << "the surface spans part of the field's range";
+  EXPECT_GT(s.colour.min, d.min) << "the surface spans part of the field's range";
   setSliceEnabled(s, true);
   ASSERT_TRUE(setSlicePlane(s, {0, 0, 1}, 0.3f));
   rangeOf(s.slice.surface(), lo, hi);
   ASSERT_TRUE(fitColourRange(s));
-  EXPECT_EQ(s.colourMin, lo);
-  EXPECT_EQ(s.colourMax, hi);
+  EXPECT_EQ(s.colour.min, lo);
+  EXPECT_EQ(s.colour.max, hi);
 }

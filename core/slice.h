@@ -18,7 +18,7 @@
 #include "isosurface_incremental.h"
 #include "mesh.h"
 
-namespace tetstream::viewer {
+namespace tetstream {
 
 class SliceTracker {
  public:
@@ -55,4 +55,4 @@ class SliceTracker {
   IncrementalIsosurface surface_;
 };
 
-}  // namespace tetstream::viewer
+}  // namespace tetstream

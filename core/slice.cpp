@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace tetstream::viewer {
+namespace tetstream {
 
 bool SliceTracker::setPlane(std::array<float, 3> normal, float offset) {
   const double len = std::sqrt(double(normal[0]) * normal[0] + double(normal[1]) * normal[1] +
@@ -62,4 +62,4 @@ void SliceTracker::offsetRange(std::array<float, 3> normal, const float boxMin[3
   }
 }
 
-}  // namespace tetstream::viewer
+}  // namespace tetstream

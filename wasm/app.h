@@ -1,0 +1,71 @@
+// The viewer program's state, shared by the Emscripten platform (platform.cpp: canvas, input,
+// frames, work slices) and the exported functions (api.cpp; docs/js-api.md). Neither the model
+// (viewer_state.h) nor this header includes Emscripten.
+#pragma once
+#include <GLES3/gl3.h>
+
+#include <string>
+
+#include "camera.h"
+#include "renderer.h"
+#include "viewer_state.h"
+
+struct GLFWwindow;
+
+namespace tetstream::viewer {
+
+// The canvas and its WebGL 2 context.
+struct Canvas {
+  GLFWwindow* window = nullptr;
+  std::string platformError;  // set when WebGL 2 / GLFW could not start; sticky
+  bool softwareGl = false;    // SwiftShader & co: drawn without multisampling, reduced while refining
+  int width = 0, height = 0;  // canvas size in device pixels (= GLFW window and framebuffer size)
+  double pixelRatio = 1;      // device pixels per CSS pixel
+  float uiScale = 1;
+};
+
+// The camera and who placed it.
+struct CameraControl {
+  OrbitCamera camera;
+  bool moved = false;   // by the user since the last framing; if not, a resize re-frames
+  bool pinned = false;  // set by the page (a shared link): the framing keeps it
+};
+
+// The mouse drag under way.
+struct Drag {
+  int button = -1;     // mouse button that started a camera drag, -1 when none
+  bool slice = false;  // the drag moves the slice (shift + left drag)
+  double lastX = 0, lastY = 0;
+};
+
+// When to draw, and the work slices between frames.
+struct FramePacing {
+  int redrawFrames = 2;       // frames still to draw; 0 = idle, nothing changed
+  GLsync gpuFence = nullptr;  // after the last drawn frame: signalled once the GPU has done it
+  double fenceSince = 0;
+  double lastFrameStart = -1;     // emscripten_get_now() of the previous frame callback
+  double lastDrawStart = -1;      // ... of the previous frame that drew
+  bool captureRequested = false;  // the page wants the next drawn frame (screenshot)
+  bool reducedShown = false;      // the last drawn frame's scene was drawn at reduced resolution
+  bool workQueued = false;        // a refinement slice is queued (ts_work)
+};
+
+struct App {
+  ViewerState state;
+  Renderer renderer;
+  Canvas canvas;
+  CameraControl view;
+  Drag drag;
+  FramePacing pacing;
+};
+
+extern App g_app;
+
+// Draws the next `frames` frames (something changed).
+void requestRedraw(int frames = 2);
+// New work (a chunk, a level, resuming) starts at once rather than at the next frame.
+void workOnChange();
+// Passes a pause or resume asked for in the panel on to the page (Module.onPauseChange).
+void notifyPause();
+
+}  // namespace tetstream::viewer

@@ -1,0 +1,112 @@
+#include "telemetry.h"
+
+#include <algorithm>
+#include <nlohmann/json.hpp>
+
+#include "viewer_state.h"
+
+namespace tetstream::viewer {
+
+std::string statsJson(const ViewerState& s) {
+  using json = nlohmann::json;
+  const Dataset& ds = s.dataset;
+  const Manifest& m = ds.manifest;
+  json fields = json::array();
+  for (const FieldInfo& f : m.fields)
+    fields.push_back(json{{"name", f.name}, {"min", f.range.min}, {"max", f.range.max}});
+  auto rect = [](const Rect& r) { return json{{"x", r.x}, {"y", r.y}, {"w", r.w}, {"h", r.h}}; };
+  auto time = [](double t) { return t >= 0 ? json(t) : json(nullptr); };
+  uint32_t splitsTotal = 0;
+  for (size_t c = 1; c < m.chunks.size(); ++c) splitsTotal += m.chunks[c].splits;
+  const double fieldError = fieldErrorBound(s);
+  json j = {
+      {"state", loadStateName(s.state)},
+      {"error", s.error},
+      {"name", m.name},
+      {"vertices", ds.pm.mesh.vertexCount()},
+      {"tets", ds.pm.mesh.tetCount()},
+      {"triangles", s.surface.triangleCount()},
+      {"surfaceVertices", s.surface.vertexCount()},
+      {"isovalue", s.isovalue},
+      {"surfaceArea", s.surface.area()},
+      {"field", s.field >= 0 ? json(m.fields[size_t(s.field)].name) : json(nullptr)},
+      {"colourField", s.colour.field >= 0 ? json(m.fields[size_t(s.colour.field)].name) : json(nullptr)},
+      {"colourMap", colourMapName(s.colour.map)},
+      {"colourRange", json::array({s.colour.min, s.colour.max})},
+      {"slice",
+       {{"on", s.sliceOn},
+        {"normal", json::array({s.slice.normal()[0], s.slice.normal()[1], s.slice.normal()[2]})},
+        {"offset", s.slice.offset()},
+        {"triangles", s.slice.surface().triangleCount()},
+        {"area", s.slice.surface().area()}}},
+      {"fields", std::move(fields)},
+      {"chunksReceived", ds.chunksReceived},
+      {"chunksApplied", ds.chunksApplied()},
+      {"chunksTotal", s.chunksTotal},
+      {"bytesReceived", ds.bytesReceived},
+      {"bytesTotal", m.totalBytes()},
+      {"rateBytesPerSec", s.network.bytesPerSecond},
+      {"secondsLeft", s.network.secondsLeft >= 0 ? json(s.network.secondsLeft) : json(nullptr)},
+      {"splitsApplied", ds.splitsApplied()},
+      {"splitsReceived", ds.splitsReceived()},
+      {"splitsTotal", splitsTotal},
+      {"targetSplits", std::min(s.level.targetSplits, ds.splitsReceived())},
+      {"level", levelFraction(s)},
+      {"live", s.level.live},
+      {"paused", s.network.paused},
+      {"fieldError", fieldError >= 0 ? json(fieldError) : json(nullptr)},
+      {"fieldRms", levelChunk(s) && levelChunk(s)->fieldRms >= 0 ? json(levelChunk(s)->fieldRms) : json(nullptr)},
+      {"fieldMax", levelChunk(s) && levelChunk(s)->fieldMax >= 0 ? json(levelChunk(s)->fieldMax) : json(nullptr)},
+      {"baseVertices", ds.pm.baseVertices},
+      {"hullTriangles", s.hull.triangleCount()},
+      {"hullLines", s.hull.lineCount()},
+      {"firstSurfaceMs", time(s.telemetry.firstSurfaceMs)},
+      {"completeMs", time(s.telemetry.completeMs)},
+      {"extractMs", s.telemetry.extractMs},
+      {"refineMs", s.telemetry.refineMs},
+      {"maxRefineMs", s.telemetry.maxRefineMs},
+      {"refineTotalMs", s.telemetry.refineTotalMs},
+      {"refineSteps", s.telemetry.refineSteps},
+      {"sliceEdgesMs", kSliceEdgesMs},
+      {"sliceCounts", s.telemetry.sliceCounts},
+      {"frameMs", s.telemetry.frameMs},
+      {"maxFrameMs", s.telemetry.maxFrameMs},
+      {"maxFrameGapMs", s.telemetry.maxFrameGapMs},
+      {"drawMs", s.telemetry.drawMs},
+      {"treeTets", s.surface.treeCoverage()},
+      {"maxDrawMs", s.telemetry.maxDrawMs},
+      {"drawTotalMs", s.telemetry.drawTotalMs},
+      {"reducedFrames", s.telemetry.reducedFrames},
+      {"busyFrames", s.telemetry.busyFrames},
+      {"softwareGl", s.telemetry.softwareGl},
+      {"samples", s.telemetry.samples},
+      {"contextLost", s.contextLost},
+      {"uploadBytes", s.telemetry.uploadBytes},
+      {"fullUploads", s.telemetry.fullUploads},
+      {"partialUploads", s.telemetry.partialUploads},
+      {"grownUploads", s.telemetry.grownUploads},
+      {"showBoundary", s.view.showBoundary},
+      {"notice", s.network.notice},
+      {"chunksAllowed", s.memory.chunksAllowed},
+      {"memoryLimited", s.memory.limited},
+      {"memory",
+       {{"heapBytes", s.memory.heapBytes},
+        {"dataBytes", memoryInUse(s)},
+        {"gpuBytes", s.memory.gpuBytes},
+        {"limitBytes", s.memory.limitBytes ? json(s.memory.limitBytes) : json(nullptr)},
+        {"neededBytes", s.memory.neededBytes},
+        {"allowedBytes",
+         s.memory.chunksAllowed ? s.memory.baseBytes + estimateLevelBytes(m, s.memory.chunksAllowed) : 0}}},
+      {"sliderRect", rect(s.telemetry.screen.slider)},
+      {"levelSliderRect", rect(s.telemetry.screen.levelSlider)},
+      {"pauseButtonRect", rect(s.telemetry.screen.pauseButton)},
+      {"sliceSliderRect", rect(s.telemetry.screen.sliceSlider)},
+      {"panelRect", rect(s.telemetry.screen.panel)},
+      {"showHelp", s.view.showHelp},
+      {"targetLevel", targetLevel(s)},
+  };
+  // Messages may carry bytes from the network: never let invalid UTF-8 abort the dump.
+  return j.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+}  // namespace tetstream::viewer
