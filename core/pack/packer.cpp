@@ -11,7 +11,7 @@
 #include <utility>
 
 #include "chunk_encode.h"
-#include "pack/file_writer.h"
+#include "io/file_writer.h"
 #include "pack/renumber.h"
 #include "pack/simplify.h"
 #include "pack/split_encode.h"

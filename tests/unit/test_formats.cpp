@@ -16,8 +16,8 @@
 #include <sstream>
 
 #include "adjacency.h"
-#include "pack/mesh_io.h"
-#include "pack/readers.h"
+#include "io/mesh_io.h"
+#include "io/readers.h"
 #include "test_helpers.h"
 #include "validate.h"
 

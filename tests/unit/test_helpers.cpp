@@ -17,7 +17,7 @@
 
 #include "chunk.h"
 #include "pack/chunk_encode.h"
-#include "pack/generators.h"
+#include "io/generators.h"
 #include "split_stream.h"
 
 namespace tetstream::test {

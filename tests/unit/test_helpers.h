@@ -7,7 +7,7 @@
 
 #include "manifest.h"
 #include "mesh.h"
-#include "pack/mesh_io.h"
+#include "io/mesh_io.h"
 
 namespace tetstream::test {
 

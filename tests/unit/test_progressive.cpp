@@ -26,7 +26,7 @@
 #include "dataset.h"
 #include "split_stream.h"
 #include "pack/chunk_encode.h"
-#include "pack/generators.h"
+#include "io/generators.h"
 #include "pack/packer.h"
 #include "pack/renumber.h"
 #include "pack/simplify.h"

@@ -1,4 +1,4 @@
-// Mesh readers and writers (core/pack/mesh_io.h): every fixture written by VTK or meshio reads
+// Mesh readers and writers (core/io/mesh_io.h): every fixture written by VTK or meshio reads
 // with the right counts and analytic field values; our .vtu round-trips through our reader and
 // through meshio/VTK; and hostile bytes (truncations, flips, lies in headers) give a Result.
 #include <gtest/gtest.h>
@@ -9,10 +9,10 @@
 #include <filesystem>
 #include <random>
 
-#include "pack/generators.h"
-#include "pack/mesh_io.h"
-#include "pack/ply_writer.h"
-#include "pack/readers.h"
+#include "io/generators.h"
+#include "io/mesh_io.h"
+#include "io/ply_writer.h"
+#include "io/readers.h"
 #include "test_helpers.h"
 
 namespace tetstream {

@@ -18,7 +18,7 @@
 #include "adjacency.h"
 #include "camera.h"
 #include "pack/chunk_encode.h"
-#include "pack/generators.h"
+#include "io/generators.h"
 #include "pack/packer.h"
 #include "test_helpers.h"
 #include "viewer_memory.h"

@@ -31,7 +31,7 @@
 #include <numeric>
 
 #include "adjacency.h"
-#include "pack/readers.h"
+#include "io/readers.h"
 
 namespace tetstream {
 namespace vtkio {
