@@ -51,38 +51,6 @@
 
 namespace tetstream {
 
-// Open-addressing hash map from a surface vertex key (isosurface.h: lo << 32 | hi for an edge,
-// v << 32 | v for a mesh vertex on λ) to a vertex slot, with erase (backward-shift deletion, no
-// tombstones). Capacity is a power of two, at most half full; clear() keeps it.
-class SurfaceVertexMap {
- public:
-  static constexpr uint64_t kEmpty = ~uint64_t(0);
-  static constexpr uint32_t kNone = ~uint32_t(0);
-
-  void clear();
-  size_t size() const { return size_; }
-  uint32_t find(uint64_t key) const;  // kNone when absent
-  // The value stored for key; when absent, stores `value` first. *inserted tells which.
-  uint32_t findOrInsert(uint64_t key, uint32_t value, bool* inserted);
-  void erase(uint64_t key);  // precondition: key present
-  // Rewrites every value v as remap[v] (compaction).
-  void remapValues(std::span<const uint32_t> remap);
-  size_t memoryBytes() const { return keys_.capacity() * 8 + values_.capacity() * 4; }
-
- private:
-  static uint64_t hash(uint64_t x) {  // splitmix64 finaliser, as EdgeMap
-    x ^= x >> 30;
-    x *= 0xbf58476d1ce4e5b9ull;
-    x ^= x >> 27;
-    x *= 0x94d049bb133111ebull;
-    return x ^ (x >> 31);
-  }
-  void rehash(size_t cap);
-  std::vector<uint64_t> keys_;
-  std::vector<uint32_t> values_;
-  size_t size_ = 0;
-};
-
 class IncrementalIsosurface {
  public:
   static constexpr uint32_t kNone = ~uint32_t(0);
@@ -183,7 +151,7 @@ class IncrementalIsosurface {
   uint32_t coverage_ = 0;   // the tree holds tets [0, coverage_)
   bool bulk_ = false;  // inside rebuild(): no per-slot change tracking
   IntervalTree tree_;
-  SurfaceVertexMap map_;
+  FlatMap map_;
 
   // A tet with a cut case: the up to 4 distinct surface vertices it created or shares
   // (kNone-padded; each counted once in Vertex::refs) and its 0-2 triangle slots (kNone: none).

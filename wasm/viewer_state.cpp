@@ -812,7 +812,7 @@ void HullTracker::updateEdge(const float* p, uint64_t key) {
     draw = n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2] < kCreaseCos;
   }
   const uint32_t line = lineOfEdge_.find(key);
-  if (draw && line == SurfaceVertexMap::kNone) {
+  if (draw && line == FlatMap::kNone) {
     const uint32_t slot = lineCount();
     lines_.insert(lines_.end(), p + 3 * size_t(a), p + 3 * size_t(a) + 3);
     lines_.insert(lines_.end(), p + 3 * size_t(b), p + 3 * size_t(b) + 3);
@@ -820,7 +820,7 @@ void HullTracker::updateEdge(const float* p, uint64_t key) {
     bool inserted;
     lineOfEdge_.findOrInsert(key, slot, &inserted);
     if (!fullUpload_) changedLines_.push_back(slot);
-  } else if (!draw && line != SurfaceVertexMap::kNone) {
+  } else if (!draw && line != FlatMap::kNone) {
     removeLine(line);
   }
 }

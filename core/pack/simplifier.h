@@ -22,6 +22,7 @@
 #include "adjacency.h"
 #include "pack/quadric.h"
 #include "tet_quality.h"
+#include "tet_tables.h"
 #include "simplify.h"
 
 namespace tetstream::simplify_detail {
@@ -69,7 +70,6 @@ inline Tri makeTri(uint32_t a, uint32_t b, uint32_t c) {
   if (a > b) std::swap(a, b);
   return {{a, b, c}};
 }
-inline uint64_t makeEdge(uint32_t a, uint32_t b) { return a < b ? uint64_t(a) << 32 | b : uint64_t(b) << 32 | a; }
 
 class Simplifier {
  public:
@@ -113,8 +113,6 @@ class Simplifier {
     const double a = f.q[12], b = f.q[3] * x[0] + f.q[7] * x[1] + f.q[10] * x[2] + f.q[13];
     return a > 0 ? std::clamp(-b / a, fieldMin_, fieldMax_) : fallback;
   }
-
-  static constexpr uint8_t kFaces[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
 
   // Vertex v's position, from the floats of vert_ (exact in double; a copy in double took 24
   // bytes a vertex of memory and of the caches).

@@ -20,7 +20,7 @@ bool hasTriangle(const std::vector<uint64_t>& edges) {
       else if (b == c) p = a, q = d;
       else if (b == d) p = a, q = c;
       if (p == ~0u || p == q) continue;
-      const uint64_t third = makeEdge(p, q);
+      const uint64_t third = edgeKey(p, q);
       for (size_t z = 0; z < edges.size(); ++z)
         if (edges[z] == third) return true;
     }
@@ -44,9 +44,9 @@ void Simplifier::gatherLink(uint32_t v, std::vector<uint32_t>& verts, std::vecto
       else o[n++] = x[k];
     }
     verts.insert(verts.end(), o, o + 3);
-    edges.push_back(makeEdge(o[0], o[1]));
-    edges.push_back(makeEdge(o[0], o[2]));
-    edges.push_back(makeEdge(o[1], o[2]));
+    edges.push_back(edgeKey(o[0], o[1]));
+    edges.push_back(edgeKey(o[0], o[2]));
+    edges.push_back(edgeKey(o[1], o[2]));
     tris.push_back(makeTri(o[0], o[1], o[2]));
     for (int f = 0; f < 4; ++f) {
       if (f == sv || opp_[4 * t + f] != kNoNeighbor) continue;
@@ -55,8 +55,8 @@ void Simplifier::gatherLink(uint32_t v, std::vector<uint32_t>& verts, std::vecto
       for (int k = 0; k < 4; ++k)
         if (k != f && x[k] != v) (m++ == 0 ? a : b) = x[k];
       verts.push_back(kOmega);
-      edges.push_back(makeEdge(a, kOmega));
-      edges.push_back(makeEdge(b, kOmega));
+      edges.push_back(edgeKey(a, kOmega));
+      edges.push_back(edgeKey(b, kOmega));
       tris.push_back(makeTri(a, b, kOmega));
     }
   }
@@ -108,11 +108,11 @@ do {                                                                 \
     for (int k = 0; k < 2; ++k)
       if (L.seen[o[k]] != stampE) { L.seen[o[k]] = stampE; ++edgeVerts; }
     ++edgeEdges;  // each tet around the edge has its own opposite edge
-    W.edgeLink.push_back(makeEdge(o[0], o[1]));
+    W.edgeLink.push_back(edgeKey(o[0], o[1]));
   }, [&](uint32_t k) {
     boundaryEdge = true;
     ++edgeEdges;  // (k, ω) for the boundary face (i, j, k): one per face
-    W.edgeLink.push_back(makeEdge(k, kOmega));
+    W.edgeLink.push_back(edgeKey(k, kOmega));
   });
   if (common != edgeVerts + (boundaryEdge ? 1 : 0)) TS_LINK_RESULT(false);
   // Edges: those of Lk(j) in a table, then the distinct ones of Lk(i) found there. With the
@@ -128,14 +128,14 @@ do {                                                                 \
       for (int k = 0; k < 4; ++k)
         if (x[k] != v) o[n++] = x[k];
       const bool in[3] = {inEdgeLink(o[0]), inEdgeLink(o[1]), inEdgeLink(o[2])};
-      if (in[0] && in[1]) each(makeEdge(o[0], o[1]));
-      if (in[0] && in[2]) each(makeEdge(o[0], o[2]));
-      if (in[1] && in[2]) each(makeEdge(o[1], o[2]));
+      if (in[0] && in[1]) each(edgeKey(o[0], o[1]));
+      if (in[0] && in[2]) each(edgeKey(o[0], o[2]));
+      if (in[1] && in[2]) each(edgeKey(o[1], o[2]));
     }
     if (boundaryEdge)
       forBoundaryFaces(v, [&](uint32_t a, uint32_t b) {
-        if (inEdgeLink(a)) each(makeEdge(a, kOmega));
-        if (inEdgeLink(b)) each(makeEdge(b, kOmega));
+        if (inEdgeLink(a)) each(edgeKey(a, kOmega));
+        if (inEdgeLink(b)) each(edgeKey(b, kOmega));
       });
   };
   linkEdgesOf(j, [&](uint64_t e) { W.edgeTable.mark(e, 1); });
@@ -163,10 +163,10 @@ do {                                                                 \
   // Boundary triangles (a, b, ω) in both links: boundary faces (i, a, b) and (j, a, b).
   if (bothBoundary) {
     W.linkEdges.clear();  // edges (a, b) of the boundary faces at j
-    forBoundaryFaces(j, [&](uint32_t a, uint32_t b) { W.linkEdges.push_back(makeEdge(a, b)); });
+    forBoundaryFaces(j, [&](uint32_t a, uint32_t b) { W.linkEdges.push_back(edgeKey(a, b)); });
     bool shared = false;
     forBoundaryFaces(i, [&](uint32_t a, uint32_t b) {
-      shared |= std::find(W.linkEdges.begin(), W.linkEdges.end(), makeEdge(a, b)) != W.linkEdges.end();
+      shared |= std::find(W.linkEdges.begin(), W.linkEdges.end(), edgeKey(a, b)) != W.linkEdges.end();
     });
     if (shared) TS_LINK_RESULT(false);
   }
@@ -185,10 +185,10 @@ bool Simplifier::linkConditionBySorting(uint32_t i, uint32_t j) {
   // Link of the edge: the opposite edges of the tets around it, and the boundary faces at it.
   forEdgeLink(i, j, [&](const uint32_t o[2]) {
     lvE.insert(lvE.end(), o, o + 2);
-    leE.push_back(makeEdge(o[0], o[1]));
+    leE.push_back(edgeKey(o[0], o[1]));
   }, [&](uint32_t k) {
     lvE.push_back(kOmega);
-    leE.push_back(makeEdge(k, kOmega));
+    leE.push_back(edgeKey(k, kOmega));
   });
   sortUnique(lvE);
   sortUnique(leE);

@@ -52,7 +52,7 @@ void Simplifier::init() {
   for (uint32_t h = 0; h < 4 * T_; ++h) {
     if (opp_[h] != kNoNeighbor) continue;
     const uint32_t* v = &out_.tets[h & ~3u];
-    uint32_t a = v[kFaces[h & 3][0]], b = v[kFaces[h & 3][1]], c = v[kFaces[h & 3][2]];
+    uint32_t a = v[kTetFaces[h & 3][0]], b = v[kTetFaces[h & 3][1]], c = v[kTetFaces[h & 3][2]];
     const Point pa = p(a), pb = p(b), pc = p(c);
     double u[3] = {pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]}, w[3] = {pc[0] - pa[0], pc[1] - pa[1], pc[2] - pa[2]};
     double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
