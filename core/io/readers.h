@@ -229,10 +229,6 @@ struct TextReader {
     while (e < s.size() && s[e] != ' ' && s[e] != '\t' && s[e] != '\r' && s[e] != '\n' && s[e] != '#') ++e;
     return s.substr(pos, e - pos);
   }
-  // The rest of the current line is consumed (comment included).
-  void endLine() {
-    while (pos < s.size() && s[pos] != '\n') ++pos;
-  }
   // Number of tokens left on the current line (before a comment).
   int tokensLeftOnLine() const {
     int n = 0;

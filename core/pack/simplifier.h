@@ -7,7 +7,7 @@
 //   simplify_collapse.cpp  a collapse and its log entry
 //   simplify_slabs.cpp     the parallel phase: slabs of a large mesh, one thread each
 //   simplify_refit.cpp     the last level's values, fitted again at the end
-// Internal to the packer: nothing outside these files includes it.
+// Internal to the packer: nothing outside these files includes it but the tests (SimplifyTuning).
 #pragma once
 #include <algorithm>
 #include <atomic>
@@ -24,6 +24,29 @@
 #include "tet_quality.h"
 #include "tet_tables.h"
 #include "simplify.h"
+
+namespace tetstream {
+
+// Not product options: knobs that exist so tests can compare the cost with the simpler ones it
+// replaced, and a self-check of the link condition. simplifyMesh always uses the defaults.
+struct SimplifyTuning {
+  // How much of the input a collapse stands for, the weight of its error terms (simplify.h,
+  // boundTerms()): the larger of its input vertices and its volume (in units of an interior
+  // vertex's mean volume), or (false) the vertices alone.
+  bool weighByVolume = true;
+  // Each cost is divided by (tets the collapse removes)^this (simplify.h); 0: not at all.
+  double removedTetsExponent = 0.5;
+  // Also runs the plain reference link check (linkConditionBySorting) at every collapse attempt
+  // and counts in linkMismatches where it disagrees with the fast one.
+  bool verifyLinkCondition = false;
+  uint64_t linkMismatches = 0;  // written by simplifyMeshTuned
+};
+
+// simplifyMesh (simplify.h) with other tuning than the defaults.
+Result simplifyMeshTuned(const TetMesh& mesh, const SimplifyOptions& options, SimplifyTuning& tuning,
+                         SimplifyResult& out);
+
+}  // namespace tetstream
 
 namespace tetstream::simplify_detail {
 
@@ -73,9 +96,9 @@ inline Tri makeTri(uint32_t a, uint32_t b, uint32_t c) {
 
 class Simplifier {
  public:
-  Simplifier(const TetMesh& m, const SimplifyOptions& o, SimplifyResult& r, FaceAdjacency* adjacency = nullptr,
-             std::vector<uint32_t>* takeTets = nullptr)
-      : mesh_(m), opt_(o), out_(r), adjacency_(adjacency), takeTets_(takeTets) {}
+  Simplifier(const TetMesh& m, const SimplifyOptions& o, SimplifyTuning& tuning, SimplifyResult& r,
+             FaceAdjacency* adjacency = nullptr, std::vector<uint32_t>* takeTets = nullptr)
+      : mesh_(m), opt_(o), tune_(tuning), out_(r), adjacency_(adjacency), takeTets_(takeTets) {}
 
   CollapseVerdict check(uint32_t i, uint32_t j);
   Result run();
@@ -159,7 +182,7 @@ class Simplifier {
     double cost;     // exact, or a lower bound until stage Exact
     double base;     // the cost without the shape term
     double sj, region, eg, weight, shapeBound;  // parts of the cost (boundTerms)
-    double perTets;  // the factor for the tets it removes (SimplifyOptions::removedTetsExponent)
+    double perTets;  // the factor for the tets it removes (SimplifyTuning::removedTetsExponent)
     uint32_t j;
     uint64_t bit;    // bitOf(j's place in Lane::nbr)
     float fieldErr;  // E_f (from stage Local on)
@@ -402,6 +425,7 @@ class Simplifier {
     }
   }
 
+  // The plain reference for linkCondition(), for SimplifyTuning::verifyLinkCondition only.
   bool linkConditionBySorting(uint32_t i, uint32_t j);
 
   // ------------------------------------------------------------------ the last level's values
@@ -416,6 +440,7 @@ class Simplifier {
 
   const TetMesh& mesh_;
   const SimplifyOptions& opt_;
+  SimplifyTuning& tune_;
   SimplifyResult& out_;
   FaceAdjacency* adjacency_;  // the caller's, taken over by init() (or none)
   std::vector<uint32_t>* takeTets_;  // mesh_.tets, taken over by init() (or none: copied)

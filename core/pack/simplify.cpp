@@ -100,7 +100,7 @@ Result Simplifier::run() {
     out_.requeued += w.requeued;
     out_.rejectedByLink += w.rejectedByLink;
     out_.flatTetsRemoved += w.flatTetsRemoved;
-    out_.linkMismatches += w.linkMismatches;
+    tune_.linkMismatches += w.linkMismatches;
   };
   count(main_);
   for (const Worker& w : parts_) count(w);
@@ -178,7 +178,8 @@ const char* collapseVerdictName(CollapseVerdict v) {
 
 CollapseVerdict checkCollapse(const TetMesh& mesh, uint32_t i, uint32_t j, const SimplifyOptions& options) {
   SimplifyResult scratch;
-  Simplifier s(mesh, options, scratch);
+  SimplifyTuning tuning;
+  Simplifier s(mesh, options, tuning, scratch);
   return s.check(i, j);
 }
 
@@ -186,7 +187,17 @@ Result simplifyMesh(const TetMesh& mesh, const SimplifyOptions& options, Simplif
                     std::vector<uint32_t>* takeTets) {
   assert(options.field >= 0 && size_t(options.field) < mesh.fields.size());
   out = SimplifyResult{};
-  Simplifier s(mesh, options, out, adjacency, takeTets);
+  SimplifyTuning tuning;
+  Simplifier s(mesh, options, tuning, out, adjacency, takeTets);
+  return s.run();
+}
+
+Result simplifyMeshTuned(const TetMesh& mesh, const SimplifyOptions& options, SimplifyTuning& tuning,
+                         SimplifyResult& out) {
+  assert(options.field >= 0 && size_t(options.field) < mesh.fields.size());
+  out = SimplifyResult{};
+  tuning.linkMismatches = 0;
+  Simplifier s(mesh, options, tuning, out);
   return s.run();
 }
 

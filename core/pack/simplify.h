@@ -86,18 +86,9 @@ struct SimplifyOptions {
   // With fitValues, at the end the values of the vertices that stand for others are fitted again,
   // all together, to the input field at every input vertex (least squares; simplify_refit.cpp).
   bool refitValues = true;
-  // How much of the input a collapse stands for, the weight of its error terms (see the cost
-  // above and boundTerms()): the larger of its input vertices and its volume (in units of an
-  // interior vertex's mean volume), or (false) the vertices alone, as before session 25 (tests
-  // compare the two).
-  bool weighByVolume = true;
-  // Each cost divided by (tets the collapse removes)^this (see the cost above); 0: not at all,
-  // as before session 33 (tests compare the two).
-  double removedTetsExponent = 0.5;
   std::function<void(uint32_t done, uint32_t planned)> progress;  // called now and then
   // Keep in the log what each split reads (CollapseLog::star), for StreamOptions::orderSplits.
   bool recordReadSets = false;
-  bool verifyLinkCondition = false;  // tests: also run the slow reference link check, count mismatches
   // Threads (1 or 2; the result is the same either way): the slabs run on one each, and the
   // one queue evaluates its next entries on both for meshes of at least parallelMinVertices
   // vertices (below that, starting rounds costs more than it saves).
@@ -124,7 +115,6 @@ struct SimplifyResult {
   uint64_t costEvaluations = 0, rejectedByLink = 0;
   uint64_t queuePops = 0, requeued = 0;  // pops of current entries, and those pushed back costlier
   uint32_t slabCollapses = 0;          // collapses made in the slabs at once (partitionMinVertices)
-  uint64_t linkMismatches = 0;           // with verifyLinkCondition: fast and reference disagreed
   std::string stopReason;          // "target reached", "no legal collapse left", "error bound"
 };
 

@@ -145,15 +145,15 @@ Simplifier::Candidate Simplifier::boundTerms(Lane& L, uint32_t i, uint32_t j, ui
   //   against 3.9e-5 now; session 25).
   // The manifest reports the unweighted E_f.
   const double volume = fq.weight / meanVertexVolume_;  // (fq: i's and j's field quadrics, summed above)
-  c.weight = std::sqrt(opt_.weighByVolume ? std::max(double(count), volume) : double(count));
+  c.weight = std::sqrt(tune_.weighByVolume ? std::max(double(count), volume) : double(count));
   // E_s after the collapse with every new tet at the best quality (3/κ = 1), as the tets of
   // p_j's star that stay are known: most candidates lose without finishCost(). Scaled down a
   // little so that round-off (its sums run in another order) never lifts it above E_s.
   const double moved = double(L.star.size()) - removed, after = double(star_[j].size()) - removed + moved;
   c.shapeBound = after > 0 ? std::max(0.0, 1.0 - (qualitySum_[j] - removedQuality + moved) / after) : 0.0;
   // Per tet removed (simplify.h); legal() counted them (at least the one tet of the edge).
-  c.perTets = opt_.removedTetsExponent == 0.5 ? 1.0 / std::sqrt(double(std::max(removed, 1)))
-                                              : std::pow(double(std::max(removed, 1)), -opt_.removedTetsExponent);
+  c.perTets = tune_.removedTetsExponent == 0.5 ? 1.0 / std::sqrt(double(std::max(removed, 1)))
+                                              : std::pow(double(std::max(removed, 1)), -tune_.removedTetsExponent);
   setCost(c, 0.0);  // a lower bound: the local error is at least 0 (rounding is monotone)
   c.stage = Candidate::Bound;
   return c;

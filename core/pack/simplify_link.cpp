@@ -68,9 +68,9 @@ void Simplifier::gatherLink(uint32_t v, std::vector<uint32_t>& verts, std::vecto
 // The same condition without sorting (this runs once per collapse attempt): vertex sets by
 // stamps, edge sets in a small stamped hash table, shared tet triangles through the face
 // adjacency. linkConditionBySorting() is the plain reference; tests run both
-// (SimplifyOptions::verifyLinkCondition) and count disagreements.
+// (SimplifyTuning::verifyLinkCondition) and count disagreements.
 bool Simplifier::linkCondition(Worker& W, uint32_t i, uint32_t j) {
-  const bool verify = opt_.verifyLinkCondition;
+  const bool verify = tune_.verifyLinkCondition;
   const bool reference = verify && linkConditionBySorting(i, j);
 #define TS_LINK_RESULT(x)                                              \
 do {                                                                 \
