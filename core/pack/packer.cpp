@@ -193,7 +193,7 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   so.weightField = opt.weights[1];
   so.weightShape = opt.weights[2];
   so.threads = opt.threads;
-  so.partitionMinVertices = opt.partitionMinVertices;
+  so.slabMinVertices = opt.slabMinVertices;
   so.fitValues = opt.fitValues;
   so.field = iso;
   so.recordReadSets = opt.orderSplits;

@@ -164,7 +164,7 @@ class Simplifier {
   struct StarTet {
     uint32_t t;
     uint32_t other[3];        // the vertices besides i, in slot order
-    uint64_t mask;            // bitOf() their places in Lane::nbr (see removes())
+    uint64_t mask;            // bitOf() their places in Scratch::nbr (see removes())
     double g[3];              // det of the new tet with P in the slot of i: g·(P − x[0]) (newDet)
     double detOld;            // det with p_i (numerator for the slot of i)
     double fixedEdges, fixedFace;  // κ's terms of the edges and the face without p_i
@@ -184,13 +184,13 @@ class Simplifier {
     double sj, region, eg, weight, shapeBound;  // parts of the cost (boundTerms)
     double perTets;  // the factor for the tets it removes (SimplifyTuning::removedTetsExponent)
     uint32_t j;
-    uint64_t bit;    // bitOf(j's place in Lane::nbr)
+    uint64_t bit;    // bitOf(j's place in Scratch::nbr)
     float fieldErr;  // E_f (from stage Local on)
     Stage stage;
   };
 
   // Scratch for evaluating one vertex's out-edges; one per thread.
-  struct Lane {
+  struct Scratch {
     std::vector<StarTet> star;
     uint32_t center = 0;  // the vertex of star
     double flatBound = 0;  // see prepareStar
@@ -264,15 +264,15 @@ class Simplifier {
 
   using Heap = std::priority_queue<Entry, std::vector<Entry>, EntryAfter>;
 
-  // What the collapse loop works with: the queue of the whole mesh, or of one slab in the
-  // parallel phase (runParts), with its own log and scratch.
-  struct Worker {
-    int part = -1;          // -1: the whole mesh; else the slab
+  // What the collapse loop works with (a queue and its log, not a thread): the queue of the whole
+  // mesh, or of one slab in the parallel phase (runSlabs), with its own log and scratch.
+  struct Queue {
+    int slab = -1;          // -1: the whole mesh; else the slab
     Heap heap;
     CollapseLog ownLog;     // a slab's collapses in this round (merged into out_.log after it)
     CollapseLog* log = &ownLog;
     std::vector<float> keys;  // a slab's collapses: the queue key each was taken at
-    Lane* lane = nullptr;   // link condition and collapse (and a slab's evaluations): its thread's
+    Scratch* scratch = nullptr;  // link condition and collapse (and a slab's evaluations): its thread's
     std::atomic<uint32_t> collapsed{0};  // (read by the progress report on the other thread)
     uint32_t tetsRemoved = 0;
     uint64_t pops = 0, requeued = 0, rejectedByLink = 0, flatTetsRemoved = 0, linkMismatches = 0;
@@ -284,7 +284,7 @@ class Simplifier {
     uint32_t edgeTableStamp = 0;
   };
 
-  void prepareStar(Lane& L, uint32_t i);
+  void prepareStar(Scratch& sc, uint32_t i);
 
   // Whether the new tet (P and the others of st) is flat, judged by its own longest edge.
   static bool isFlat(const StarTet& st, const double* P, double det) {
@@ -298,7 +298,7 @@ class Simplifier {
     return d0 * d0 + d1 * d1 + d2 * d2;
   }
   static double dot(const double* u, const double* v) { return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]; }
-  // A bit for each of the first 64 neighbours (by place in Lane::nbr), 0 for the others.
+  // A bit for each of the first 64 neighbours (by place in Scratch::nbr), 0 for the others.
   static uint64_t bitOf(size_t place) { return place < 64 ? uint64_t(1) << place : 0; }
   // Whether the collapse onto j (bit: bitOf(its place)) removes star tet st: st has j.
   static bool removes(const StarTet& st, uint32_t j, uint64_t bit) {
@@ -325,14 +325,14 @@ class Simplifier {
     n[2] = u[0] * v[1] - u[1] * v[0];
   }
 
-  bool legal(Lane& L, uint32_t i, uint32_t j, uint64_t bit, CollapseVerdict* verdict);
-  Candidate boundTerms(Lane& L, uint32_t i, uint32_t j, uint64_t bit, int removed, double removedQuality);
+  bool legal(Scratch& sc, uint32_t i, uint32_t j, uint64_t bit, CollapseVerdict* verdict);
+  Candidate boundTerms(Scratch& sc, uint32_t i, uint32_t j, uint64_t bit, int removed, double removedQuality);
   void setCost(Candidate& c, double local) const;
-  void localTerm(Lane& L, uint32_t i, Candidate& c);
-  bool finishCost(Lane& L, Candidate& c, CollapseVerdict* verdict);
-  void gatherCandidates(Lane& L, uint32_t i);
-  int cheapestCandidate(Lane& L, uint32_t i);
-  void neighbours(Lane& L, uint32_t v, std::vector<uint32_t>& out);
+  void localTerm(Scratch& sc, uint32_t i, Candidate& c);
+  bool finishCost(Scratch& sc, Candidate& c, CollapseVerdict* verdict);
+  void gatherCandidates(Scratch& sc, uint32_t i);
+  int cheapestCandidate(Scratch& sc, uint32_t i);
+  void neighbours(Scratch& sc, uint32_t v, std::vector<uint32_t>& out);
 
   // Asks for the tets around v, which neighbours(v) reads first: called for the vertex likely
   // to be evaluated next, while the current one is.
@@ -340,8 +340,8 @@ class Simplifier {
     for (uint32_t t : star_[v]) __builtin_prefetch(&out_.tets[4 * size_t(t)]);
   }
 
-  float bestCost(Lane& L, uint32_t v);
-  void evaluateVertex(Lane& L, uint32_t v);
+  float bestCost(Scratch& sc, uint32_t v);
+  void evaluateVertex(Scratch& sc, uint32_t v);
 
   // The key v is queued under: its last known cost, or 0 when it had no legal collapse then.
   float queueKey(uint32_t v) const { return std::isfinite(lastCost_[v]) ? lastCost_[v] : 0.0f; }
@@ -356,17 +356,17 @@ class Simplifier {
     return false;
   }
 
-  // Whether a collapse of this round changed anything evaluateVertex(L, v) read: v's star and,
+  // Whether a collapse of this round changed anything evaluateVertex(sc, v) read: v's star and,
   // for the targets, their quadrics, κ sums and star sizes; all of these change only for the
   // vertices a collapse touches.
-  bool changedThisRound(const Lane& L, uint32_t v) const {
+  bool changedThisRound(const Scratch& sc, uint32_t v) const {
     if (changed_[v] == roundStamp_) return true;
-    for (uint32_t w : L.nbr)
+    for (uint32_t w : sc.nbr)
       if (changed_[w] == roundStamp_) return true;
     return false;
   }
 
-  // Collapses i along its cheapest legal out-edge (evaluated in L) unless that costs more than
+  // Collapses i along its cheapest legal out-edge (evaluated in sc) unless that costs more than
   // slack_ × `next`, the key of the next entry: then i goes back into the queue under its new
   // cost. Most pops find that the cost went up since a neighbour collapsed. On meshes large
   // enough to be cut in slabs, those within 10% are taken anyway: a quarter fewer pops (each
@@ -374,23 +374,23 @@ class Simplifier {
   // on the carotid data, 1.8% fewer bytes. Small meshes pack in moments: they keep the exact
   // order (the 8,750 tets of post.vtk got up to 12% worse with the slack).
   static constexpr float kLargeMeshSlack = 1.1f;
-  void tryCollapse(Worker& W, uint32_t i, Lane& L, float next);
+  void tryCollapse(Queue& Q, uint32_t i, Scratch& sc, float next);
 
   // ------------------------------------------------------------------ the parallel phase
   // How slabs, rounds and these constants were chosen: simplify_slabs.cpp.
-  static constexpr double kPartShare = 0.98;
+  static constexpr double kSlabShare = 0.98;
   static constexpr float kTauGrowth = 1.41421356f;
   static constexpr uint32_t kMaxSlabs = 3;
 
   uint32_t slabsOf(const std::vector<uint32_t>& order, bool staggered, std::vector<uint8_t>& slab) const;
-  void runParts(uint32_t planned);
+  void runSlabs(uint32_t planned);
   void mergeRound(uint32_t slabs);
   void markInner(const std::vector<uint8_t>& slab);
   static constexpr uint32_t kTwoThreadScan = 200000;  // tets: markInner() on two threads from here
 
   // ------------------------------------------------------------------ link condition
   void gatherLink(uint32_t v, std::vector<uint32_t>& verts, std::vector<uint64_t>& edges, std::vector<Tri>& tris);
-  bool linkCondition(Worker& W, uint32_t i, uint32_t j);
+  bool linkCondition(Queue& Q, uint32_t i, uint32_t j);
 
   // The link of edge (i, j): calls edge(o) with the opposite edge o[2] of every tet around it,
   // and face(k) for every boundary face (i, j, k).
@@ -436,7 +436,7 @@ class Simplifier {
   bool locate(uint32_t x, uint32_t t, uint32_t* vertices, double* w) const;
 
   // ------------------------------------------------------------------ the collapse
-  void collapse(Worker& W, uint32_t i, uint32_t j, float fieldErr, float key);
+  void collapse(Queue& Q, uint32_t i, uint32_t j, float fieldErr, float key);
 
   const TetMesh& mesh_;
   const SimplifyOptions& opt_;
@@ -473,24 +473,24 @@ class Simplifier {
   double meanVertexVolume_ = 1;              // the unit of the volume measure (init(), boundTerms())
   std::vector<double> qualitySum_;  // per vertex: Σ 3/κ over its star
   std::vector<uint8_t> queued_;  // per vertex: has an entry in the queue (or in the current round)
-  Lane mainLane_;
-  std::vector<Lane> lanes_;  // one per entry of a round (and per thread in init() and runParts())
-  // The one queue's lanes (all but the two of the first costs and the slabs) get their
+  Scratch mainScratch_;
+  std::vector<Scratch> scratches_;  // one per entry of a round (and per thread in init() and runSlabs())
+  // The one queue's scratches (all but the two of the first costs and the slabs) get their
   // per-vertex arrays only now, after the slabs, when less memory is in use (peak memory).
-  void readyLanes() {
-    if (mainLane_.seen.size() != V_) mainLane_.reset(V_);
-    for (Lane& L : lanes_)
-      if (L.seen.size() != V_) L.reset(V_);
+  void readyScratches() {
+    if (mainScratch_.seen.size() != V_) mainScratch_.reset(V_);
+    for (Scratch& sc : scratches_)
+      if (sc.seen.size() != V_) sc.reset(V_);
   }
   static constexpr uint32_t kRoundSize = 4;
   std::vector<Entry> round_;
   std::vector<uint32_t> changed_;  // per vertex: roundStamp_ of the last round that touched it
   bool trackChanges_ = false;      // collapses keep changed_ (the one queue's rounds of several)
   uint32_t roundStamp_ = 0;
-  Worker main_;     // the one queue of the whole mesh (its log is out_.log)
-  Worker parts_[kMaxSlabs];  // the slabs of the parallel phase
+  Queue main_;     // the one queue of the whole mesh (its log is out_.log)
+  Queue slabs_[kMaxSlabs];  // the slabs of the parallel phase
   float slack_ = 1.0f;  // see tryCollapse
-  std::vector<uint8_t> inner_;  // per vertex: every neighbour is in its slab (runParts)
+  std::vector<uint8_t> inner_;  // per vertex: every neighbour is in its slab (runSlabs)
 };
 
 }  // namespace tetstream::simplify_detail

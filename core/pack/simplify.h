@@ -43,7 +43,7 @@
 // disappear (when they contain the collapsed edge) or become proper.
 //
 // Order: one priority queue of vertices by the cost of their cheapest out-edge, updated lazily.
-// Meshes of partitionMinVertices or more are first simplified in slabs, one thread each (cut
+// Meshes of slabMinVertices or more are first simplified in slabs, one thread each (cut
 // along the vertex numbering or an axis, whichever crosses fewest vertices), each slab
 // collapsing only vertices whose whole neighbourhood is its own, so the two threads touch
 // disjoint data. Rounds of rising cost alternate between two slabs cut at the median and three
@@ -99,7 +99,7 @@ struct SimplifyOptions {
   // kiefer bracket (16,468 vertices) and Blunt Fin (40,921) pack in about 2/3 of the time at
   // the same field error (within -10%..+9% at 5, 10, 30% of the tets) and stream size; on
   // post.vtk (2,288) slabs doubled the error of the coarse levels and saved nothing.
-  uint32_t partitionMinVertices = 10000;
+  uint32_t slabMinVertices = 10000;
 };
 
 struct SimplifyResult {
@@ -114,7 +114,7 @@ struct SimplifyResult {
   uint32_t flatTetsLeft = 0;
   uint64_t costEvaluations = 0, rejectedByLink = 0;
   uint64_t queuePops = 0, requeued = 0;  // pops of current entries, and those pushed back costlier
-  uint32_t slabCollapses = 0;          // collapses made in the slabs at once (partitionMinVertices)
+  uint32_t slabCollapses = 0;          // collapses made in the slabs at once (slabMinVertices)
   std::string stopReason;          // "target reached", "no legal collapse left", "error bound"
 };
 

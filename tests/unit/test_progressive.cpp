@@ -466,7 +466,7 @@ TEST(Progressive, SlabsCollapseTheSameOnOneThreadAndTwo) {
   SimplifyResult one, two;
   SimplifyOptions o;
   o.targetVertices = 100;
-  o.partitionMinVertices = 0;
+  o.slabMinVertices = 0;
   SimplifyTuning tuning;
   tuning.verifyLinkCondition = true;  // (and the fast link check agrees with the reference throughout)
   expectSameOnOneThreadAndTwo(harmonic(20), o, one, two, tuning);
@@ -766,9 +766,9 @@ void simplifyInSlabsAndWhole(const TetMesh& m, uint32_t vertices, uint32_t tets,
   SimplifyOptions so;
   so.targetVertices = vertices;
   so.targetTets = tets;
-  so.partitionMinVertices = 0;
+  so.slabMinVertices = 0;
   ASSERT_TRUE(simplifyMesh(m, so, slabs));
-  so.partitionMinVertices = ~0u;
+  so.slabMinVertices = ~0u;
   ASSERT_TRUE(simplifyMesh(m, so, whole));
 }
 
@@ -779,7 +779,7 @@ void simplifyInSlabsAndWhole(const TetMesh& m, uint32_t vertices, uint32_t tets,
 TEST(Progressive, SlabsGiveValidLevelsAndTheSameQuality) {
   TetMesh m = harmonic(20);
   PackOptions o;
-  o.partitionMinVertices = 0;
+  o.slabMinVertices = 0;
   roundTrip("slabs", m, o);
   SimplifyResult slabs, whole;
   simplifyInSlabsAndWhole(m, 0, m.tetCount() / 20, slabs, whole);
