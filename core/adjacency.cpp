@@ -72,8 +72,7 @@ void buildFaceAdjacency(std::span<const uint32_t> tets, uint32_t vertexCount, Fa
   for ([[maybe_unused]] uint32_t v : tets) assert(v < vertexCount);
 #if !defined(__EMSCRIPTEN__)
   // Natively, a large mesh's vertices in two halves on two threads (each scans every face and
-  // pairs those of its half: the pairs never cross, so the writes don't either). Harmonic 64³:
-  // 124 → ~70 ms.
+  // pairs those of its half: the pairs never cross, so the writes don't either).
   if (tets.size() >= kParallelHalfFaces) {
     uint64_t upper = 0;
     std::jthread other([&] { upper = pairFaces(tets, vertexCount / 2, vertexCount, out.opposite); });

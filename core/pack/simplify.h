@@ -18,19 +18,18 @@
 //        s_j is the value j takes after the collapse (fitValues below).
 //   E_s  shape error, paper §3.3: the measure κ(S) − 3 normalised as (κ − 3)/κ = 1 − 3/κ, in
 //        [0, 1), averaged over the tets around p_j after the collapse (0: all equilateral).
-//        The paper's unbounded κ − 3 let the shape term outweigh the field wherever a mesh is
-//        anisotropic: on the Blunt Fin CFD grid it made the density error 6.6× larger.
+//        The paper's unbounded κ − 3 lets the shape term outweigh the field wherever a mesh is
+//        anisotropic (graded CFD grids, docs/design-notes.md).
 // The whole cost is then divided by sqrt(r), r the number of tets the collapse removes (the
 // tets around the edge): a level is as large as its tets (the base's bytes, the viewer's work
 // and the benchmarks' levels go by tets), so a collapse that removes six tets may err more
 // than one that removes three and still go first. The root, not r itself: a split's bytes go
-// by its vertex as well as by its tets (session 33: r itself gave a 5-15% higher error at the
-// same bytes received).
+// by its vertex as well as by its tets, so r itself over-rewards collapses of many tets and
+// gives a higher error at the same bytes received.
 // Defaults (100, 1, 0.005) keep the boundary first, then the field; tet shape is a
 // tie-breaker; all terms are scale free, so they work for any mesh size and field range.
-// (Shape weight chosen on Harmonic 64³ and Blunt Fin: 0.002 to 0.02 trade the field error at the
-// coarsest levels against that at finer ones; 0.02 gives better tets, mean 3/κ 0.535 against 0.50
-// at 5% of Harmonic's tets, and a 2% lower error there, but a 10% higher one at 30%.)
+// A larger shape weight gives better tets and a lower error at the coarsest levels, but a higher
+// one at finer levels; 0.005 balances the two (docs/design-notes.md).
 //
 // Legality, checked for every collapse (paper §3.2 and Staadt & Gross / Dey et al.):
 //   - a boundary vertex may only move along a boundary edge;
@@ -95,10 +94,10 @@ struct SimplifyOptions {
   int threads = 2;
   uint32_t parallelMinVertices = 20000;
   // Meshes of at least this many vertices are simplified in slabs at once for most of the
-  // way (simplify_slabs.cpp); the result depends on this, not on `threads`. From 10,000: the
-  // kiefer bracket (16,468 vertices) and Blunt Fin (40,921) pack in about 2/3 of the time at
-  // the same field error (within -10%..+9% at 5, 10, 30% of the tets) and stream size; on
-  // post.vtk (2,288) slabs doubled the error of the coarse levels and saved nothing.
+  // way (simplify_slabs.cpp); the result depends on this, not on `threads`. Above it slabs save
+  // about a third of the time at the same field error and stream size; on much smaller meshes
+  // the cuts are a large share of the vertices, the coarse levels' error grows and little time
+  // is saved.
   uint32_t slabMinVertices = 10000;
 };
 

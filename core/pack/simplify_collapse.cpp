@@ -66,7 +66,7 @@ void Simplifier::collapse(Queue& Q, uint32_t i, uint32_t j, float fieldErr, floa
     for (int k = 0; k < 4; ++k)
       if (v[k] != i) eraseFrom(star_[v[k]], t);
   }
-  {  // j's star grows by a quarter beyond what it needs, not by doubling (peak memory 197 -> 192 MB on Harmonic 64³)
+  {  // j's star grows by a quarter beyond what it needs, not by doubling (a lower peak memory)
     std::vector<uint32_t>& sj = star_[j];
     size_t need = sj.size();
     for (uint32_t t : around) need += out_.tetAlive[t];
@@ -100,8 +100,8 @@ void Simplifier::collapse(Queue& Q, uint32_t i, uint32_t j, float fieldErr, floa
   fieldQuadric_[j].add(fieldQuadric_[i]);
   // j now stands for the region of both: its value becomes the one that fits the original
   // field there best (least squares over the region's original tets, at p_j); the split gives
-  // the value before back. (The paper keeps the sample; at 5% of Harmonic's tets fitting
-  // lowers the RMS field error by a fifth.)
+  // the value before back. (The paper keeps the sample; fitting lowers the coarse levels' RMS
+  // field error.)
   represented_[j] += represented_[i];
   if (fitsRegion(represented_[j])) vert_[j].fit = float(fitted(fieldQuadric_[j], p(j), vert_[j].fit));
 

@@ -135,14 +135,13 @@ Simplifier::Candidate Simplifier::boundTerms(Scratch& sc, uint32_t i, uint32_t j
   // region), so a collapse that spreads an error over a large region waits behind one that
   // keeps it local. "How much" is the larger of two measures, which agree on an even mesh:
   // - their input vertices: the RMS at the input's vertices is what the benchmarks compare
-  //   with VTK. A volume alone made it 1.8× larger on Blunt Fin, whose vertices are mostly in
-  //   thin boundary layers;
+  //   with VTK. A volume alone lets it grow on meshes whose vertices crowd into thin boundary
+  //   layers;
   // - their input volume (the field quadrics' weights) in units of an interior vertex's mean
   //   volume: averaged over all isovalues, an isosurface moves by the volume integral of the
   //   field error, so an error over a large coarse region shows on every isosurface through it.
-  //   With the count alone the coarse far field of Blunt Fin went early: at 30% of its tets the
-  //   isosurface of density 1.2 lay 9× farther from the input's (3.6e-4 of the diagonal, mean,
-  //   against 3.9e-5 now; session 25).
+  //   With the count alone a graded mesh's coarse far field goes early, and the isosurfaces
+  //   through it move far from the input's (figures: docs/design-notes.md).
   // The manifest reports the unweighted E_f.
   const double volume = fq.weight / meanVertexVolume_;  // (fq: i's and j's field quadrics, summed above)
   c.weight = std::sqrt(tune_.weighByVolume ? std::max(double(count), volume) : double(count));
@@ -237,9 +236,9 @@ bool Simplifier::finishCost(Scratch& sc, Candidate& c, CollapseVerdict* verdict)
 // The legal out-edges of i with their lower bounds (prepareStar(i) and neighbours(i) first).
 // What boundTerms() reads of a neighbour is scattered over large arrays (the loads of the field
 // quadrics were half of its time): it is asked for as soon as legal() passes the out-edge, and
-// only then. Asking for every neighbour's while legal() ran, as before session 21, fetched four
-// times what was used (about 3 of 14 out-edges are legal), and the two threads of the slabs
-// share the memory's bandwidth: 3-5% more time in the simplifier on Harmonic 64³.
+// only then. Asking for every neighbour's while legal() runs would fetch about four times what
+// is used (most out-edges are not legal), and the two threads of the slabs share the memory's
+// bandwidth.
 void Simplifier::gatherCandidates(Scratch& sc, uint32_t i) {
   sc.candidates.clear();
   sc.passed.clear();
@@ -289,8 +288,8 @@ void Simplifier::neighbours(Scratch& sc, uint32_t v, std::vector<uint32_t>& out)
   const bool onBoundary = boundary_[v];
   for (uint32_t t : star_[v]) {
     __builtin_prefetch(&kappa_[t]);
-    // prepareStar reads a boundary vertex's face neighbours next: waiting on those loads took
-    // a third of its time on the kiefer bracket, whose vertices are mostly on the boundary.
+    // prepareStar reads a boundary vertex's face neighbours next: on meshes whose vertices are
+    // mostly on the boundary, waiting on those loads would be a large share of its time.
     if (onBoundary) __builtin_prefetch(&opp_[4 * size_t(t)]);
     for (int k = 0; k < 4; ++k) {
       uint32_t w = out_.tets[4 * size_t(t) + k];

@@ -12,18 +12,17 @@
 // Rounds: every slab collapses its entries up to a key τ, then τ grows by kTauGrowth. The
 // rounds alternate between two slabs cut at the median and three cut at the quartiles, so a
 // vertex left waiting along one round's cut is inner in the next and is collapsed within a
-// step of τ of its turn. (With one fixed cut its vertices waited for the whole mesh's queue at
-// the end: they were the last collapses and so the first splits, and the levels around 12% of
-// Harmonic 64³'s vertices spent a quarter of their vertices on a refined slab along the cut.
-// Parallel cuts never cross, so no vertex waits on two; more slabs, for smaller working sets,
-// made the stream up to 10% larger and were no faster.) Growth 2 left the levels up to 3%
-// worse than √2; 2^¼ was no better than √2 and takes twice the rounds (each ~10 ms on
-// Harmonic 64³).
+// step of τ of its turn. (With one fixed cut its vertices would wait for the whole mesh's queue
+// at the end: they would be the last collapses and so the first splits, and the coarse levels
+// would spend many of their vertices on a refined band along the cut. Parallel cuts never
+// cross, so no vertex waits on two; more slabs, for smaller working sets, make the stream
+// larger and are no faster.) A larger growth makes the levels worse; a smaller one is no
+// better and takes more rounds.
 // The slabs take kSlabShare of the planned collapses; the one queue of the whole mesh then
 // evens out what they left along the last round's cuts and takes the rest. Its collapses cost
-// twice as much time as the slabs' (Harmonic 64³: 5% of the collapses took 0.22 s there).
-// Shares from 0.95 to 0.99 gave the same field error within 0.3% at every level of Harmonic
-// 64³; with 1, Harmonic 20³ cut to 2.5% of its vertices got 55% worse (nothing evens out).
+// about twice as much time as the slabs', so the share is high; below 1, so that something is
+// left to even out the cuts (with 1 the coarsest levels get much worse). The error hardly
+// depends on the share between 0.95 and 0.99. Figures: docs/design-notes.md.
 #include "pack/simplifier.h"
 
 namespace tetstream::simplify_detail {
@@ -70,8 +69,8 @@ uint32_t Simplifier::slabsOf(const std::vector<uint32_t>& order, bool staggered,
 
 void Simplifier::runSlabs(uint32_t planned) {
   // The order the slabs follow: the vertex numbering (meshes are mostly numbered coherently,
-  // and the split stream then compresses best: Harmonic 64³'s grew by 9% with slabs across its
-  // numbering) or an axis, whichever crosses fewest vertices when halved.
+  // and the split stream then compresses best; slabs across the numbering make it larger) or
+  // an axis, whichever crosses fewest vertices when halved.
   // (Each axis sorts the order of the one before, stably: ties keep that order.)
   std::vector<uint32_t> order, candidate;  // (alive vertices only: those that die leave each round)
   std::vector<uint8_t> slab(V_, 0);
@@ -219,8 +218,8 @@ void Simplifier::mergeRound(uint32_t slabs) {
 }
 
 // inner_[v]: every alive tet around v lies in v's slab.
-// Every round scans all tets: on large meshes in two halves at once (carotid, 950k tets, 25
-// scans: ~90 → 60-70 ms). Both halves only ever write 0, relaxed: the result is the same.
+// Every round scans all tets: on large meshes (kTwoThreadScan) in two halves at once. Both
+// halves only ever write 0, relaxed: the result is the same.
 void Simplifier::markInner(const std::vector<uint8_t>& slab) {
   inner_.assign(V_, 1);
   auto scan = [&](uint32_t begin, uint32_t end) {
