@@ -217,7 +217,9 @@ class Simplifier {
   };
 
   // A small open-addressing table of edge keys with a byte of state, emptied in O(1) by
-  // changing its stamp. Link edge sets have tens of entries; it grows if ever needed.
+  // changing its stamp. Link edge sets have tens of entries; it grows if ever needed. (Not
+  // FlatMap: that one is emptied by a pass over its slots, and this is emptied at every link
+  // check.)
   struct EdgeTable {
     std::vector<uint64_t> keys;
     std::vector<uint32_t> stamps;
