@@ -1,10 +1,9 @@
 # The native libraries (zstd, pugixml, zlib) as TETSTREAM_ZSTD, TETSTREAM_PUGIXML and
 # TETSTREAM_ZLIB, and tetstream_static_cli(target), which links a program statically.
 #
-# Why the CLI is one static executable: it starts in about half the time (a pack of 48 tets took
-# 10.6-11.1 ms, 5.8-6.1 ms static, medians of 30 in two series: the dynamic loader bound
-# libstdc++'s symbols at each start, and the CLI starts twice when it restarts itself for huge
-# pages), and the one file runs on any x86-64 Linux, with no libzstd or pugixml installed and an
+# Why the CLI is one static executable: it starts in about half the time (the dynamic loader
+# binds libstdc++'s symbols at each start, and the CLI starts twice when it restarts itself for
+# huge pages), and the one file runs on any x86-64 Linux, with no libzstd or pugixml installed and an
 # older glibc, so it can be copied to the cluster where a simulation's results are and pack them
 # there. It reads files and starts threads only: nothing of glibc that needs shared objects at
 # run time (name services, iconv, dlopen).

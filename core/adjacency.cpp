@@ -6,6 +6,7 @@
 #include <thread>
 #endif
 
+#include "mesh.h"
 #include "tet_tables.h"
 
 namespace tetstream {
@@ -42,7 +43,7 @@ uint64_t pairFaces(std::span<const uint32_t> tets, uint32_t lo, uint32_t hi, std
   for (size_t h = 0; h < halfFaces; ++h) {
     uint32_t s[3];
     sortedFace(tets, h, s);
-    if (s[0] >= lo && s[0] < hi) entries[fill[s[0] - lo]++] = {uint64_t(s[1]) << 32 | s[2], uint32_t(h)};
+    if (s[0] >= lo && s[0] < hi) entries[fill[s[0] - lo]++] = {edgeKey(s[1], s[2]), uint32_t(h)};
   }
   uint64_t nonManifold = 0;
   for (size_t v = 0; v < hi - lo; ++v) {
@@ -71,8 +72,7 @@ void buildFaceAdjacency(std::span<const uint32_t> tets, uint32_t vertexCount, Fa
   for ([[maybe_unused]] uint32_t v : tets) assert(v < vertexCount);
 #if !defined(__EMSCRIPTEN__)
   // Natively, a large mesh's vertices in two halves on two threads (each scans every face and
-  // pairs those of its half: the pairs never cross, so the writes don't either). Harmonic 64³:
-  // 124 → ~70 ms.
+  // pairs those of its half: the pairs never cross, so the writes don't either).
   if (tets.size() >= kParallelHalfFaces) {
     uint64_t upper = 0;
     std::jthread other([&] { upper = pairFaces(tets, vertexCount / 2, vertexCount, out.opposite); });

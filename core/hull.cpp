@@ -4,6 +4,8 @@
 #include <cmath>
 
 #include "adjacency.h"
+#include "hash.h"
+#include "mesh.h"
 #include "tet_tables.h"
 
 namespace tetstream {
@@ -11,16 +13,6 @@ namespace {
 
 // Boundary edges whose two triangles' normals differ by more than ~30 degrees are creases.
 constexpr float kCreaseCos = 0.866f;
-
-uint64_t edgeKey(uint32_t a, uint32_t b) { return a < b ? uint64_t(a) << 32 | b : uint64_t(b) << 32 | a; }
-
-uint64_t mix(uint64_t x) {  // splitmix64 finaliser
-  x ^= x >> 30;
-  x *= 0xbf58476d1ce4e5b9ull;
-  x ^= x >> 27;
-  x *= 0x94d049bb133111ebull;
-  return x ^ (x >> 31);
-}
 
 // Outward unit normal of triangle (a, b, c), 0 when degenerate.
 void faceNormal(const float* p, const uint32_t tri[3], float n[3]) {
@@ -141,7 +133,7 @@ void HullTracker::recount(const ProgressiveMesh& pm, uint32_t v) {
       for (int i = 0; i < 3; ++i)
         if (kTetFaces[f][i] != k) other[n++] = tets[4 * t + kTetFaces[f][i]];
       const uint64_t key = edgeKey(other[0], other[1]);
-      parity ^= mix(key);
+      parity ^= hash64(key);
       entries_.push_back({key, t << 2 | f});
     }
   }
@@ -256,7 +248,7 @@ void HullTracker::updateEdge(const float* p, uint64_t key) {
     draw = n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2] < kCreaseCos;
   }
   const uint32_t line = lineOfEdge_.find(key);
-  if (draw && line == SurfaceVertexMap::kNone) {
+  if (draw && line == FlatMap::kNone) {
     const uint32_t slot = lineCount();
     lines_.insert(lines_.end(), p + 3 * size_t(a), p + 3 * size_t(a) + 3);
     lines_.insert(lines_.end(), p + 3 * size_t(b), p + 3 * size_t(b) + 3);
@@ -264,7 +256,7 @@ void HullTracker::updateEdge(const float* p, uint64_t key) {
     bool inserted;
     lineOfEdge_.findOrInsert(key, slot, &inserted);
     if (!fullUpload_) changedLines_.push_back(slot);
-  } else if (!draw && line != SurfaceVertexMap::kNone) {
+  } else if (!draw && line != FlatMap::kNone) {
     removeLine(line);
   }
 }

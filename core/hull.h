@@ -71,7 +71,7 @@ class HullTracker {
   // reverse (edge key lo << 32 | hi -> slot).
   std::vector<float> lines_;
   std::vector<uint64_t> lineKeys_;
-  SurfaceVertexMap lineOfEdge_;
+  FlatMap lineOfEdge_;
 
   std::vector<uint64_t> dirtyEdges_;
   std::vector<FaceEntry> entries_;                               // recount scratch

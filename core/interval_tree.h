@@ -36,12 +36,10 @@
 //                 would grow (amortised O(1) per operation). When removals leave the buckets on
 //                 average 1/8 full the buckets are rebuilt (amortised over those removals).
 // Memory: 8 bytes per id (its interval) + 8 bytes per stored interval in a slab with slack
-// (built 80% full) + dead arena up to a quarter + 28 bytes per bucket. Measured on Harmonic 64
-// (1.5M tets): 18.2 bytes per tet after build, 27-28 after 20000 simulated splits or 200k
-// random updates. memoryBytes() reports the actual figure.
-// Measured query times there, wasm (node 20, -O3): 0.03-0.19 ms for 6k-68k cut tets, against
-// 3-4 ms for a scan over precomputed intervals and 8-9 ms for classifying every tet; update of
-// one tet's interval 0.9 us (native 0.6 us).
+// (built 80% full) + dead arena up to a quarter + 28 bytes per bucket. memoryBytes() reports
+// the actual figure. A query costs in proportion to the cut tets it returns, an order of
+// magnitude below a scan of every tet's interval; an update of one tet's interval is about a
+// microsecond. Figures: docs/design-notes.md.
 #pragma once
 #include <cstdint>
 #include <span>

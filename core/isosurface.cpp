@@ -17,21 +17,15 @@ struct Extraction {
 
   // Surface vertex on the edge (a, b), one endpoint above λ and one at or below.
   uint32_t edgeVertex(uint32_t a, uint32_t b) {
-    uint32_t lo = field[a] > iso ? b : a;  // at or below λ
-    uint32_t hi = lo == a ? b : a;         // above λ
-    float s0 = field[lo], s1 = field[hi];
-    uint64_t key = s0 == iso ? (uint64_t(lo) << 32 | lo)
-                             : (uint64_t(a < b ? a : b) << 32 | (a < b ? b : a));
+    const CutEdge c = cutEdge(field, iso, a, b);
     bool inserted;
-    uint32_t id = scratch->vertexOfEdge.findOrInsert(key, out->vertexCount(), &inserted);
+    uint32_t id = scratch->vertexOfEdge.findOrInsert(c.key, out->vertexCount(), &inserted);
     if (!inserted) return id;
-    // Paper eq. (7) with p0 = the vertex below, p1 = the vertex above: s1 > λ >= s0, so the
-    // denominator is positive and the weights lie in [0, 1].
-    float w1 = (iso - s0) / (s1 - s0);
-    float w0 = 1.0f - w1;
-    const float* p0 = pos + 3 * size_t(lo);
-    const float* p1 = pos + 3 * size_t(hi);
-    for (int k = 0; k < 3; ++k) out->positions.push_back(s0 == iso ? p0[k] : w0 * p0[k] + w1 * p1[k]);
+    const float w1 = c.weightHi(iso);
+    const float w0 = 1.0f - w1;
+    const float* p0 = pos + 3 * size_t(c.lo);
+    const float* p1 = pos + 3 * size_t(c.hi);
+    for (int k = 0; k < 3; ++k) out->positions.push_back(cutValue(c, w0, w1, p0[k], p1[k]));
     for (int k = 0; k < 3; ++k) out->normals.push_back(0.0f);
     return id;
   }

@@ -11,7 +11,7 @@
 #include <span>
 #include <vector>
 
-#include "edge_map.h"
+#include "flat_map.h"
 #include "mesh.h"
 
 namespace tetstream {
@@ -26,9 +26,39 @@ struct IsoSurface {
   void clear() { positions.clear(); normals.clear(); indices.clear(); }
 };
 
+// The surface vertex on mesh edge (a, b), one end above λ and one at or below. Both extractors
+// (this one and IncrementalIsosurface) build their vertices with cutEdge() and cutValue(), so
+// they agree on every key and every position bit.
+struct CutEdge {
+  uint32_t lo, hi;  // the end at or below λ, the end above
+  float s0, s1;     // their values: s1 > λ >= s0
+  bool onVertex;    // s0 == λ: the surface vertex is mesh vertex lo itself
+  uint64_t key;     // edgeKey(a, b), or lo << 32 | lo when onVertex (one vertex for all its edges)
+
+  // Paper eq. (7) with p0 = lo, p1 = hi: the denominator is positive, the weights lie in [0, 1].
+  float weightHi(float isovalue) const { return (isovalue - s0) / (s1 - s0); }
+};
+
+inline CutEdge cutEdge(const float* field, float isovalue, uint32_t a, uint32_t b) {
+  CutEdge c;
+  c.lo = field[a] > isovalue ? b : a;
+  c.hi = c.lo == a ? b : a;
+  c.s0 = field[c.lo];
+  c.s1 = field[c.hi];
+  c.onVertex = c.s0 == isovalue;
+  c.key = c.onVertex ? (uint64_t(c.lo) << 32 | c.lo) : edgeKey(a, b);
+  return c;
+}
+
+// A per-vertex quantity (a coordinate, a colour) at the surface vertex of c, from its values at
+// lo and hi and the weights w0 = 1 - w1, w1 = c.weightHi(λ).
+inline float cutValue(const CutEdge& c, float w0, float w1, float atLo, float atHi) {
+  return c.onVertex ? atLo : w0 * atLo + w1 * atHi;
+}
+
 // Long-lived scratch state: create once, reuse for every extraction (no reallocation once warm).
 struct IsoExtractor {
-  EdgeMap vertexOfEdge;  // edge key (lo << 32 | hi), or (v << 32 | v) for a vertex on λ
+  FlatMap vertexOfEdge;  // CutEdge::key -> surface vertex
 };
 
 // Extracts the isosurface field == isovalue from all tetrahedra of `mesh`, or only from those

@@ -42,81 +42,6 @@ double triangleArea(const float* p, uint32_t ia, uint32_t ib, uint32_t ic) {
 
 }  // namespace
 
-// ------------------------------------------------------------------ SurfaceVertexMap
-
-void SurfaceVertexMap::clear() {
-  if (size_ != 0) std::fill(keys_.begin(), keys_.end(), kEmpty);
-  size_ = 0;
-}
-
-uint32_t SurfaceVertexMap::find(uint64_t key) const {
-  if (keys_.empty()) return kNone;
-  const size_t mask = keys_.size() - 1;
-  for (size_t i = hash(key) & mask;; i = (i + 1) & mask) {
-    if (keys_[i] == key) return values_[i];
-    if (keys_[i] == kEmpty) return kNone;
-  }
-}
-
-uint32_t SurfaceVertexMap::findOrInsert(uint64_t key, uint32_t value, bool* inserted) {
-  assert(key != kEmpty);
-  if (2 * (size_ + 1) > keys_.size()) rehash(keys_.empty() ? 1024 : 2 * keys_.size());
-  const size_t mask = keys_.size() - 1;
-  for (size_t i = hash(key) & mask;; i = (i + 1) & mask) {
-    if (keys_[i] == key) {
-      *inserted = false;
-      return values_[i];
-    }
-    if (keys_[i] == kEmpty) {
-      keys_[i] = key;
-      values_[i] = value;
-      ++size_;
-      *inserted = true;
-      return value;
-    }
-  }
-}
-
-void SurfaceVertexMap::erase(uint64_t key) {
-  assert(!keys_.empty());
-  const size_t mask = keys_.size() - 1;
-  size_t i = hash(key) & mask;
-  while (keys_[i] != key) {
-    assert(keys_[i] != kEmpty);
-    i = (i + 1) & mask;
-  }
-  // Backward shift: move later members of the probe run into the hole unless their home slot
-  // lies cyclically in (hole, j], where they must stay reachable.
-  for (size_t j = i;;) {
-    j = (j + 1) & mask;
-    if (keys_[j] == kEmpty) break;
-    size_t h = hash(keys_[j]) & mask;
-    bool stays = i <= j ? (i < h && h <= j) : (i < h || h <= j);
-    if (stays) continue;
-    keys_[i] = keys_[j];
-    values_[i] = values_[j];
-    i = j;
-  }
-  keys_[i] = kEmpty;
-  --size_;
-}
-
-void SurfaceVertexMap::remapValues(std::span<const uint32_t> remap) {
-  for (size_t i = 0; i < keys_.size(); ++i)
-    if (keys_[i] != kEmpty) values_[i] = remap[values_[i]];
-}
-
-void SurfaceVertexMap::rehash(size_t cap) {
-  std::vector<uint64_t> oldKeys(cap, kEmpty);
-  std::vector<uint32_t> oldValues(cap);
-  oldKeys.swap(keys_);
-  oldValues.swap(values_);
-  size_ = 0;
-  bool inserted;
-  for (size_t i = 0; i < oldKeys.size(); ++i)
-    if (oldKeys[i] != kEmpty) findOrInsert(oldKeys[i], oldValues[i], &inserted);
-}
-
 // ------------------------------------------------------------------ IncrementalIsosurface
 
 struct IncrementalIsosurface::Context {
@@ -339,19 +264,18 @@ void IncrementalIsosurface::removeTet(uint32_t t) {
   tetRecord_[t] = kNone;
 }
 
-// The surface vertex on mesh edge (a, b), one end above λ: isosurface.cpp's edgeVertex, with
-// the same key, the same arithmetic and therefore the same position bits.
+// The surface vertex on mesh edge (a, b), one end above λ: the same key and position bits as
+// extractIsosurface's (both use cutEdge and cutValue, isosurface.h).
 uint32_t IncrementalIsosurface::acquireVertex(const Context& c, uint32_t a, uint32_t b) {
-  const uint32_t lo = c.field[a] > c.iso ? b : a;  // at or below λ
-  const uint32_t hi = lo == a ? b : a;             // above λ
-  const float s0 = c.field[lo], s1 = c.field[hi];
-  const uint64_t key = s0 == c.iso ? (uint64_t(lo) << 32 | lo) : (uint64_t(a < b ? a : b) << 32 | (a < b ? b : a));
+  const CutEdge e = cutEdge(c.field, c.iso, a, b);
+  const uint32_t lo = e.lo, hi = e.hi;
+  const uint64_t key = e.key;
   uint32_t v = freeVertices_.empty() ? vertexSlotCount() : freeVertices_.back();
   bool inserted;
   const uint32_t found = map_.findOrInsert(key, v, &inserted);
   if (!inserted) return found;
 
-  const float w1 = (c.iso - s0) / (s1 - s0);  // paper eq. (7), s1 > λ >= s0
+  const float w1 = e.weightHi(c.iso);
   const float w0 = 1.0f - w1;
   const float* p0 = c.pos + 3 * size_t(lo);
   const float* p1 = c.pos + 3 * size_t(hi);
@@ -365,12 +289,12 @@ uint32_t IncrementalIsosurface::acquireVertex(const Context& c, uint32_t a, uint
   }
   float* q = &positions_[3 * size_t(v)];
   for (int k = 0; k < 3; ++k) {
-    q[k] = s0 == c.iso ? p0[k] : w0 * p0[k] + w1 * p1[k];
+    q[k] = cutValue(e, w0, w1, p0[k], p1[k]);
     normals_[3 * size_t(v) + k] = 0;
   }
   // The weight of the key's second vertex (the larger id), so recolour() can interpolate again.
-  const float tHigh = s0 == c.iso ? 0.f : (hi == uint32_t(key) ? w1 : w0);
-  colours_[v] = !c.colour ? 0.f : s0 == c.iso ? c.colour[lo] : w0 * c.colour[lo] + w1 * c.colour[hi];
+  const float tHigh = e.onVertex ? 0.f : (hi == uint32_t(key) ? w1 : w0);
+  colours_[v] = !c.colour ? 0.f : cutValue(e, w0, w1, c.colour[lo], c.colour[hi]);
   vertices_[v] = Vertex{{0, 0, 0}, key, 0, 0, 0, tHigh};
   touchVertex(v);
   return v;

@@ -33,13 +33,12 @@
 //
 // Memory: per tet 4 bytes (record index) + 1 bit (rebuild's ordering bitmap) + the interval
 // tree (18-28 bytes); per cut tet a 28-byte record; per triangle 17 bytes; per surface vertex
-// about 104 bytes (position, normal, colour, double normal sum, key, counts, hash slots). Measured on
-// Harmonic 64 at λ = 0.1 after 20000 simulated splits: 49 bytes per tet in all.
-// Measured speed there (wasm, node 20, -O3; native in brackets): updateTets 9.7 us per split of
-// 11.6 changed tets (5.7 us), its undo 7.4 us (4.2 us); rebuild 1.0-12.5 ms for 8k-86k triangles
-// against 7.9-15.7 ms for extractIsosurface on the whole mesh. Past the query (< 0.2 ms), a
-// rebuild costs about 1.7x the bare marching-tets work on the cut tets: the bookkeeping that
-// makes the local updates possible.
+// about 104 bytes (position, normal, colour, double normal sum, key, counts, hash slots);
+// memoryBytes() reports the actual figure.
+// Speed: updateTets costs microseconds per split (a dozen changed tets), far below a full
+// extraction; rebuild() only visits the cut tets the interval tree returns, at about twice the
+// bare marching-tets work on them (the bookkeeping that makes the local updates possible).
+// Figures: docs/design-notes.md.
 #pragma once
 #include <cstdint>
 #include <span>
@@ -50,38 +49,6 @@
 #include "mesh.h"
 
 namespace tetstream {
-
-// Open-addressing hash map from a surface vertex key (isosurface.h: lo << 32 | hi for an edge,
-// v << 32 | v for a mesh vertex on λ) to a vertex slot, with erase (backward-shift deletion, no
-// tombstones). Capacity is a power of two, at most half full; clear() keeps it.
-class SurfaceVertexMap {
- public:
-  static constexpr uint64_t kEmpty = ~uint64_t(0);
-  static constexpr uint32_t kNone = ~uint32_t(0);
-
-  void clear();
-  size_t size() const { return size_; }
-  uint32_t find(uint64_t key) const;  // kNone when absent
-  // The value stored for key; when absent, stores `value` first. *inserted tells which.
-  uint32_t findOrInsert(uint64_t key, uint32_t value, bool* inserted);
-  void erase(uint64_t key);  // precondition: key present
-  // Rewrites every value v as remap[v] (compaction).
-  void remapValues(std::span<const uint32_t> remap);
-  size_t memoryBytes() const { return keys_.capacity() * 8 + values_.capacity() * 4; }
-
- private:
-  static uint64_t hash(uint64_t x) {  // splitmix64 finaliser, as EdgeMap
-    x ^= x >> 30;
-    x *= 0xbf58476d1ce4e5b9ull;
-    x ^= x >> 27;
-    x *= 0x94d049bb133111ebull;
-    return x ^ (x >> 31);
-  }
-  void rehash(size_t cap);
-  std::vector<uint64_t> keys_;
-  std::vector<uint32_t> values_;
-  size_t size_ = 0;
-};
 
 class IncrementalIsosurface {
  public:
@@ -116,10 +83,10 @@ class IncrementalIsosurface {
   // Deferred interval tree, for a mesh that is being refined fast (a level streaming in). The
   // tree covers tets [0, treeCoverage()): rebuild() queries it for those and tests every other
   // tet's interval itself; updateTets keeps it up to date for those only. Keeping it up to date
-  // costs ~1 us per changed tet, a third of a split's refinement time, which is wasted while
+  // costs about a third of a split's refinement time, which is wasted while
   // hundreds of thousands of splits stream in and the isovalue does not change. By default
   // (deferred off) rebuild() builds the tree over the whole mesh and updateTets keeps it whole.
-  // Deferred, rebuild() never builds it at once (156 ms at 1.5M tets in wasm: a frozen frame);
+  // Deferred, rebuild() never builds it at once (on a large mesh that freezes a frame);
   // extendTree() grows it by at most maxTets tets per call, for idle time in short slices, and
   // returns true once it covers the mesh. Tets added by updateTets later are not covered until
   // extendTree() is called again. setTreeDeferred(true) keeps what is covered.
@@ -183,7 +150,7 @@ class IncrementalIsosurface {
   uint32_t coverage_ = 0;   // the tree holds tets [0, coverage_)
   bool bulk_ = false;  // inside rebuild(): no per-slot change tracking
   IntervalTree tree_;
-  SurfaceVertexMap map_;
+  FlatMap map_;
 
   // A tet with a cut case: the up to 4 distinct surface vertices it created or shares
   // (kNone-padded; each counted once in Vertex::refs) and its 0-2 triangle slots (kNone: none).

@@ -43,6 +43,9 @@ Bounds computeBounds(std::span<const float> positions);
 // Range of the finite values; {0,0} when there are none.
 Range computeRange(std::span<const float> values);
 
+// The key of the undirected edge (a, b): the smaller id in the high 32 bits, the larger in the low.
+inline uint64_t edgeKey(uint32_t a, uint32_t b) { return a < b ? uint64_t(a) << 32 | b : uint64_t(b) << 32 | a; }
+
 // Signed volume of tet (a, b, c, d), paper eq. (1), computed in double.
 double tetVolume(const float* a, const float* b, const float* c, const float* d);
 inline double tetVolume(const TetMesh& m, uint32_t t) {

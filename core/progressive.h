@@ -19,8 +19,7 @@ namespace tetstream {
 
 // Per-vertex corner lists in one flat array. Block sizes go 8, 12, 16, 24, 32, 48, ... (steps of
 // about 1.5); a full block moves to the next size, and freed blocks are kept by size for reuse,
-// so the pool holds about 1.3 slots per corner (1.27 measured on Harmonic 64³, streamed) and
-// never needs compacting. Order within a list is not meaningful (starOf and neighboursOf sort).
+// so the pool holds about 1.3 slots per corner and never needs compacting. Order within a list is not meaningful (starOf and neighboursOf sort).
 class StarPool {
  public:
   void clear();
@@ -100,8 +99,8 @@ struct ProgressiveMesh {
 void initProgressive(ProgressiveMesh& pm, TetMesh base);
 
 // Sets aside room for a mesh of `vertices` and `tets` (the full level), so that applying
-// splits never moves the arrays (the packer's encoder: growing them by doubling copied and
-// first-touched ~40 MB on Harmonic 64³).
+// splits never moves the arrays (the packer's encoder: growing them by doubling would copy and
+// first-touch tens of MB on a large mesh).
 void reserveProgressive(ProgressiveMesh& pm, uint32_t vertices, uint32_t tets);
 
 // Tets around v, ascending ids (the canonical order of FORMAT.md §4).

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <limits>
 
+#include "tet_tables.h"
+
 namespace tetstream {
 
 // Everything the simplifier's tests need about one tet, from shared edge vectors:
@@ -53,15 +55,13 @@ inline TetShape tetShape(const double* a, const double* b, const double* c, cons
 inline double tetConditionNumber(const double* a, const double* b, const double* c, const double* d) {
   const double* p[4] = {a, b, c, d};
   double l2 = 0;
-  static constexpr int kE[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
-  for (const auto& e : kE)
+  for (const auto& e : kTetEdges)
     for (int k = 0; k < 3; ++k) {
       double x = p[e[1]][k] - p[e[0]][k];
       l2 += x * x;
     }
-  static constexpr int kF[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
   double a2 = 0;
-  for (const auto& f : kF) {
+  for (const auto& f : kTetFaces) {
     double u[3], v[3];
     for (int k = 0; k < 3; ++k) {
       u[k] = p[f[1]][k] - p[f[0]][k];

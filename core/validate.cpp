@@ -103,9 +103,8 @@ ValidationReport validateMesh(const TetMesh& m, FaceAdjacency* adjacency) {
     if (adjacency) *adjacency = std::move(adj);
   };
   // The faces take about as long as the rest together (each fills its own counts): natively, a
-  // mesh of some size has the shapes and duplicates done on a second thread meanwhile (the
-  // kiefer bracket, 56,786 tets: 26 → 16 ms, 30 → 22 in a fresh process). The web build has no
-  // threads.
+  // mesh of some size has the shapes and duplicates done on a second thread meanwhile, which
+  // nearly halves the time. The web build has no threads.
   if (!indicesOk || T == 0) {
     shapes();
   } else {

@@ -5,7 +5,7 @@
 #include <filesystem>
 
 #include "dataset.h"
-#include "pack/mesh_io.h"
+#include "io/mesh_io.h"
 
 namespace tetstream::cli {
 

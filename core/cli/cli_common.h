@@ -10,7 +10,7 @@
 
 #include "manifest.h"
 #include "mesh.h"
-#include "pack/mesh_io.h"
+#include "io/mesh_io.h"
 #include "status.h"
 
 namespace tetstream::cli {

@@ -4,8 +4,8 @@
 
 #include "cli_common.h"
 #include "commands.h"
-#include "pack/generators.h"
-#include "pack/mesh_io.h"
+#include "io/generators.h"
+#include "io/mesh_io.h"
 
 namespace tetstream::cli {
 

@@ -6,7 +6,7 @@
 #include "cli_common.h"
 #include "commands.h"
 #include "isosurface.h"
-#include "pack/ply_writer.h"
+#include "io/ply_writer.h"
 
 namespace tetstream::cli {
 

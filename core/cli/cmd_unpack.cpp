@@ -4,7 +4,7 @@
 
 #include "cli_common.h"
 #include "commands.h"
-#include "pack/mesh_io.h"
+#include "io/mesh_io.h"
 
 namespace tetstream::cli {
 

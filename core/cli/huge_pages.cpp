@@ -19,8 +19,8 @@ namespace {
 
 #if defined(__linux__) && defined(__GLIBC__)
 // What a first touch of a fresh 4 KB page costs here, in microseconds: 64 pages of a new mapping
-// written once each (about 0.3–1 µs on a machine of its own, 8–30 µs on this project's virtual
-// machines; the probe takes 2 ms there).
+// written once each (well under a microsecond on bare hardware, tens of microseconds on some
+// virtual machines, where the probe still takes only milliseconds).
 double microsecondsPerFreshPage() {
   constexpr size_t kPages = 64, kPage = 4096;
   const auto start = std::chrono::steady_clock::now();
@@ -48,34 +48,27 @@ std::string smallInputTunables(const char* userTunables) {
 
 // Why: packing touches about 2.5 times its peak memory afresh (arrays freed and allocated again
 // phase after phase: the file, the face pairing, the simplifier's and the encoder's arrays), and
-// on virtual machines such as this project's a first touch is expensive: 128,000 page faults cost
-// Harmonic 64³'s pack 1.2 s of system time. glibc asks the kernel for huge pages (2 MB, one fault
-// instead of 512) when the tunable glibc.malloc.hugetlb=1 is set at start, and a running program
-// cannot set it for itself: so the program starts itself again, once, with it set. Measured
-// (medians, the two settings taking turns): Harmonic 64³ to 5% 6.8 -> 5.5 s (reading 0.82 ->
-// 0.40 s, checks 0.37 -> 0.17 s), carotid 4.5 -> 3.7 s, Harmonic 24³ 491 -> 432 ms, peak memory
-// +3%; the output is the same. The second start costs ~0.3 ms since the CLI is linked statically
-// (~6 ms before, mostly the dynamic loader; cmake/static_cli.cmake), and post.vtk's pack (8,750
-// tets) gains ~2 ms. A file's size does not tell a small mesh from a large one (ironProt.vtk's
-// 314 KB hold 1.8M tets), so every command that reads an input does it (all but gen). Not done
-// when the kernel gives huge pages to every program anyway ("always") or to none ("never"), when
-// the tunable is set already, under valgrind (its tools would lose the program) or with
-// TETSTREAM_HUGE_PAGES=0. Nor where a first touch is cheap (under 2 µs a page), as there fewer
-// faults can gain little, and huge pages have been seen to cost: on session 16's machine the
-// simplifier was no faster with them and reading 2.3× slower.
+// on some virtual machines a first touch is expensive, so that page faults become a large share
+// of a pack's time. glibc asks the kernel for huge pages (2 MB, one fault instead of 512) when
+// the tunable glibc.malloc.hugetlb=1 is set at start, and a running program cannot set it for
+// itself: so the program starts itself again, once, with it set. The output is the same; peak
+// memory grows by a few percent. The second start is cheap because the CLI is linked statically
+// (cmake/static_cli.cmake). A file's size does not tell a small mesh from a large one (a
+// structured grid's file is tiny), so every command that reads an input does it (all but gen).
+// Not done when the kernel gives huge pages to every program anyway ("always") or to none
+// ("never"), when the tunable is set already, under valgrind (its tools would lose the program)
+// or with TETSTREAM_HUGE_PAGES=0. Nor where a first touch is cheap (kCheapPageMicroseconds):
+// there fewer faults can gain little, and huge pages can cost (slower reading).
 //
 // A small input (a file under 4 MB) also gets a heap that grows 32 MB at a time, every block up
 // to 32 MB taken from it (glibc's top_pad and mmap_threshold). glibc advises huge pages on each
 // growth of the heap only when that growth is 2 MB or more; grown a little at a time, a small
-// pack's heap stays in 4 KB pages, and blocks of 128 KB to 2 MB are mapped and unmapped afresh:
-// post.vtk's pack had 1,180 page faults, Harmonic 24³'s 2,550; with these settings 370 and 430.
-// Packs (medians of 7, 7 and 5, old and new taking turns, the same bytes): post.vtk 55 -> 46 ms,
-// Harmonic 24³ (a 3.2 MB .vtu) 314 -> 276 ms, Blunt Fin (PLOT3D) 1.09 -> 1.05 s; peak memory +1.2,
-// +2.8, +0.5 MB. Not for larger files: there they gained nothing measurable (Harmonic 40³ +1%,
-// Harmonic 64³ +2%, .vtu files of 16 and 66 MB) for up to 12% more peak memory, as they also stop
-// glibc from moving its own threshold up. A file's size does not always tell (ironProt.vtk's
-// 314 KB hold 1.8M tets), but the structured files that fool it came out the same (carotid.vtk
-// 4.09 / 4.08 s, ironProt.vtk 7.2 / 6.9 s, the same peak).
+// pack's heap stays in 4 KB pages, and blocks of 128 KB to 2 MB are mapped and unmapped afresh,
+// so these settings remove most of a small pack's page faults for a MB or two of peak memory.
+// Not for larger files: there they gain nothing measurable and cost more peak memory, as they
+// also stop glibc from moving its own threshold up. Structured files that fool the size test
+// come out the same either way.
+// Figures: docs/design-notes.md.
 void useHugePages(char** argv, const std::string& input) {
 #if defined(__linux__) && defined(__GLIBC__)
   constexpr double kCheapPageMicroseconds = 2.0;

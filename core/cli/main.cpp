@@ -12,8 +12,7 @@
 int main(int argc, char** argv) {
 #if defined(__GLIBC__)
   // One malloc arena for all threads: the packer's two simplifier threads grow and free star
-  // lists that other threads allocated, and separate arenas kept 24 MB more at the peak
-  // (Harmonic 64³).
+  // lists that other threads allocated, and separate arenas keep tens of MB more at the peak.
   mallopt(M_ARENA_MAX, 1);
 #endif
   using namespace tetstream::cli;

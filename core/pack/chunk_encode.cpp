@@ -36,9 +36,8 @@ Result finishChunk(const std::vector<uint8_t>& raw, int level, std::vector<uint8
   ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, level);
   if (level == kTunedZstdLevel) {
     // Level 18's match finder (btultra, 21-bit tables) gains nothing on split records: btopt
-    // with 17-bit hash and chain tables gives the same bytes (Harmonic 64³ +0.18%, carotid
-    // −0.05%, Blunt Fin +0.17%, post.vtk +0.08%) in two thirds of the time, and small tables
-    // are quick to set up for each chunk.
+    // with 17-bit hash and chain tables gives the same bytes within a fraction of a percent in
+    // two thirds of the time, and small tables are quick to set up for each chunk.
     ZSTD_CCtx_setParameter(cctx, ZSTD_c_strategy, ZSTD_btopt);
     ZSTD_CCtx_setParameter(cctx, ZSTD_c_hashLog, 17);
     ZSTD_CCtx_setParameter(cctx, ZSTD_c_chainLog, 17);

@@ -178,10 +178,10 @@ uint32_t LevelErrorMeter::acrossByStarsUncached(uint32_t t, int k) const {
 // Input vertex v left its tet, or was outside the mesh: a walk from there. If that ends outside,
 // a look among the tets of the level vertex that v was collapsed into (directly or not), where
 // v lies unless a collapse along the boundary moved the boundary past it. (A walk can leave a
-// non-convex mesh on the way to a point inside it: Blunt Fin's input vertices near the fin.) If
+// non-convex mesh on the way to a point inside it, e.g. input vertices near a fin.) If
 // v is outside the mesh after all, it takes the tet it is least outside of among those, the
 // walk's, and the tets around the corners of the best of these: often much nearer than the
-// walk's own where a coarse level cuts across a curved boundary (the kiefer bracket's holes).
+// walk's own where a coarse level cuts across a curved boundary (around holes).
 LevelErrorMeter::Found LevelErrorMeter::locateAgain(Scratch& s, uint32_t v) const {
   return nearby(s, v, walk(s, v));
 }

@@ -2,8 +2,8 @@
 // level's piecewise-linear field, interpolated at each input vertex, lies from the input's value
 // there (the figure the benchmarks compare with VTK). The encoder drives it while it replays the
 // splits, so the manifest can give each chunk's level a measured RMS and maximum over every input
-// vertex; the simplifier's per-collapse estimate (fieldError) is no bound: carotid's base measures
-// a largest error of 252 against an estimate of 239.
+// vertex; the simplifier's per-collapse estimate (fieldError) is no bound: a level's measured
+// largest error can exceed it.
 //
 // Every input vertex stays located in a tet of the level mesh. A split changes only the tets
 // T_moved (j becomes i) and adds T_new around the new edge (i, j); together they cover exactly
@@ -11,9 +11,8 @@
 // dirty (and the tets around j when j's value changed); a measurement runs through the input
 // vertices in order, on two threads, and tests those in dirty tets there; those no longer inside
 // walk from it to the tet that holds them now. Each vertex is tested at most once a measurement
-// however many splits its tet went through. (Before, a sample of 16,384 vertices was followed
-// split by split, in about the same time: it missed carotid's largest error by more than half,
-// 36.9 against 76.4 at the level of 23,939 vertices, and Harmonic 64³'s by up to 43%.)
+// however many splits its tet went through. (A sample of vertices followed split by split takes
+// about the same time and misses the largest errors, which lie at few vertices.)
 // An input vertex outside the level mesh (where a coarse level cuts across a curved or
 // non-convex boundary) takes the tet it is least outside of among those near where a walk
 // towards it ends, with its coordinates clamped to that tet; as splits move the boundary, those

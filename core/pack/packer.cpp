@@ -11,7 +11,7 @@
 #include <utility>
 
 #include "chunk_encode.h"
-#include "pack/file_writer.h"
+#include "io/file_writer.h"
 #include "pack/renumber.h"
 #include "pack/simplify.h"
 #include "pack/split_encode.h"
@@ -40,8 +40,8 @@ double msSince(std::chrono::steady_clock::time_point t0) {
 
 // The positions snapped to the quantization grid of `m` (FORMAT.md §4), into `snapped`. Returns
 // the number of tets that the snapping flattens or turns over (0 means this grid is safe).
-// (Into a copy of the positions only: copying the whole mesh and keeping every tet's volume took
-// 38 ms on Harmonic 64³.)
+// (Into a copy of the positions only: copying the whole mesh and keeping every tet's volume
+// costs more than the snapping.)
 uint64_t snapPositions(const TetMesh& mesh, const Manifest& m, std::vector<float>& snapped) {
   const Quantizer q = makeQuantizer(m);
   snapped.resize(mesh.positions.size());
@@ -67,10 +67,10 @@ void snapFields(TetMesh& mesh, const Manifest& m) {
 
 }  // namespace
 
-// Packing needs about kPackBytesPerTet per input tet at its peak (measured in session 20 with
-// huge pages, which add 2-4%: 138 B on Harmonic 64³, 136 B on ironProt.vtk, 130 B on Harmonic
-// 128³, 145 B on the carotid data, 178 B on Blunt Fin, README), with a margin. A mesh that would need more than the limit is refused up
-// front with the figure, rather than failing an allocation halfway through a long run.
+// Packing needs about kPackBytesPerTet per input tet at its peak (the measured peaks of the
+// benchmark meshes, huge pages included, with a margin). A mesh that would need more than the
+// limit is refused up front with the figure, rather than failing an allocation halfway through
+// a long run.
 constexpr double kPackBytesPerTet = 200;
 
 Result checkMemoryFor(const TetMesh& mesh, const PackOptions& opt) {
@@ -89,7 +89,7 @@ Result checkMemoryFor(const TetMesh& mesh, const PackOptions& opt) {
     };
     return fail(Status::TooLarge, "packing " + std::to_string(mesh.tetCount()) + " tetrahedra needs about " +
                                       size(need) + " of memory, more than the " + size(limit) + " allowed (" +
-                                      (physical ? "90% of this machine's memory; " : "") + "--max-memory)");
+                                      (physical ? "90% of the physical memory; " : "") + "--max-memory)");
   }
   return Result::success();
 }
@@ -105,9 +105,8 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   // A numbering that scatters neighbours costs cache misses at every step from here on, the
   // validation's included (renumber.h): such meshes are renumbered first (the stream has its
   // own numbering), when their indices and positions are usable at all (the validation says
-  // what is wrong with the others). The kiefer bracket's face pairing: 13.5 → 11.8 ms. (The
-  // spread is a sample, whatever the indices: the full pass of renumberable() only follows for
-  // a scattered mesh.)
+  // what is wrong with the others). (The spread is a sample, whatever the indices: the full
+  // pass of renumberable() only follows for a scattered mesh.)
   const double spread = mesh.tetCount() >= opt.renumberMinTets ? numberingSpread(mesh) : 0.0;
   const bool renumber = spread > kScatteredNumbering && renumberable(mesh);
   if (renumber) renumberForLocality(mesh);
@@ -131,7 +130,7 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
 
   // FORMAT.md §3 wants positively oriented tets: flip the others (an odd permutation).
   // (Swapping slots 2 and 3 swaps the faces opposite them: the adjacency follows.)
-  // (Only when the validation saw any: every tet's volume again took 30 ms on Harmonic 64³.)
+  // (Only when the validation saw any: every tet's volume again is a pass over the whole mesh.)
   std::vector<uint32_t>& opp = adjacency.opposite;
   const bool turnAdjacency = opp.size() == mesh.tets.size();
   const bool anyToTurn = report.negativeTets > 0 || report.zeroVolumeTets > 0 || report.repeatedVertexTets > 0;
@@ -193,7 +192,7 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   so.weightField = opt.weights[1];
   so.weightShape = opt.weights[2];
   so.threads = opt.threads;
-  so.partitionMinVertices = opt.partitionMinVertices;
+  so.slabMinVertices = opt.slabMinVertices;
   so.fitValues = opt.fitValues;
   so.field = iso;
   so.recordReadSets = opt.orderSplits;
@@ -209,7 +208,7 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
     so.targetVertices = mesh.vertexCount();
   }
   so.progress = [&](uint32_t done, uint32_t planned) { progress("simplify", done, planned); };
-  progress("simplify", 0, 0);  // (its set-up, 15-20% of its time on carotid and Harmonic 64³, reports no collapses yet)
+  progress("simplify", 0, 0);  // (its set-up, a sizeable share of its time, reports no collapses yet)
   if (Result r = simplifyMesh(mesh, so, simplified, &adjacency, &mesh.tets); !r) return r;  // (mesh.tets taken over)
   summary.simplifyMs = msSince(t0);
   summary.stopReason = simplified.stopReason;

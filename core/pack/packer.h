@@ -17,7 +17,7 @@ namespace tetstream {
 struct PackOptions {
   std::string field;     // field that steers simplification and is shown first; "" = first field
   std::string name;      // dataset name; "" = mesh.name
-  int zstdLevel = 18;  // 19 takes 1.4× as long for 0.1% fewer bytes (Harmonic 64³)
+  int zstdLevel = 18;  // higher levels take much longer for hardly fewer bytes
   double weights[3] = {100.0, 1.0, 0.005};  // geometry, field, shape (simplify.h)
   double baseFraction = 0.01;             // base mesh size as a fraction of the vertices...
   uint32_t baseVertices = 0;              // ...or as a vertex count (wins when non-zero)
@@ -31,7 +31,7 @@ struct PackOptions {
   bool orderSplits = false;               // splits by kept vertex inside each chunk (pack --compact)
   double maxMemoryBytes = 0;              // refuse meshes that need more (0: 90% of physical memory)
   int threads = 2;                        // threads that evaluate collapse costs and measure levels (1 or 2; same output)
-  uint32_t partitionMinVertices = 10000;  // simplify in slabs at once from this size (SimplifyOptions)
+  uint32_t slabMinVertices = 10000;  // simplify in slabs at once from this size (SimplifyOptions)
   uint32_t renumberMinTets = 50000;       // renumber scattered meshes from this size (pack/renumber.h)
   // Progress for displays: phase ("validate", "simplify", "encode", "write"), items done and
   // planned in that phase (collapses, splits; 0 planned when not countable).

@@ -7,7 +7,7 @@
 //   simplify_collapse.cpp  a collapse and its log entry
 //   simplify_slabs.cpp     the parallel phase: slabs of a large mesh, one thread each
 //   simplify_refit.cpp     the last level's values, fitted again at the end
-// Internal to the packer: nothing outside these files includes it.
+// Internal to the packer: nothing outside these files includes it but the tests (SimplifyTuning).
 #pragma once
 #include <algorithm>
 #include <atomic>
@@ -22,7 +22,31 @@
 #include "adjacency.h"
 #include "pack/quadric.h"
 #include "tet_quality.h"
+#include "tet_tables.h"
 #include "simplify.h"
+
+namespace tetstream {
+
+// Not product options: knobs that exist so tests can compare the cost with the simpler ones it
+// replaced, and a self-check of the link condition. simplifyMesh always uses the defaults.
+struct SimplifyTuning {
+  // How much of the input a collapse stands for, the weight of its error terms (simplify.h,
+  // boundTerms()): the larger of its input vertices and its volume (in units of an interior
+  // vertex's mean volume), or (false) the vertices alone.
+  bool weighByVolume = true;
+  // Each cost is divided by (tets the collapse removes)^this (simplify.h); 0: not at all.
+  double removedTetsExponent = 0.5;
+  // Also runs the plain reference link check (linkConditionBySorting) at every collapse attempt
+  // and counts in linkMismatches where it disagrees with the fast one.
+  bool verifyLinkCondition = false;
+  uint64_t linkMismatches = 0;  // written by simplifyMeshTuned
+};
+
+// simplifyMesh (simplify.h) with other tuning than the defaults.
+Result simplifyMeshTuned(const TetMesh& mesh, const SimplifyOptions& options, SimplifyTuning& tuning,
+                         SimplifyResult& out);
+
+}  // namespace tetstream
 
 namespace tetstream::simplify_detail {
 
@@ -69,13 +93,12 @@ inline Tri makeTri(uint32_t a, uint32_t b, uint32_t c) {
   if (a > b) std::swap(a, b);
   return {{a, b, c}};
 }
-inline uint64_t makeEdge(uint32_t a, uint32_t b) { return a < b ? uint64_t(a) << 32 | b : uint64_t(b) << 32 | a; }
 
 class Simplifier {
  public:
-  Simplifier(const TetMesh& m, const SimplifyOptions& o, SimplifyResult& r, FaceAdjacency* adjacency = nullptr,
-             std::vector<uint32_t>* takeTets = nullptr)
-      : mesh_(m), opt_(o), out_(r), adjacency_(adjacency), takeTets_(takeTets) {}
+  Simplifier(const TetMesh& m, const SimplifyOptions& o, SimplifyTuning& tuning, SimplifyResult& r,
+             FaceAdjacency* adjacency = nullptr, std::vector<uint32_t>* takeTets = nullptr)
+      : mesh_(m), opt_(o), tune_(tuning), out_(r), adjacency_(adjacency), takeTets_(takeTets) {}
 
   CollapseVerdict check(uint32_t i, uint32_t j);
   Result run();
@@ -114,8 +137,6 @@ class Simplifier {
     return a > 0 ? std::clamp(-b / a, fieldMin_, fieldMax_) : fallback;
   }
 
-  static constexpr uint8_t kFaces[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
-
   // Vertex v's position, from the floats of vert_ (exact in double; a copy in double took 24
   // bytes a vertex of memory and of the caches).
   struct Point {
@@ -143,7 +164,7 @@ class Simplifier {
   struct StarTet {
     uint32_t t;
     uint32_t other[3];        // the vertices besides i, in slot order
-    uint64_t mask;            // bitOf() their places in Lane::nbr (see removes())
+    uint64_t mask;            // bitOf() their places in Scratch::nbr (see removes())
     double g[3];              // det of the new tet with P in the slot of i: g·(P − x[0]) (newDet)
     double detOld;            // det with p_i (numerator for the slot of i)
     double fixedEdges, fixedFace;  // κ's terms of the edges and the face without p_i
@@ -161,15 +182,15 @@ class Simplifier {
     double cost;     // exact, or a lower bound until stage Exact
     double base;     // the cost without the shape term
     double sj, region, eg, weight, shapeBound;  // parts of the cost (boundTerms)
-    double perTets;  // the factor for the tets it removes (SimplifyOptions::removedTetsExponent)
+    double perTets;  // the factor for the tets it removes (SimplifyTuning::removedTetsExponent)
     uint32_t j;
-    uint64_t bit;    // bitOf(j's place in Lane::nbr)
+    uint64_t bit;    // bitOf(j's place in Scratch::nbr)
     float fieldErr;  // E_f (from stage Local on)
     Stage stage;
   };
 
   // Scratch for evaluating one vertex's out-edges; one per thread.
-  struct Lane {
+  struct Scratch {
     std::vector<StarTet> star;
     uint32_t center = 0;  // the vertex of star
     double flatBound = 0;  // see prepareStar
@@ -196,7 +217,9 @@ class Simplifier {
   };
 
   // A small open-addressing table of edge keys with a byte of state, emptied in O(1) by
-  // changing its stamp. Link edge sets have tens of entries; it grows if ever needed.
+  // changing its stamp. Link edge sets have tens of entries; it grows if ever needed. (Not
+  // FlatMap: that one is emptied by a pass over its slots, and this is emptied at every link
+  // check.)
   struct EdgeTable {
     std::vector<uint64_t> keys;
     std::vector<uint32_t> stamps;
@@ -243,15 +266,15 @@ class Simplifier {
 
   using Heap = std::priority_queue<Entry, std::vector<Entry>, EntryAfter>;
 
-  // What the collapse loop works with: the queue of the whole mesh, or of one slab in the
-  // parallel phase (runParts), with its own log and scratch.
-  struct Worker {
-    int part = -1;          // -1: the whole mesh; else the slab
+  // What the collapse loop works with (a queue and its log, not a thread): the queue of the whole
+  // mesh, or of one slab in the parallel phase (runSlabs), with its own log and scratch.
+  struct Queue {
+    int slab = -1;          // -1: the whole mesh; else the slab
     Heap heap;
     CollapseLog ownLog;     // a slab's collapses in this round (merged into out_.log after it)
     CollapseLog* log = &ownLog;
     std::vector<float> keys;  // a slab's collapses: the queue key each was taken at
-    Lane* lane = nullptr;   // link condition and collapse (and a slab's evaluations): its thread's
+    Scratch* scratch = nullptr;  // link condition and collapse (and a slab's evaluations): its thread's
     std::atomic<uint32_t> collapsed{0};  // (read by the progress report on the other thread)
     uint32_t tetsRemoved = 0;
     uint64_t pops = 0, requeued = 0, rejectedByLink = 0, flatTetsRemoved = 0, linkMismatches = 0;
@@ -263,7 +286,7 @@ class Simplifier {
     uint32_t edgeTableStamp = 0;
   };
 
-  void prepareStar(Lane& L, uint32_t i);
+  void prepareStar(Scratch& sc, uint32_t i);
 
   // Whether the new tet (P and the others of st) is flat, judged by its own longest edge.
   static bool isFlat(const StarTet& st, const double* P, double det) {
@@ -277,7 +300,7 @@ class Simplifier {
     return d0 * d0 + d1 * d1 + d2 * d2;
   }
   static double dot(const double* u, const double* v) { return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]; }
-  // A bit for each of the first 64 neighbours (by place in Lane::nbr), 0 for the others.
+  // A bit for each of the first 64 neighbours (by place in Scratch::nbr), 0 for the others.
   static uint64_t bitOf(size_t place) { return place < 64 ? uint64_t(1) << place : 0; }
   // Whether the collapse onto j (bit: bitOf(its place)) removes star tet st: st has j.
   static bool removes(const StarTet& st, uint32_t j, uint64_t bit) {
@@ -304,14 +327,14 @@ class Simplifier {
     n[2] = u[0] * v[1] - u[1] * v[0];
   }
 
-  bool legal(Lane& L, uint32_t i, uint32_t j, uint64_t bit, CollapseVerdict* verdict);
-  Candidate boundTerms(Lane& L, uint32_t i, uint32_t j, uint64_t bit, int removed, double removedQuality);
+  bool legal(Scratch& sc, uint32_t i, uint32_t j, uint64_t bit, CollapseVerdict* verdict);
+  Candidate boundTerms(Scratch& sc, uint32_t i, uint32_t j, uint64_t bit, int removed, double removedQuality);
   void setCost(Candidate& c, double local) const;
-  void localTerm(Lane& L, uint32_t i, Candidate& c);
-  bool finishCost(Lane& L, Candidate& c, CollapseVerdict* verdict);
-  void gatherCandidates(Lane& L, uint32_t i);
-  int cheapestCandidate(Lane& L, uint32_t i);
-  void neighbours(Lane& L, uint32_t v, std::vector<uint32_t>& out);
+  void localTerm(Scratch& sc, uint32_t i, Candidate& c);
+  bool finishCost(Scratch& sc, Candidate& c, CollapseVerdict* verdict);
+  void gatherCandidates(Scratch& sc, uint32_t i);
+  int cheapestCandidate(Scratch& sc, uint32_t i);
+  void neighbours(Scratch& sc, uint32_t v, std::vector<uint32_t>& out);
 
   // Asks for the tets around v, which neighbours(v) reads first: called for the vertex likely
   // to be evaluated next, while the current one is.
@@ -319,8 +342,8 @@ class Simplifier {
     for (uint32_t t : star_[v]) __builtin_prefetch(&out_.tets[4 * size_t(t)]);
   }
 
-  float bestCost(Lane& L, uint32_t v);
-  void evaluateVertex(Lane& L, uint32_t v);
+  float bestCost(Scratch& sc, uint32_t v);
+  void evaluateVertex(Scratch& sc, uint32_t v);
 
   // The key v is queued under: its last known cost, or 0 when it had no legal collapse then.
   float queueKey(uint32_t v) const { return std::isfinite(lastCost_[v]) ? lastCost_[v] : 0.0f; }
@@ -335,41 +358,41 @@ class Simplifier {
     return false;
   }
 
-  // Whether a collapse of this round changed anything evaluateVertex(L, v) read: v's star and,
+  // Whether a collapse of this round changed anything evaluateVertex(sc, v) read: v's star and,
   // for the targets, their quadrics, κ sums and star sizes; all of these change only for the
   // vertices a collapse touches.
-  bool changedThisRound(const Lane& L, uint32_t v) const {
+  bool changedThisRound(const Scratch& sc, uint32_t v) const {
     if (changed_[v] == roundStamp_) return true;
-    for (uint32_t w : L.nbr)
+    for (uint32_t w : sc.nbr)
       if (changed_[w] == roundStamp_) return true;
     return false;
   }
 
-  // Collapses i along its cheapest legal out-edge (evaluated in L) unless that costs more than
+  // Collapses i along its cheapest legal out-edge (evaluated in sc) unless that costs more than
   // slack_ × `next`, the key of the next entry: then i goes back into the queue under its new
   // cost. Most pops find that the cost went up since a neighbour collapsed. On meshes large
-  // enough to be cut in slabs, those within 10% are taken anyway: a quarter fewer pops (each
-  // evaluates every out-edge of i), a field error 0.3–1.2% higher on Harmonic 64³ and up to 0.6%
-  // on the carotid data, 1.8% fewer bytes. Small meshes pack in moments: they keep the exact
-  // order (the 8,750 tets of post.vtk got up to 12% worse with the slack).
+  // enough to be cut in slabs, those within 10% are taken anyway: far fewer pops (each
+  // evaluates every out-edge of i) for a slightly higher field error and a slightly smaller
+  // stream. Small meshes pack in moments: they keep the exact order, where the slack would cost
+  // relatively more error.
   static constexpr float kLargeMeshSlack = 1.1f;
-  void tryCollapse(Worker& W, uint32_t i, Lane& L, float next);
+  void tryCollapse(Queue& Q, uint32_t i, Scratch& sc, float next);
 
   // ------------------------------------------------------------------ the parallel phase
   // How slabs, rounds and these constants were chosen: simplify_slabs.cpp.
-  static constexpr double kPartShare = 0.98;
+  static constexpr double kSlabShare = 0.98;
   static constexpr float kTauGrowth = 1.41421356f;
   static constexpr uint32_t kMaxSlabs = 3;
 
   uint32_t slabsOf(const std::vector<uint32_t>& order, bool staggered, std::vector<uint8_t>& slab) const;
-  void runParts(uint32_t planned);
+  void runSlabs(uint32_t planned);
   void mergeRound(uint32_t slabs);
   void markInner(const std::vector<uint8_t>& slab);
   static constexpr uint32_t kTwoThreadScan = 200000;  // tets: markInner() on two threads from here
 
   // ------------------------------------------------------------------ link condition
   void gatherLink(uint32_t v, std::vector<uint32_t>& verts, std::vector<uint64_t>& edges, std::vector<Tri>& tris);
-  bool linkCondition(Worker& W, uint32_t i, uint32_t j);
+  bool linkCondition(Queue& Q, uint32_t i, uint32_t j);
 
   // The link of edge (i, j): calls edge(o) with the opposite edge o[2] of every tet around it,
   // and face(k) for every boundary face (i, j, k).
@@ -404,6 +427,7 @@ class Simplifier {
     }
   }
 
+  // The plain reference for linkCondition(), for SimplifyTuning::verifyLinkCondition only.
   bool linkConditionBySorting(uint32_t i, uint32_t j);
 
   // ------------------------------------------------------------------ the last level's values
@@ -414,10 +438,11 @@ class Simplifier {
   bool locate(uint32_t x, uint32_t t, uint32_t* vertices, double* w) const;
 
   // ------------------------------------------------------------------ the collapse
-  void collapse(Worker& W, uint32_t i, uint32_t j, float fieldErr, float key);
+  void collapse(Queue& Q, uint32_t i, uint32_t j, float fieldErr, float key);
 
   const TetMesh& mesh_;
   const SimplifyOptions& opt_;
+  SimplifyTuning& tune_;
   SimplifyResult& out_;
   FaceAdjacency* adjacency_;  // the caller's, taken over by init() (or none)
   std::vector<uint32_t>* takeTets_;  // mesh_.tets, taken over by init() (or none: copied)
@@ -450,24 +475,24 @@ class Simplifier {
   double meanVertexVolume_ = 1;              // the unit of the volume measure (init(), boundTerms())
   std::vector<double> qualitySum_;  // per vertex: Σ 3/κ over its star
   std::vector<uint8_t> queued_;  // per vertex: has an entry in the queue (or in the current round)
-  Lane mainLane_;
-  std::vector<Lane> lanes_;  // one per entry of a round (and per thread in init() and runParts())
-  // The one queue's lanes (all but the two of the first costs and the slabs) get their
+  Scratch mainScratch_;
+  std::vector<Scratch> scratches_;  // one per entry of a round (and per thread in init() and runSlabs())
+  // The one queue's scratches (all but the two of the first costs and the slabs) get their
   // per-vertex arrays only now, after the slabs, when less memory is in use (peak memory).
-  void readyLanes() {
-    if (mainLane_.seen.size() != V_) mainLane_.reset(V_);
-    for (Lane& L : lanes_)
-      if (L.seen.size() != V_) L.reset(V_);
+  void readyScratches() {
+    if (mainScratch_.seen.size() != V_) mainScratch_.reset(V_);
+    for (Scratch& sc : scratches_)
+      if (sc.seen.size() != V_) sc.reset(V_);
   }
   static constexpr uint32_t kRoundSize = 4;
   std::vector<Entry> round_;
   std::vector<uint32_t> changed_;  // per vertex: roundStamp_ of the last round that touched it
   bool trackChanges_ = false;      // collapses keep changed_ (the one queue's rounds of several)
   uint32_t roundStamp_ = 0;
-  Worker main_;     // the one queue of the whole mesh (its log is out_.log)
-  Worker parts_[kMaxSlabs];  // the slabs of the parallel phase
+  Queue main_;     // the one queue of the whole mesh (its log is out_.log)
+  Queue slabs_[kMaxSlabs];  // the slabs of the parallel phase
   float slack_ = 1.0f;  // see tryCollapse
-  std::vector<uint8_t> inner_;  // per vertex: every neighbour is in its slab (runParts)
+  std::vector<uint8_t> inner_;  // per vertex: every neighbour is in its slab (runSlabs)
 };
 
 }  // namespace tetstream::simplify_detail

@@ -14,7 +14,7 @@
 // that of the one-thread loop, whatever the timing (tests compare the two).
 //
 // Before that, a large mesh is simplified in slabs, one thread each, in rounds of rising cost
-// (runParts, simplify_slabs.cpp). simplifier.h lists where the rest of the class lives.
+// (runSlabs, simplify_slabs.cpp). simplifier.h lists where the rest of the class lives.
 #include "simplify.h"
 
 #include <cassert>
@@ -28,17 +28,17 @@ namespace simplify_detail {
 // The verdict the simplifier would reach on hec(i → j) of the input (checkCollapse, tests).
 CollapseVerdict Simplifier::check(uint32_t i, uint32_t j) {
   init();
-  readyLanes();
-  Lane& L = *main_.lane;
-  neighbours(L, i, L.nbr);
-  const size_t slot = size_t(std::find(L.nbr.begin(), L.nbr.end(), j) - L.nbr.begin());
-  if (slot == L.nbr.size()) return CollapseVerdict::NotAnEdge;
+  readyScratches();
+  Scratch& sc = *main_.scratch;
+  neighbours(sc, i, sc.nbr);
+  const size_t slot = size_t(std::find(sc.nbr.begin(), sc.nbr.end(), j) - sc.nbr.begin());
+  if (slot == sc.nbr.size()) return CollapseVerdict::NotAnEdge;
   CollapseVerdict v = CollapseVerdict::Legal;
-  prepareStar(L, i);
-  if (legal(L, i, j, bitOf(slot), &v)) {
-    Candidate c = boundTerms(L, i, j, bitOf(slot), L.removed, L.removedQuality);
-    localTerm(L, i, c);
-    finishCost(L, c, &v);
+  prepareStar(sc, i);
+  if (legal(sc, i, j, bitOf(slot), &v)) {
+    Candidate c = boundTerms(sc, i, j, bitOf(slot), sc.removed, sc.removedQuality);
+    localTerm(sc, i, c);
+    finishCost(sc, c, &v);
   }
   if (v == CollapseVerdict::Legal && !linkCondition(main_, i, j)) v = CollapseVerdict::LinkCondition;
   return v;
@@ -51,25 +51,25 @@ Result Simplifier::run() {
   const uint32_t planned = alive_ > target ? alive_ - target : 0;
   out_.stopReason = "target reached";
   tetsAlive_ = T_;
-  Worker& W = main_;
-  W.log = &out_.log;
-  slack_ = V_ >= opt_.partitionMinVertices ? kLargeMeshSlack : 1.0f;
-  if (V_ >= opt_.partitionMinVertices) runParts(planned);
-  for (uint32_t v = 0; v < V_; ++v)  // (after the parts: what they left queued)
-    if (out_.vertexAlive[v] && queued_[v]) W.heap.push({queueKey(v), v});
-  readyLanes();
+  Queue& Q = main_;
+  Q.log = &out_.log;
+  slack_ = V_ >= opt_.slabMinVertices ? kLargeMeshSlack : 1.0f;
+  if (V_ >= opt_.slabMinVertices) runSlabs(planned);
+  for (uint32_t v = 0; v < V_; ++v)  // (after the slabs: what they left queued)
+    if (out_.vertexAlive[v] && queued_[v]) Q.heap.push({queueKey(v), v});
+  readyScratches();
   const bool parallel = opt_.threads > 1 && V_ >= opt_.parallelMinVertices;
   const uint32_t roundSize = parallel ? kRoundSize : 1;
   trackChanges_ = roundSize > 1;  // (changedThisRound reads changed_ only then)
   if (trackChanges_) changed_.assign(V_, 0);
   WorkPool pool(parallel ? 1 : 0);
-  auto evaluateTask = [this](uint32_t k) { evaluateVertex(lanes_[k], round_[k].vertex); };
-  auto goOn = [&] { return alive_ - W.collapsed > target && tetsAlive_ - W.tetsRemoved > opt_.targetTets && !W.errorBound; };
+  auto evaluateTask = [this](uint32_t k) { evaluateVertex(scratches_[k], round_[k].vertex); };
+  auto goOn = [&] { return alive_ - Q.collapsed > target && tetsAlive_ - Q.tetsRemoved > opt_.targetTets && !Q.errorBound; };
   while (goOn()) {
     round_.clear();
     Entry e;
-    while (round_.size() < roundSize && peekValid(W.heap, e)) {
-      W.heap.pop();
+    while (round_.size() < roundSize && peekValid(Q.heap, e)) {
+      Q.heap.pop();
       round_.push_back(e);
     }
     if (round_.empty()) {
@@ -81,34 +81,34 @@ Result Simplifier::run() {
     for (size_t k = 0; k < round_.size(); ++k) {
       const Entry& r = round_[k];
       Entry top;
-      const bool topValid = peekValid(W.heap, top);
-      if (k > 0 && (!goOn() || (topValid && EntryAfter()(r, top)) || changedThisRound(lanes_[k], r.vertex))) {
-        for (size_t x = k; x < round_.size(); ++x) W.heap.push(round_[x]);  // evaluated for nothing
+      const bool topValid = peekValid(Q.heap, top);
+      if (k > 0 && (!goOn() || (topValid && EntryAfter()(r, top)) || changedThisRound(scratches_[k], r.vertex))) {
+        for (size_t x = k; x < round_.size(); ++x) Q.heap.push(round_[x]);  // evaluated for nothing
         break;
       }
       float next = topValid ? top.cost : float(kInf);
       if (k + 1 < round_.size()) next = std::min(next, round_[k + 1].cost);
       queued_[r.vertex] = 0;
-      tryCollapse(W, r.vertex, lanes_[k], next);
+      tryCollapse(Q, r.vertex, scratches_[k], next);
       if (opt_.progress && (out_.log.size() & 4095) == 0) opt_.progress(out_.log.size(), planned);
     }
   }
-  if (W.errorBound) out_.stopReason = "error bound reached";
+  if (Q.errorBound) out_.stopReason = "error bound reached";
   if (opt_.progress) opt_.progress(out_.log.size(), planned);
-  auto count = [&](const Worker& w) {
+  auto count = [&](const Queue& w) {
     out_.queuePops += w.pops;
     out_.requeued += w.requeued;
     out_.rejectedByLink += w.rejectedByLink;
     out_.flatTetsRemoved += w.flatTetsRemoved;
-    out_.linkMismatches += w.linkMismatches;
+    tune_.linkMismatches += w.linkMismatches;
   };
   count(main_);
-  for (const Worker& w : parts_) count(w);
-  alive_ -= W.collapsed;
-  tetsAlive_ -= W.tetsRemoved;
+  for (const Queue& w : slabs_) count(w);
+  alive_ -= Q.collapsed;
+  tetsAlive_ -= Q.tetsRemoved;
   out_.vertices = alive_;
-  out_.costEvaluations += mainLane_.evaluations;
-  for (const Lane& L : lanes_) out_.costEvaluations += L.evaluations;
+  out_.costEvaluations += mainScratch_.evaluations;
+  for (const Scratch& sc : scratches_) out_.costEvaluations += sc.evaluations;
   out_.tetCount = 0;
   for (uint32_t t = 0; t < T_; ++t) {
     out_.tetCount += out_.tetAlive[t];
@@ -124,35 +124,35 @@ Result Simplifier::run() {
   return Result::success();
 }
 
-void Simplifier::tryCollapse(Worker& W, uint32_t i, Lane& L, float next) {
-  ++W.pops;
+void Simplifier::tryCollapse(Queue& Q, uint32_t i, Scratch& sc, float next) {
+  ++Q.pops;
   bool first = true;
-  for (int c; (c = cheapestCandidate(L, i)) >= 0;) {
-    const Candidate cand = L.candidates[size_t(c)];
+  for (int c; (c = cheapestCandidate(sc, i)) >= 0;) {
+    const Candidate cand = sc.candidates[size_t(c)];
     if (first) lastCost_[i] = float(cand.cost);
     first = false;
     if (float(cand.cost) > next * slack_) {
-      W.heap.push({float(cand.cost), i});  // something else is cheaper now
+      Q.heap.push({float(cand.cost), i});  // something else is cheaper now
       queued_[i] = 1;
-      ++W.requeued;
+      ++Q.requeued;
       return;
     }
     if (cand.fieldErr > opt_.maxError) {  // the next collapse in line would exceed the bound
-      W.heap.push({float(cand.cost), i});
+      Q.heap.push({float(cand.cost), i});
       queued_[i] = 1;
-      W.errorBound = true;
+      Q.errorBound = true;
       return;
     }
-    if (W.part >= 0 && !inner_[cand.j]) {  // a part leaves it to the whole mesh's queue
+    if (Q.slab >= 0 && !inner_[cand.j]) {  // a slab leaves it to the whole mesh's queue
       queued_[i] = 1;
       return;
     }
-    if (!linkCondition(W, i, cand.j)) {
-      ++W.rejectedByLink;
-      L.candidates.erase(L.candidates.begin() + c);
+    if (!linkCondition(Q, i, cand.j)) {
+      ++Q.rejectedByLink;
+      sc.candidates.erase(sc.candidates.begin() + c);
       continue;
     }
-    collapse(W, i, cand.j, cand.fieldErr, float(cand.cost));
+    collapse(Q, i, cand.j, cand.fieldErr, float(cand.cost));
     return;
   }
   if (first) lastCost_[i] = float(kInf);
@@ -178,7 +178,8 @@ const char* collapseVerdictName(CollapseVerdict v) {
 
 CollapseVerdict checkCollapse(const TetMesh& mesh, uint32_t i, uint32_t j, const SimplifyOptions& options) {
   SimplifyResult scratch;
-  Simplifier s(mesh, options, scratch);
+  SimplifyTuning tuning;
+  Simplifier s(mesh, options, tuning, scratch);
   return s.check(i, j);
 }
 
@@ -186,7 +187,17 @@ Result simplifyMesh(const TetMesh& mesh, const SimplifyOptions& options, Simplif
                     std::vector<uint32_t>* takeTets) {
   assert(options.field >= 0 && size_t(options.field) < mesh.fields.size());
   out = SimplifyResult{};
-  Simplifier s(mesh, options, out, adjacency, takeTets);
+  SimplifyTuning tuning;
+  Simplifier s(mesh, options, tuning, out, adjacency, takeTets);
+  return s.run();
+}
+
+Result simplifyMeshTuned(const TetMesh& mesh, const SimplifyOptions& options, SimplifyTuning& tuning,
+                         SimplifyResult& out) {
+  assert(options.field >= 0 && size_t(options.field) < mesh.fields.size());
+  out = SimplifyResult{};
+  tuning.linkMismatches = 0;
+  Simplifier s(mesh, options, tuning, out);
   return s.run();
 }
 

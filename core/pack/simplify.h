@@ -18,19 +18,18 @@
 //        s_j is the value j takes after the collapse (fitValues below).
 //   E_s  shape error, paper §3.3: the measure κ(S) − 3 normalised as (κ − 3)/κ = 1 − 3/κ, in
 //        [0, 1), averaged over the tets around p_j after the collapse (0: all equilateral).
-//        The paper's unbounded κ − 3 let the shape term outweigh the field wherever a mesh is
-//        anisotropic: on the Blunt Fin CFD grid it made the density error 6.6× larger.
+//        The paper's unbounded κ − 3 lets the shape term outweigh the field wherever a mesh is
+//        anisotropic (graded CFD grids, docs/design-notes.md).
 // The whole cost is then divided by sqrt(r), r the number of tets the collapse removes (the
 // tets around the edge): a level is as large as its tets (the base's bytes, the viewer's work
 // and the benchmarks' levels go by tets), so a collapse that removes six tets may err more
 // than one that removes three and still go first. The root, not r itself: a split's bytes go
-// by its vertex as well as by its tets (session 33: r itself gave a 5-15% higher error at the
-// same bytes received).
+// by its vertex as well as by its tets, so r itself over-rewards collapses of many tets and
+// gives a higher error at the same bytes received.
 // Defaults (100, 1, 0.005) keep the boundary first, then the field; tet shape is a
 // tie-breaker; all terms are scale free, so they work for any mesh size and field range.
-// (Shape weight chosen on Harmonic 64³ and Blunt Fin: 0.002 to 0.02 trade the field error at the
-// coarsest levels against that at finer ones; 0.02 gives better tets, mean 3/κ 0.535 against 0.50
-// at 5% of Harmonic's tets, and a 2% lower error there, but a 10% higher one at 30%.)
+// A larger shape weight gives better tets and a lower error at the coarsest levels, but a higher
+// one at finer levels; 0.005 balances the two (docs/design-notes.md).
 //
 // Legality, checked for every collapse (paper §3.2 and Staadt & Gross / Dey et al.):
 //   - a boundary vertex may only move along a boundary edge;
@@ -43,7 +42,7 @@
 // disappear (when they contain the collapsed edge) or become proper.
 //
 // Order: one priority queue of vertices by the cost of their cheapest out-edge, updated lazily.
-// Meshes of partitionMinVertices or more are first simplified in slabs, one thread each (cut
+// Meshes of slabMinVertices or more are first simplified in slabs, one thread each (cut
 // along the vertex numbering or an axis, whichever crosses fewest vertices), each slab
 // collapsing only vertices whose whole neighbourhood is its own, so the two threads touch
 // disjoint data. Rounds of rising cost alternate between two slabs cut at the median and three
@@ -86,29 +85,20 @@ struct SimplifyOptions {
   // With fitValues, at the end the values of the vertices that stand for others are fitted again,
   // all together, to the input field at every input vertex (least squares; simplify_refit.cpp).
   bool refitValues = true;
-  // How much of the input a collapse stands for, the weight of its error terms (see the cost
-  // above and boundTerms()): the larger of its input vertices and its volume (in units of an
-  // interior vertex's mean volume), or (false) the vertices alone, as before session 25 (tests
-  // compare the two).
-  bool weighByVolume = true;
-  // Each cost divided by (tets the collapse removes)^this (see the cost above); 0: not at all,
-  // as before session 33 (tests compare the two).
-  double removedTetsExponent = 0.5;
   std::function<void(uint32_t done, uint32_t planned)> progress;  // called now and then
   // Keep in the log what each split reads (CollapseLog::star), for StreamOptions::orderSplits.
   bool recordReadSets = false;
-  bool verifyLinkCondition = false;  // tests: also run the slow reference link check, count mismatches
   // Threads (1 or 2; the result is the same either way): the slabs run on one each, and the
   // one queue evaluates its next entries on both for meshes of at least parallelMinVertices
   // vertices (below that, starting rounds costs more than it saves).
   int threads = 2;
   uint32_t parallelMinVertices = 20000;
   // Meshes of at least this many vertices are simplified in slabs at once for most of the
-  // way (simplify_slabs.cpp); the result depends on this, not on `threads`. From 10,000: the
-  // kiefer bracket (16,468 vertices) and Blunt Fin (40,921) pack in about 2/3 of the time at
-  // the same field error (within -10%..+9% at 5, 10, 30% of the tets) and stream size; on
-  // post.vtk (2,288) slabs doubled the error of the coarse levels and saved nothing.
-  uint32_t partitionMinVertices = 10000;
+  // way (simplify_slabs.cpp); the result depends on this, not on `threads`. Above it slabs save
+  // about a third of the time at the same field error and stream size; on much smaller meshes
+  // the cuts are a large share of the vertices, the coarse levels' error grows and little time
+  // is saved.
+  uint32_t slabMinVertices = 10000;
 };
 
 struct SimplifyResult {
@@ -123,8 +113,7 @@ struct SimplifyResult {
   uint32_t flatTetsLeft = 0;
   uint64_t costEvaluations = 0, rejectedByLink = 0;
   uint64_t queuePops = 0, requeued = 0;  // pops of current entries, and those pushed back costlier
-  uint32_t slabCollapses = 0;          // collapses made in the slabs at once (partitionMinVertices)
-  uint64_t linkMismatches = 0;           // with verifyLinkCondition: fast and reference disagreed
+  uint32_t slabCollapses = 0;          // collapses made in the slabs at once (slabMinVertices)
   std::string stopReason;          // "target reached", "no legal collapse left", "error bound"
 };
 

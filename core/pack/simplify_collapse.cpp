@@ -29,19 +29,19 @@ void orientedOthers(const uint32_t* v, int si, int sj, uint32_t* out) {
 
 }  // namespace
 
-void Simplifier::collapse(Worker& W, uint32_t i, uint32_t j, float fieldErr, float key) {
-  CollapseLog& log = *W.log;
-  if (W.part >= 0) W.keys.push_back(key);
+void Simplifier::collapse(Queue& Q, uint32_t i, uint32_t j, float fieldErr, float key) {
+  CollapseLog& log = *Q.log;
+  if (Q.slab >= 0) Q.keys.push_back(key);
   log.i.push_back(i);
   log.j.push_back(j);
   log.iValue.push_back(vert_[i].fit);
   log.jValue.push_back(vert_[j].fit);
   log.fieldError.push_back(float(fieldErr * range_));
-  CollapseTets& record = W.record;
+  CollapseTets& record = Q.record;
   record.clear();
 
-  W.around.assign(star_[i].begin(), star_[i].end());  // star_ lists change below
-  const std::vector<uint32_t>& around = W.around;
+  Q.around.assign(star_[i].begin(), star_[i].end());  // star_ lists change below
+  const std::vector<uint32_t>& around = Q.around;
   for (uint32_t t : around) {
     uint32_t* v = &out_.tets[4 * size_t(t)];
     if (!tetHas(t, j)) continue;
@@ -59,14 +59,14 @@ void Simplifier::collapse(Worker& W, uint32_t i, uint32_t j, float fieldErr, flo
     if (hA != kNoNeighbor) opp_[hA] = hB;
     if (hB != kNoNeighbor) opp_[hB] = hA;
     for (int f = 0; f < 4; ++f) opp_[4 * t + f] = kNoNeighbor;
-    if (kappa_[t] >= kKappaCap) ++W.flatTetsRemoved;
+    if (kappa_[t] >= kKappaCap) ++Q.flatTetsRemoved;
     out_.tetAlive[t] = 0;
-    ++W.tetsRemoved;
+    ++Q.tetsRemoved;
     for (int k = 0; k < 4; ++k) qualitySum_[v[k]] -= 3.0 / kappa_[t];
     for (int k = 0; k < 4; ++k)
       if (v[k] != i) eraseFrom(star_[v[k]], t);
   }
-  {  // j's star grows by a quarter beyond what it needs, not by doubling (peak memory 197 -> 192 MB on Harmonic 64³)
+  {  // j's star grows by a quarter beyond what it needs, not by doubling (a lower peak memory)
     std::vector<uint32_t>& sj = star_[j];
     size_t need = sj.size();
     for (uint32_t t : around) need += out_.tetAlive[t];
@@ -91,7 +91,7 @@ void Simplifier::collapse(Worker& W, uint32_t i, uint32_t j, float fieldErr, flo
   star_[i].clear();
   star_[i].shrink_to_fit();
   out_.vertexAlive[i] = 0;
-  ++W.collapsed;
+  ++Q.collapsed;
   if (boundary_[i]) {  // (then j is on the boundary too, and has a quadric: see legal())
     boundary_[j] = 1;
     assert(quadricOf_[j] != kNoQuadric);
@@ -100,35 +100,35 @@ void Simplifier::collapse(Worker& W, uint32_t i, uint32_t j, float fieldErr, flo
   fieldQuadric_[j].add(fieldQuadric_[i]);
   // j now stands for the region of both: its value becomes the one that fits the original
   // field there best (least squares over the region's original tets, at p_j); the split gives
-  // the value before back. (The paper keeps the sample; at 5% of Harmonic's tets fitting
-  // lowers the RMS field error by a fifth.)
+  // the value before back. (The paper keeps the sample; fitting lowers the coarse levels' RMS
+  // field error.)
   represented_[j] += represented_[i];
   if (fitsRegion(represented_[j])) vert_[j].fit = float(fitted(fieldQuadric_[j], p(j), vert_[j].fit));
 
   // Everything around j changed. j and its neighbours are re-evaluated lazily, when they reach
   // the top: those already queued keep their entry; a blocked one (no legal collapse last
   // time) is queued again under its last known cost, as its neighbourhood changed.
-  Lane& L = *W.lane;
-  W.touched.clear();
-  ++L.stamp;
-  L.seen[i] = L.stamp;
+  Scratch& sc = *Q.scratch;
+  Q.touched.clear();
+  ++sc.stamp;
+  sc.seen[i] = sc.stamp;
   for (uint32_t t : around)
     for (int k = 0; k < 4; ++k) {
       uint32_t w = out_.tets[4 * size_t(t) + k];
-      if (L.seen[w] != L.stamp) {
-        L.seen[w] = L.stamp;
-        W.touched.push_back(w);
+      if (sc.seen[w] != sc.stamp) {
+        sc.seen[w] = sc.stamp;
+        Q.touched.push_back(w);
       }
     }
   if (trackChanges_) {  // (random writes the slabs and a one-thread queue would make for nothing)
     changed_[i] = roundStamp_;
-    for (uint32_t v : W.touched) changed_[v] = roundStamp_;
+    for (uint32_t v : Q.touched) changed_[v] = roundStamp_;
   }
-  for (uint32_t v : W.touched) {
+  for (uint32_t v : Q.touched) {
     if (queued_[v]) continue;  // its entry stays: it is evaluated afresh when popped
     queued_[v] = 1;
-    if (W.part >= 0 && !inner_[v]) continue;  // left to the whole mesh's queue
-    W.heap.push({queueKey(v), v});
+    if (Q.slab >= 0 && !inner_[v]) continue;  // left to the whole mesh's queue
+    Q.heap.push({queueKey(v), v});
   }
 }
 

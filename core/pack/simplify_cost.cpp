@@ -13,17 +13,17 @@ bool Simplifier::isBoundaryEdge(uint32_t i, uint32_t j) const {
   return false;
 }
 
-// (After neighbours(L, i, L.nbr).)
-void Simplifier::prepareStar(Lane& L, uint32_t i) {
+// (After neighbours(sc, i, sc.nbr).)
+void Simplifier::prepareStar(Scratch& sc, uint32_t i) {
   const std::vector<uint32_t>& star = star_[i];
-  L.star.resize(star.size());
-  L.center = i;
+  sc.star.resize(star.size());
+  sc.center = i;
   const Point pi = p(i);
   // Every edge of a tet after the collapse lies in the star's bounding box, so the flatness
   // threshold of the longest possible edge bounds every tet's own threshold from above.
   double lo[3] = {pi[0], pi[1], pi[2]}, hi[3] = {pi[0], pi[1], pi[2]};
   float worstKappa = 0;
-  L.boundaryEdges = 0;
+  sc.boundaryEdges = 0;
   for (size_t n = 0; n < star.size(); ++n) {
     const uint32_t t = star[n];
     const uint32_t* v = &out_.tets[4 * size_t(t)];
@@ -31,8 +31,8 @@ void Simplifier::prepareStar(Lane& L, uint32_t i) {
       for (int f = 0; f < 4; ++f)
         if (v[f] != i && opp_[4 * size_t(t) + f] == kNoNeighbor)
           for (int k = 0; k < 4; ++k)
-            if (k != f && v[k] != i) L.boundaryEdges |= bitOf(L.place[v[k]]);
-    StarTet& st = L.star[n];
+            if (k != f && v[k] != i) sc.boundaryEdges |= bitOf(sc.place[v[k]]);
+    StarTet& st = sc.star[n];
     st.t = t;
     st.mask = 0;
     st.kappa = kappa_[t];
@@ -43,7 +43,7 @@ void Simplifier::prepareStar(Lane& L, uint32_t i) {
       if (v[k] == i) { si = k; continue; }
       const Point q = p(v[k]);
       st.other[m] = v[k];
-      st.mask |= bitOf(L.place[v[k]]);
+      st.mask |= bitOf(sc.place[v[k]]);
       st.f[m] = vert_[v[k]].fit;
       for (int a = 0; a < 3; ++a) st.x[m][a] = q[a];
       ++m;
@@ -64,7 +64,7 @@ void Simplifier::prepareStar(Lane& L, uint32_t i) {
     st.fixedFace = dot(st.g, st.g);
     st.fixedEdges = dot(u, u) + dot(w, w) + dist2(st.x[1], st.x[2]);
   }
-  for (uint32_t w : L.nbr) {  // (neighbours() listed the star's vertices but i)
+  for (uint32_t w : sc.nbr) {  // (neighbours() listed the star's vertices but i)
     const Point q = p(w);
     for (int a = 0; a < 3; ++a) {
       lo[a] = std::min(lo[a], q[a]);
@@ -72,11 +72,11 @@ void Simplifier::prepareStar(Lane& L, uint32_t i) {
     }
   }
   const double diam2 = (hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]);
-  L.flatBound = kFlat * diam2 * std::sqrt(diam2);
+  sc.flatBound = kFlat * diam2 * std::sqrt(diam2);
   // A changed tet must reach the minimum quality, or else be no worse than the worst tet of
   // the star now: real meshes (boundary layers of CFD grids) start with tets far below any
   // fixed minimum, and a collapse that does not make their region worse is allowed.
-  L.qualityFloor = std::min(opt_.minQuality, 3.0 / double(worstKappa));
+  sc.qualityFloor = std::min(opt_.minQuality, 3.0 / double(worstKappa));
 }
 
 // Cost of hec(i → j) given prepareStar(i), in steps so that the expensive terms are only
@@ -84,25 +84,25 @@ void Simplifier::prepareStar(Lane& L, uint32_t i) {
 // rule and that no tet inverts or flattens, boundTerms() a lower bound from the geometric and
 // region terms, localTerm() adds the local field error, finishCost() the exact shape term and
 // the minimum-quality check.
-bool Simplifier::legal(Lane& L, uint32_t i, uint32_t j, uint64_t bit, CollapseVerdict* verdict) {
-  ++L.evaluations;
+bool Simplifier::legal(Scratch& sc, uint32_t i, uint32_t j, uint64_t bit, CollapseVerdict* verdict) {
+  ++sc.evaluations;
   *verdict = CollapseVerdict::Legal;
-  if (boundary_[i] && !(bit ? (L.boundaryEdges & bit) != 0 : isBoundaryEdge(i, j)))
+  if (boundary_[i] && !(bit ? (sc.boundaryEdges & bit) != 0 : isBoundaryEdge(i, j)))
     return *verdict = CollapseVerdict::BoundaryRule, false;
   const Point P = p(j);
   double m[3];
   moveTo(P, p(i), m);
-  L.removedQuality = 0;  // Σ 3/κ of the tets the collapse removes, and their count
-  L.removed = 0;
-  for (const StarTet& st : L.star) {
+  sc.removedQuality = 0;  // Σ 3/κ of the tets the collapse removes, and their count
+  sc.removed = 0;
+  for (const StarTet& st : sc.star) {
     if (removes(st, j, bit)) {
-      L.removedQuality += st.quality;
-      ++L.removed;
+      sc.removedQuality += st.quality;
+      ++sc.removed;
       continue;
     }
     const double det = newDet(st, m);
     if (det <= 0) return *verdict = CollapseVerdict::Inverted, false;
-    if (det <= L.flatBound && isFlat(st, P, det)) return *verdict = CollapseVerdict::Flat, false;
+    if (det <= sc.flatBound && isFlat(st, P, det)) return *verdict = CollapseVerdict::Flat, false;
   }
   return true;
 }
@@ -110,7 +110,7 @@ bool Simplifier::legal(Lane& L, uint32_t i, uint32_t j, uint64_t bit, CollapseVe
 // Everything of the cost but the local field error and the exact shape term: the geometric
 // error, the region term of the field error and a lower bound of the shape term.
 // (removed, removedQuality: what legal() found of the tets the collapse removes.)
-Simplifier::Candidate Simplifier::boundTerms(Lane& L, uint32_t i, uint32_t j, uint64_t bit, int removed, double removedQuality) {
+Simplifier::Candidate Simplifier::boundTerms(Scratch& sc, uint32_t i, uint32_t j, uint64_t bit, int removed, double removedQuality) {
   const Point P = p(j);
   Candidate c;
   c.j = j;
@@ -135,25 +135,24 @@ Simplifier::Candidate Simplifier::boundTerms(Lane& L, uint32_t i, uint32_t j, ui
   // region), so a collapse that spreads an error over a large region waits behind one that
   // keeps it local. "How much" is the larger of two measures, which agree on an even mesh:
   // - their input vertices: the RMS at the input's vertices is what the benchmarks compare
-  //   with VTK. A volume alone made it 1.8× larger on Blunt Fin, whose vertices are mostly in
-  //   thin boundary layers;
+  //   with VTK. A volume alone lets it grow on meshes whose vertices crowd into thin boundary
+  //   layers;
   // - their input volume (the field quadrics' weights) in units of an interior vertex's mean
   //   volume: averaged over all isovalues, an isosurface moves by the volume integral of the
   //   field error, so an error over a large coarse region shows on every isosurface through it.
-  //   With the count alone the coarse far field of Blunt Fin went early: at 30% of its tets the
-  //   isosurface of density 1.2 lay 9× farther from the input's (3.6e-4 of the diagonal, mean,
-  //   against 3.9e-5 now; session 25).
+  //   With the count alone a graded mesh's coarse far field goes early, and the isosurfaces
+  //   through it move far from the input's (figures: docs/design-notes.md).
   // The manifest reports the unweighted E_f.
   const double volume = fq.weight / meanVertexVolume_;  // (fq: i's and j's field quadrics, summed above)
-  c.weight = std::sqrt(opt_.weighByVolume ? std::max(double(count), volume) : double(count));
+  c.weight = std::sqrt(tune_.weighByVolume ? std::max(double(count), volume) : double(count));
   // E_s after the collapse with every new tet at the best quality (3/κ = 1), as the tets of
   // p_j's star that stay are known: most candidates lose without finishCost(). Scaled down a
   // little so that round-off (its sums run in another order) never lifts it above E_s.
-  const double moved = double(L.star.size()) - removed, after = double(star_[j].size()) - removed + moved;
+  const double moved = double(sc.star.size()) - removed, after = double(star_[j].size()) - removed + moved;
   c.shapeBound = after > 0 ? std::max(0.0, 1.0 - (qualitySum_[j] - removedQuality + moved) / after) : 0.0;
   // Per tet removed (simplify.h); legal() counted them (at least the one tet of the edge).
-  c.perTets = opt_.removedTetsExponent == 0.5 ? 1.0 / std::sqrt(double(std::max(removed, 1)))
-                                              : std::pow(double(std::max(removed, 1)), -opt_.removedTetsExponent);
+  c.perTets = tune_.removedTetsExponent == 0.5 ? 1.0 / std::sqrt(double(std::max(removed, 1)))
+                                              : std::pow(double(std::max(removed, 1)), -tune_.removedTetsExponent);
   setCost(c, 0.0);  // a lower bound: the local error is at least 0 (rounding is monotone)
   c.stage = Candidate::Bound;
   return c;
@@ -171,13 +170,13 @@ void Simplifier::setCost(Candidate& c, double local) const {
 // |S(p_i) − S'(p_i)| / range, where S' interpolates the coarse field at p_i among the new tets.
 // The first tet that contains p_i wins; if none does (p_i on the boundary, or round-off), the
 // one it is least outside of. Only signs are needed until the tet is found (det > 0).
-void Simplifier::localTerm(Lane& L, uint32_t i, Candidate& c) {
+void Simplifier::localTerm(Scratch& sc, uint32_t i, Candidate& c) {
   const uint32_t j = c.j;
   const Point P = p(j);
   const Point pi = p(i);
   const double d[3] = {pi[0] - P[0], pi[1] - P[1], pi[2] - P[2]};
   double bestInside = -kInf, interp = c.sj;
-  for (const StarTet& st : L.star) {
+  for (const StarTet& st : sc.star) {
     if (removes(st, j, c.bit)) continue;
     // The new tet is P and the others x0, x1, x2 with det = sign·(x0 − P)·((x1 − P) × (x2 − P)).
     // p_i's barycentric numerators: that det with p_i in place of the vertex (detOld for P).
@@ -198,14 +197,14 @@ void Simplifier::localTerm(Lane& L, uint32_t i, Candidate& c) {
   c.stage = Candidate::Local;
 }
 
-bool Simplifier::finishCost(Lane& L, Candidate& c, CollapseVerdict* verdict) {
+bool Simplifier::finishCost(Scratch& sc, Candidate& c, CollapseVerdict* verdict) {
   const uint32_t j = c.j;
   const Point P = p(j);
   double m[3];
-  moveTo(P, p(L.center), m);
+  moveTo(P, p(sc.center), m);
   double qualitySum = qualitySum_[j];
   int64_t count = int64_t(star_[j].size());
-  for (const StarTet& st : L.star) {
+  for (const StarTet& st : sc.star) {
     if (removes(st, j, c.bit)) {
       qualitySum -= st.quality;
       --count;
@@ -222,7 +221,7 @@ bool Simplifier::finishCost(Lane& L, Candidate& c, CollapseVerdict* verdict) {
     const double faces = st.fixedFace + dot(ab, ab) + dot(be, be) + dot(ae, ae);
     // 3/κ = 3·det / sqrt(edges · faces / 4): one root and one division.
     const double quality = 6.0 * det / std::sqrt(edges * faces);
-    if (quality < L.qualityFloor) return *verdict = CollapseVerdict::LowQuality, false;
+    if (quality < sc.qualityFloor) return *verdict = CollapseVerdict::LowQuality, false;
     qualitySum += std::max(quality, 3.0 / kKappaCap);
     ++count;
   }
@@ -237,17 +236,17 @@ bool Simplifier::finishCost(Lane& L, Candidate& c, CollapseVerdict* verdict) {
 // The legal out-edges of i with their lower bounds (prepareStar(i) and neighbours(i) first).
 // What boundTerms() reads of a neighbour is scattered over large arrays (the loads of the field
 // quadrics were half of its time): it is asked for as soon as legal() passes the out-edge, and
-// only then. Asking for every neighbour's while legal() ran, as before session 21, fetched four
-// times what was used (about 3 of 14 out-edges are legal), and the two threads of the slabs
-// share the memory's bandwidth: 3-5% more time in the simplifier on Harmonic 64³.
-void Simplifier::gatherCandidates(Lane& L, uint32_t i) {
-  L.candidates.clear();
-  L.passed.clear();
-  for (size_t n = 0; n < L.nbr.size(); ++n) {
+// only then. Asking for every neighbour's while legal() runs would fetch about four times what
+// is used (most out-edges are not legal), and the two threads of the slabs share the memory's
+// bandwidth.
+void Simplifier::gatherCandidates(Scratch& sc, uint32_t i) {
+  sc.candidates.clear();
+  sc.passed.clear();
+  for (size_t n = 0; n < sc.nbr.size(); ++n) {
     CollapseVerdict v;
-    const uint32_t w = L.nbr[n];
-    if (!legal(L, i, w, bitOf(n), &v)) continue;
-    L.passed.push_back({uint32_t(n), L.removed, L.removedQuality});
+    const uint32_t w = sc.nbr[n];
+    if (!legal(sc, i, w, bitOf(n), &v)) continue;
+    sc.passed.push_back({uint32_t(n), sc.removed, sc.removedQuality});
     const char* q = reinterpret_cast<const char*>(&fieldQuadric_[w]);
     __builtin_prefetch(q);
     __builtin_prefetch(q + 64);
@@ -255,48 +254,48 @@ void Simplifier::gatherCandidates(Lane& L, uint32_t i) {
     __builtin_prefetch(&qualitySum_[w]);
     __builtin_prefetch(&represented_[w]);
   }
-  for (const Lane::Passed& x : L.passed) {
-    L.candidates.push_back(boundTerms(L, i, L.nbr[x.place], bitOf(x.place), x.removed, x.removedQuality));
+  for (const Scratch::Passed& x : sc.passed) {
+    sc.candidates.push_back(boundTerms(sc, i, sc.nbr[x.place], bitOf(x.place), x.removed, x.removedQuality));
   }
 }
 
 // Best-first over the candidates: the cheapest one with an exact cost, finishing bounds only
 // while one could still win. Returns its index, or -1 when none is legal.
-int Simplifier::cheapestCandidate(Lane& L, uint32_t i) {
+int Simplifier::cheapestCandidate(Scratch& sc, uint32_t i) {
   for (;;) {
     int best = -1;
-    for (int c = 0; c < int(L.candidates.size()); ++c) {
-      const Candidate& x = L.candidates[size_t(c)];
-      if (best < 0 || x.cost < L.candidates[size_t(best)].cost ||
-          (x.cost == L.candidates[size_t(best)].cost && x.j < L.candidates[size_t(best)].j))
+    for (int c = 0; c < int(sc.candidates.size()); ++c) {
+      const Candidate& x = sc.candidates[size_t(c)];
+      if (best < 0 || x.cost < sc.candidates[size_t(best)].cost ||
+          (x.cost == sc.candidates[size_t(best)].cost && x.j < sc.candidates[size_t(best)].j))
         best = c;
     }
     if (best < 0) return -1;
-    Candidate& b = L.candidates[size_t(best)];
+    Candidate& b = sc.candidates[size_t(best)];
     if (b.stage == Candidate::Exact) return best;
     CollapseVerdict v;
-    if (b.stage == Candidate::Bound) localTerm(L, i, b);
-    else if (!finishCost(L, b, &v)) L.candidates.erase(L.candidates.begin() + best);
+    if (b.stage == Candidate::Bound) localTerm(sc, i, b);
+    else if (!finishCost(sc, b, &v)) sc.candidates.erase(sc.candidates.begin() + best);
   }
 }
 
 // Distinct vertices of the tets around v (v excluded), in first-seen order: a stamp per vertex
 // instead of sorting, as this runs for every queue pop.
-void Simplifier::neighbours(Lane& L, uint32_t v, std::vector<uint32_t>& out) {
+void Simplifier::neighbours(Scratch& sc, uint32_t v, std::vector<uint32_t>& out) {
   out.clear();
-  ++L.stamp;
-  L.seen[v] = L.stamp;
+  ++sc.stamp;
+  sc.seen[v] = sc.stamp;
   const bool onBoundary = boundary_[v];
   for (uint32_t t : star_[v]) {
     __builtin_prefetch(&kappa_[t]);
-    // prepareStar reads a boundary vertex's face neighbours next: waiting on those loads took
-    // a third of its time on the kiefer bracket, whose vertices are mostly on the boundary.
+    // prepareStar reads a boundary vertex's face neighbours next: on meshes whose vertices are
+    // mostly on the boundary, waiting on those loads would be a large share of its time.
     if (onBoundary) __builtin_prefetch(&opp_[4 * size_t(t)]);
     for (int k = 0; k < 4; ++k) {
       uint32_t w = out_.tets[4 * size_t(t) + k];
-      if (L.seen[w] != L.stamp) {
-        L.seen[w] = L.stamp;
-        L.place[w] = uint8_t(std::min<size_t>(out.size(), 255));
+      if (sc.seen[w] != sc.stamp) {
+        sc.seen[w] = sc.stamp;
+        sc.place[w] = uint8_t(std::min<size_t>(out.size(), 255));
         out.push_back(w);
         __builtin_prefetch(&vert_[w]);  // prepareStar and legal() read it next
       }
@@ -305,21 +304,21 @@ void Simplifier::neighbours(Lane& L, uint32_t v, std::vector<uint32_t>& out) {
 }
 
 // The cost of v's cheapest legal out-edge (infinity when it has none).
-float Simplifier::bestCost(Lane& L, uint32_t v) {
-  neighbours(L, v, L.nbr);
-  prepareStar(L, v);
-  gatherCandidates(L, v);
-  int best = cheapestCandidate(L, v);
-  return best < 0 ? float(kInf) : float(L.candidates[size_t(best)].cost);
+float Simplifier::bestCost(Scratch& sc, uint32_t v) {
+  neighbours(sc, v, sc.nbr);
+  prepareStar(sc, v);
+  gatherCandidates(sc, v);
+  int best = cheapestCandidate(sc, v);
+  return best < 0 ? float(kInf) : float(sc.candidates[size_t(best)].cost);
 }
 
 // Pops are re-evaluated (the neighbourhood of the target may have changed since the push):
-// the candidates of every out-edge of v in lane L, the cheapest one with its exact cost.
-void Simplifier::evaluateVertex(Lane& L, uint32_t v) {
-  neighbours(L, v, L.nbr);
-  prepareStar(L, v);
-  gatherCandidates(L, v);
-  cheapestCandidate(L, v);  // finishes the winner here, on the lane's thread
+// the candidates of every out-edge of v in scratch sc, the cheapest one with its exact cost.
+void Simplifier::evaluateVertex(Scratch& sc, uint32_t v) {
+  neighbours(sc, v, sc.nbr);
+  prepareStar(sc, v);
+  gatherCandidates(sc, v);
+  cheapestCandidate(sc, v);  // finishes the winner here, on the thread that owns sc
 }
 
 }  // namespace tetstream::simplify_detail

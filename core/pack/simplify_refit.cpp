@@ -28,11 +28,11 @@ void Simplifier::refitValues() {
   const uint32_t n = uint32_t(free.size());
   std::vector<uint32_t> rowStart(n + 1, 0), cols;
   for (uint32_t r = 0; r < n; ++r) {
-    Lane& L = mainLane_;
-    neighbours(L, free[r], L.nbr);
-    L.nbr.push_back(free[r]);
-    std::sort(L.nbr.begin(), L.nbr.end());
-    for (uint32_t w : L.nbr)
+    Scratch& sc = mainScratch_;
+    neighbours(sc, free[r], sc.nbr);
+    sc.nbr.push_back(free[r]);
+    std::sort(sc.nbr.begin(), sc.nbr.end());
+    for (uint32_t w : sc.nbr)
       if (col[w] != none) cols.push_back(col[w]);
     rowStart[r + 1] = uint32_t(cols.size());
   }
@@ -51,8 +51,8 @@ void Simplifier::refitValues() {
     bool usable;  // inside the mesh, and a sample and neighbour values that are numbers
   };
   std::vector<Located> located(V_);
-  onBoth([&](int part) {
-    for (uint32_t v = part ? V_ / 2 : 0, end = part ? V_ : V_ / 2; v < end; ++v) {
+  onBoth([&](int half) {
+    for (uint32_t v = half ? V_ / 2 : 0, end = half ? V_ : V_ / 2; v < end; ++v) {
       Located& l = located[v];
       l.usable = false;
       if (out_.vertexAlive[v]) {
@@ -66,8 +66,8 @@ void Simplifier::refitValues() {
       for (int x = 0; x < 4; ++x) l.usable = l.usable && (l.w[x] == 0 || std::isfinite(vert_[l.t4[x]].fit));
     }
   });
-  onBoth([&](int part) {
-    const uint32_t lo = part ? n / 2 : 0, hi = part ? n : n / 2;
+  onBoth([&](int half) {
+    const uint32_t lo = half ? n / 2 : 0, hi = half ? n : n / 2;
     for (uint32_t v = 0; v < V_; ++v) {
       const Located& l = located[v];
       if (!l.usable) continue;

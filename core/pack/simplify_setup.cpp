@@ -52,7 +52,7 @@ void Simplifier::init() {
   for (uint32_t h = 0; h < 4 * T_; ++h) {
     if (opp_[h] != kNoNeighbor) continue;
     const uint32_t* v = &out_.tets[h & ~3u];
-    uint32_t a = v[kFaces[h & 3][0]], b = v[kFaces[h & 3][1]], c = v[kFaces[h & 3][2]];
+    uint32_t a = v[kTetFaces[h & 3][0]], b = v[kTetFaces[h & 3][1]], c = v[kTetFaces[h & 3][2]];
     const Point pa = p(a), pb = p(b), pc = p(c);
     double u[3] = {pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]}, w[3] = {pc[0] - pa[0], pc[1] - pa[1], pc[2] - pa[2]};
     double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
@@ -78,7 +78,7 @@ void Simplifier::init() {
   // formed in the same order as on one thread; a tet with vertices in both ranges is computed
   // by both (few, in a mesh numbered coherently).
   uint32_t flat[2] = {0, 0};
-  auto sums = [&](int part, uint32_t lo, uint32_t hi) {
+  auto sums = [&](int half, uint32_t lo, uint32_t hi) {
     for (uint32_t t = 0; t < T_; ++t) {
       const uint32_t* v = &out_.tets[4 * size_t(t)];
       bool mine[4], any = false;
@@ -87,7 +87,7 @@ void Simplifier::init() {
       const float kappa = tetKappa(t);
       if (mine[0]) {  // (the owner of its first vertex writes κ)
         kappa_[t] = kappa;
-        flat[part] += kappa >= kKappaCap;
+        flat[half] += kappa >= kKappaCap;
       }
       for (int k = 0; k < 4; ++k)
         if (mine[k]) qualitySum_[v[k]] += 3.0 / kappa;
@@ -97,7 +97,7 @@ void Simplifier::init() {
           if (mine[k]) fieldQuadric_[v[k]].addSquare(hyperplane, w);
     }
   };
-  onBoth([&](int part) { sums(part, part ? V_ / 2 : 0, part ? V_ : V_ / 2); });
+  onBoth([&](int half) { sums(half, half ? V_ / 2 : 0, half ? V_ : V_ / 2); });
   flatInput_ += flat[0] + flat[1];
   // The unit of volume (boundTerms): the mean of the interior vertices', which on an even grid is
   // every interior vertex's own (boundary vertices stand for half a star or less); of all
@@ -116,16 +116,16 @@ void Simplifier::init() {
   queued_.assign(V_, 0);
   represented_.assign(V_, 1);
   lastCost_.assign(V_, float(kInf));
-  // Every vertex's first cost, on two threads (each with its own scratch lane; the mesh is
+  // Every vertex's first cost, on two threads (each with its own scratch; the mesh is
   // only read), then queued in vertex order so the result does not depend on the threads.
-  main_.lane = &mainLane_;
-  lanes_.resize(kRoundSize);
-  for (size_t k = 0; k < 2; ++k) lanes_[k].reset(V_);  // (the rest: readyLanes())
-  auto work = [this](Lane& L, uint32_t begin, uint32_t end) {
+  main_.scratch = &mainScratch_;
+  scratches_.resize(kRoundSize);
+  for (size_t k = 0; k < 2; ++k) scratches_[k].reset(V_);  // (the rest: readyScratches())
+  auto work = [this](Scratch& sc, uint32_t begin, uint32_t end) {
     for (uint32_t v = begin; v < end; ++v)
-      if (out_.vertexAlive[v]) lastCost_[v] = bestCost(L, v);
+      if (out_.vertexAlive[v]) lastCost_[v] = bestCost(sc, v);
   };
-  onBoth([&](int part) { work(lanes_[size_t(part)], part ? V_ / 2 : 0, part ? V_ : V_ / 2); });
+  onBoth([&](int half) { work(scratches_[size_t(half)], half ? V_ / 2 : 0, half ? V_ : V_ / 2); });
   for (uint32_t v = 0; v < V_; ++v) queued_[v] = lastCost_[v] < float(kInf);  // (run() queues them)
 }
 

@@ -12,18 +12,17 @@
 // Rounds: every slab collapses its entries up to a key τ, then τ grows by kTauGrowth. The
 // rounds alternate between two slabs cut at the median and three cut at the quartiles, so a
 // vertex left waiting along one round's cut is inner in the next and is collapsed within a
-// step of τ of its turn. (With one fixed cut its vertices waited for the whole mesh's queue at
-// the end: they were the last collapses and so the first splits, and the levels around 12% of
-// Harmonic 64³'s vertices spent a quarter of their vertices on a refined slab along the cut.
-// Parallel cuts never cross, so no vertex waits on two; more slabs, for smaller working sets,
-// made the stream up to 10% larger and were no faster.) Growth 2 left the levels up to 3%
-// worse than √2; 2^¼ was no better than √2 and takes twice the rounds (each ~10 ms on
-// Harmonic 64³).
-// The slabs take kPartShare of the planned collapses; the one queue of the whole mesh then
+// step of τ of its turn. (With one fixed cut its vertices would wait for the whole mesh's queue
+// at the end: they would be the last collapses and so the first splits, and the coarse levels
+// would spend many of their vertices on a refined band along the cut. Parallel cuts never
+// cross, so no vertex waits on two; more slabs, for smaller working sets, make the stream
+// larger and are no faster.) A larger growth makes the levels worse; a smaller one is no
+// better and takes more rounds.
+// The slabs take kSlabShare of the planned collapses; the one queue of the whole mesh then
 // evens out what they left along the last round's cuts and takes the rest. Its collapses cost
-// twice as much time as the slabs' (Harmonic 64³: 5% of the collapses took 0.22 s there).
-// Shares from 0.95 to 0.99 gave the same field error within 0.3% at every level of Harmonic
-// 64³; with 1, Harmonic 20³ cut to 2.5% of its vertices got 55% worse (nothing evens out).
+// about twice as much time as the slabs', so the share is high; below 1, so that something is
+// left to even out the cuts (with 1 the coarsest levels get much worse). The error hardly
+// depends on the share between 0.95 and 0.99. Figures: docs/design-notes.md.
 #include "pack/simplifier.h"
 
 namespace tetstream::simplify_detail {
@@ -68,10 +67,10 @@ uint32_t Simplifier::slabsOf(const std::vector<uint32_t>& order, bool staggered,
   return count;
 }
 
-void Simplifier::runParts(uint32_t planned) {
+void Simplifier::runSlabs(uint32_t planned) {
   // The order the slabs follow: the vertex numbering (meshes are mostly numbered coherently,
-  // and the split stream then compresses best: Harmonic 64³'s grew by 9% with slabs across its
-  // numbering) or an axis, whichever crosses fewest vertices when halved.
+  // and the split stream then compresses best; slabs across the numbering make it larger) or
+  // an axis, whichever crosses fewest vertices when halved.
   // (Each axis sorts the order of the one before, stably: ties keep that order.)
   std::vector<uint32_t> order, candidate;  // (alive vertices only: those that die leave each round)
   std::vector<uint8_t> slab(V_, 0);
@@ -95,7 +94,7 @@ void Simplifier::runParts(uint32_t planned) {
       order = candidate;
     }
   }
-  for (uint32_t s = 0; s < kMaxSlabs; ++s) parts_[s].part = int(s);
+  for (uint32_t s = 0; s < kMaxSlabs; ++s) slabs_[s].slab = int(s);
   // The log sized up front (a log grown by doubling holds up to twice its size): a collapse
   // removes about (T − target tets) / planned tets and moves the rest of a star of 4T/V tets.
   const double removedEach = double(tetsAlive_ - std::min<uint32_t>(tetsAlive_, opt_.targetTets)) / std::max(1u, planned);
@@ -106,26 +105,26 @@ void Simplifier::runParts(uint32_t planned) {
                                                CollapseLog::kRemovedBytes * removedEach)));
   if (opt_.recordReadSets) out_.log.star.reserve(size_t(expected * 4.0 * tetsAlive_ / std::max<uint32_t>(alive_, 1)));
 
-  const double budgetV = kPartShare * planned;
-  const double budgetT = opt_.targetTets > 0 ? kPartShare * (double(tetsAlive_) - opt_.targetTets) : kInf;
+  const double budgetV = kSlabShare * planned;
+  const double budgetT = opt_.targetTets > 0 ? kSlabShare * (double(tetsAlive_) - opt_.targetTets) : kInf;
   double capV[kMaxSlabs], capT[kMaxSlabs], inner[kMaxSlabs];
   std::vector<uint32_t> thread[2];
   float tau = 0;
   uint32_t collapsedAll = 0, removedAll = 0;
   auto work = [&](int t) {
     for (uint32_t s : thread[t]) {
-      Worker& W = parts_[s];
+      Queue& Q = slabs_[s];
       Entry e, top;
-      while (W.collapsed < capV[s] && W.tetsRemoved < capT[s] && !W.errorBound && peekValid(W.heap, e) &&
+      while (Q.collapsed < capV[s] && Q.tetsRemoved < capT[s] && !Q.errorBound && peekValid(Q.heap, e) &&
              e.cost <= tau) {
-        W.heap.pop();
+        Q.heap.pop();
         queued_[e.vertex] = 0;
-        if (!W.heap.empty()) prefetchStar(W.heap.top().vertex);
-        evaluateVertex(*W.lane, e.vertex);
-        tryCollapse(W, e.vertex, *W.lane, peekValid(W.heap, top) ? top.cost : float(kInf));
-        if (t == 0 && opt_.progress && (W.collapsed & 4095) == 0) {
+        if (!Q.heap.empty()) prefetchStar(Q.heap.top().vertex);
+        evaluateVertex(*Q.scratch, e.vertex);
+        tryCollapse(Q, e.vertex, *Q.scratch, peekValid(Q.heap, top) ? top.cost : float(kInf));
+        if (t == 0 && opt_.progress && (Q.collapsed & 4095) == 0) {
           uint32_t done = collapsedAll;
-          for (const Worker& x : parts_) done += x.collapsed;
+          for (const Queue& x : slabs_) done += x.collapsed;
           opt_.progress(done, planned);
         }
       }
@@ -149,10 +148,10 @@ void Simplifier::runParts(uint32_t planned) {
     bool errorBound = false;
     double innerAll = 0;
     for (uint32_t s = 0; s < slabs; ++s) {
-      Worker& W = parts_[s];
-      W.heap = Heap(EntryAfter(), std::move(entries[s]));
-      if (!W.heap.empty()) least = std::min(least, W.heap.top().cost);
-      errorBound |= W.errorBound;
+      Queue& Q = slabs_[s];
+      Q.heap = Heap(EntryAfter(), std::move(entries[s]));
+      if (!Q.heap.empty()) least = std::min(least, Q.heap.top().cost);
+      errorBound |= Q.errorBound;
       innerAll += inner[s];
     }
     const double leftV = budgetV - collapsedAll, leftT = budgetT - removedAll;
@@ -168,22 +167,22 @@ void Simplifier::runParts(uint32_t planned) {
     thread[1].clear();
     for (uint32_t k = 0; k < slabs; ++k) {
       const uint32_t s = bySize[k];
-      Worker& W = parts_[s];
-      W.collapsed = 0;
-      W.tetsRemoved = 0;
+      Queue& Q = slabs_[s];
+      Q.collapsed = 0;
+      Q.tetsRemoved = 0;
       capV[s] = leftV * inner[s] / innerAll;
       capT[s] = leftT * inner[s] / innerAll;
       const int t = load[1] < load[0] ? 1 : 0;
       load[t] += inner[s];
       thread[t].push_back(s);
-      W.lane = &lanes_[size_t(t)];
+      Q.scratch = &scratches_[size_t(t)];
     }
     onBoth(work);
     mergeRound(slabs);
     uint32_t collapsed = 0;
     for (uint32_t s = 0; s < slabs; ++s) {
-      collapsed += parts_[s].collapsed;
-      removedAll += parts_[s].tetsRemoved;
+      collapsed += slabs_[s].collapsed;
+      removedAll += slabs_[s].tetsRemoved;
     }
     collapsedAll += collapsed;
     idle = collapsed ? 0 : idle + 1;
@@ -192,10 +191,10 @@ void Simplifier::runParts(uint32_t planned) {
   out_.slabCollapses += collapsedAll;
   alive_ -= collapsedAll;
   tetsAlive_ -= removedAll;
-  for (Worker& W : parts_) {
-    W.heap = Heap();
-    W.ownLog = CollapseLog();
-    W.keys = std::vector<float>();
+  for (Queue& Q : slabs_) {
+    Q.heap = Heap();
+    Q.ownLog = CollapseLog();
+    Q.keys = std::vector<float>();
   }
 }
 
@@ -206,21 +205,21 @@ void Simplifier::mergeRound(uint32_t slabs) {
   for (;;) {
     int best = -1;
     for (uint32_t s = 0; s < slabs; ++s)
-      if (next[s] < parts_[s].ownLog.size() &&
-          (best < 0 || parts_[s].keys[next[s]] < parts_[size_t(best)].keys[next[size_t(best)]]))
+      if (next[s] < slabs_[s].ownLog.size() &&
+          (best < 0 || slabs_[s].keys[next[s]] < slabs_[size_t(best)].keys[next[size_t(best)]]))
         best = int(s);
     if (best < 0) break;
-    appendCollapse(out_.log, parts_[size_t(best)].ownLog, next[size_t(best)]++);
+    appendCollapse(out_.log, slabs_[size_t(best)].ownLog, next[size_t(best)]++);
   }
   for (uint32_t s = 0; s < slabs; ++s) {
-    forEachArray([](auto& x) { x.clear(); }, parts_[s].ownLog);
-    parts_[s].keys.clear();
+    forEachArray([](auto& x) { x.clear(); }, slabs_[s].ownLog);
+    slabs_[s].keys.clear();
   }
 }
 
 // inner_[v]: every alive tet around v lies in v's slab.
-// Every round scans all tets: on large meshes in two halves at once (carotid, 950k tets, 25
-// scans: ~90 → 60-70 ms). Both halves only ever write 0, relaxed: the result is the same.
+// Every round scans all tets: on large meshes (kTwoThreadScan) in two halves at once. Both
+// halves only ever write 0, relaxed: the result is the same.
 void Simplifier::markInner(const std::vector<uint8_t>& slab) {
   inner_.assign(V_, 1);
   auto scan = [&](uint32_t begin, uint32_t end) {
@@ -232,7 +231,7 @@ void Simplifier::markInner(const std::vector<uint8_t>& slab) {
     }
   };
   if (T_ < kTwoThreadScan) return scan(0, T_);
-  onBoth([&](int part) { scan(part ? T_ / 2 : 0, part ? T_ : T_ / 2); });
+  onBoth([&](int half) { scan(half ? T_ / 2 : 0, half ? T_ : T_ / 2); });
 }
 
 }  // namespace tetstream::simplify_detail

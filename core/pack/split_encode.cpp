@@ -126,7 +126,7 @@ class Encoder {
     if (2 * count >= left && left - std::ceil(left / 2.0) >= least) count = std::ceil(left / 2.0);
     return uint32_t(std::clamp(count, 1.0, double(left)));
   }
-  static constexpr double kFirstGuessBytesPerSplit = 12;  // Harmonic 64³: 11.5, carotid 14
+  static constexpr double kFirstGuessBytesPerSplit = 12;  // typical of the compressed stream
 
   // Each level's field error, measured at every input vertex (level_error.h) for the field that
   // steered the simplification. The meter locates them in the base on another thread (it reads

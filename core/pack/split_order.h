@@ -1,6 +1,6 @@
 // The order of the splits inside one chunk with pack --compact (FORMAT.md §4). In cost order
 // the kept vertices of consecutive splits lie anywhere in the mesh, and naming p_j takes ~16 bits
-// a split, a third of Harmonic 64³'s stream. Inside a chunk the splits can go in another order
+// a split, a large share of the stream. Inside a chunk the splits can go in another order
 // that keeps each one's effect: a split comes after every earlier one (in cost order) that writes
 // a tet it reads or writes, and after every earlier one that reads a tet it writes. Splits are
 // put in waves, each one wave past everything it must follow; the splits of a wave touch nothing

@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "isosurface.h"
-#include "pack/mesh_io.h"
+#include "io/mesh_io.h"
 #include "tet_quality.h"
 
 using namespace tetstream;

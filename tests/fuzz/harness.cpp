@@ -17,10 +17,10 @@
 #include "hash.h"
 #include "manifest.h"
 #include "pack/chunk_encode.h"
-#include "pack/generators.h"
-#include "pack/mesh_io.h"
+#include "io/generators.h"
+#include "io/mesh_io.h"
 #include "pack/packer.h"
-#include "pack/readers.h"
+#include "io/readers.h"
 #include "validate.h"
 
 namespace tetstream::fuzz {

@@ -7,7 +7,7 @@
 #include <limits>
 
 #include "adjacency.h"
-#include "pack/generators.h"
+#include "io/generators.h"
 #include "tet_tables.h"
 #include "test_helpers.h"
 #include "validate.h"

@@ -1,4 +1,4 @@
-// The cell pipeline every reader shares (core/pack/cells.cpp): hexahedra, wedges and pyramids
+// The cell pipeline every reader shares (core/io/cells.cpp): hexahedra, wedges and pyramids
 // split into tets that conform across cells under any vertex numbering, structured grids split
 // as the generator splits them, and degenerate cells, repeated and duplicate vertices handled.
 #include <gtest/gtest.h>
@@ -9,8 +9,8 @@
 #include <random>
 #include <sstream>
 
-#include "pack/mesh_io.h"
-#include "pack/readers.h"
+#include "io/mesh_io.h"
+#include "io/readers.h"
 #include "test_helpers.h"
 #include "validate.h"
 

@@ -19,7 +19,7 @@
 #include "slice.h"
 #include "dataset.h"
 #include "isosurface_incremental.h"
-#include "pack/generators.h"
+#include "io/generators.h"
 #include "pack/packer.h"
 #include "test_helpers.h"
 

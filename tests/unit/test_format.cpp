@@ -10,7 +10,7 @@
 #include "dataset.h"
 #include "hash.h"
 #include "pack/chunk_encode.h"
-#include "pack/generators.h"
+#include "io/generators.h"
 #include "pack/packer.h"
 #include "test_helpers.h"
 

@@ -11,8 +11,9 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "pack/mesh_io.h"
-#include "pack/readers.h"
+#include "adjacency.h"
+#include "io/mesh_io.h"
+#include "io/readers.h"
 #include "test_helpers.h"
 
 namespace tetstream {

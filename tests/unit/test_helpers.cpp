@@ -24,7 +24,7 @@
 #include "chunk.h"
 #include "dataset.h"
 #include "pack/chunk_encode.h"
-#include "pack/generators.h"
+#include "io/generators.h"
 #include "split_stream.h"
 #include "validate.h"
 

@@ -7,7 +7,7 @@
 
 #include "manifest.h"
 #include "mesh.h"
-#include "pack/mesh_io.h"
+#include "io/mesh_io.h"
 #include "pack/packer.h"
 #include "pack/simplify.h"
 #include "quantize.h"

@@ -13,7 +13,7 @@
 #include <string>
 
 #include "interval_tree.h"
-#include "pack/generators.h"
+#include "io/generators.h"
 #include "tet_tables.h"
 
 using namespace tetstream;

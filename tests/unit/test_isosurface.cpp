@@ -6,7 +6,7 @@
 #include <numbers>
 
 #include "isosurface.h"
-#include "pack/generators.h"
+#include "io/generators.h"
 #include "test_helpers.h"
 
 using namespace tetstream;

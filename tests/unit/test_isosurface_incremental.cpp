@@ -15,7 +15,7 @@
 #include "isosurface.h"
 #include "isosurface_incremental.h"
 #include "dataset.h"
-#include "pack/generators.h"
+#include "io/generators.h"
 #include "pack/packer.h"
 #include "test_helpers.h"
 

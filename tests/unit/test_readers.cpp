@@ -1,4 +1,4 @@
-// Mesh readers for VTK files (core/pack/mesh_io.h): every fixture written by VTK or meshio reads
+// Mesh readers for VTK files (core/io/mesh_io.h): every fixture written by VTK or meshio reads
 // with the right counts and analytic field values, and hostile bytes (truncations, flips, lies in
 // headers) give a Result. The writers are tested in test_writers.cpp.
 #include <gtest/gtest.h>
@@ -8,8 +8,8 @@
 #include <filesystem>
 #include <random>
 
-#include "pack/mesh_io.h"
-#include "pack/readers.h"
+#include "io/mesh_io.h"
+#include "io/readers.h"
 #include "test_helpers.h"
 
 namespace tetstream {

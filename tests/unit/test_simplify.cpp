@@ -11,8 +11,9 @@
 #include <vector>
 
 #include "dataset.h"
-#include "pack/generators.h"
+#include "io/generators.h"
 #include "pack/packer.h"
+#include "pack/simplifier.h"
 #include "pack/simplify.h"
 #include "test_helpers.h"
 #include "validate.h"
@@ -23,11 +24,13 @@ using namespace tetstream::test;
 namespace {
 
 // Simplifies m with o on one thread and on two: the collapses must be exactly the same.
-void expectSameOnOneThreadAndTwo(const TetMesh& m, SimplifyOptions o, SimplifyResult& one, SimplifyResult& two) {
+void expectSameOnOneThreadAndTwo(const TetMesh& m, SimplifyOptions o, SimplifyResult& one, SimplifyResult& two,
+                                 SimplifyTuning tuning = {}) {
   o.threads = 1;
-  ASSERT_TRUE(simplifyMesh(m, o, one));
+  ASSERT_TRUE(simplifyMeshTuned(m, o, tuning, one));
+  EXPECT_EQ(tuning.linkMismatches, 0u);
   o.threads = 2;
-  ASSERT_TRUE(simplifyMesh(m, o, two));
+  ASSERT_TRUE(simplifyMeshTuned(m, o, tuning, two));
   EXPECT_EQ(one.log.i, two.log.i);
   EXPECT_EQ(one.log.j, two.log.j);
   EXPECT_EQ(one.log.fieldError, two.log.fieldError);
@@ -44,9 +47,9 @@ void simplifyInSlabsAndWhole(const TetMesh& m, uint32_t vertices, uint32_t tets,
   SimplifyOptions so;
   so.targetVertices = vertices;
   so.targetTets = tets;
-  so.partitionMinVertices = 0;
+  so.slabMinVertices = 0;
   ASSERT_TRUE(simplifyMesh(m, so, slabs));
-  so.partitionMinVertices = ~0u;
+  so.slabMinVertices = ~0u;
   ASSERT_TRUE(simplifyMesh(m, so, whole));
 }
 
@@ -115,10 +118,10 @@ TEST(Simplify, SlabsCollapseTheSameOnOneThreadAndTwo) {
   SimplifyResult one, two;
   SimplifyOptions o;
   o.targetVertices = 100;
-  o.partitionMinVertices = 0;
-  o.verifyLinkCondition = true;  // (and the fast link check agrees with the reference throughout)
-  expectSameOnOneThreadAndTwo(harmonic(20), o, one, two);
-  EXPECT_EQ(one.linkMismatches, 0u);
+  o.slabMinVertices = 0;
+  SimplifyTuning tuning;
+  tuning.verifyLinkCondition = true;  // (and the fast link check agrees with the reference throughout)
+  expectSameOnOneThreadAndTwo(harmonic(20), o, one, two, tuning);
   EXPECT_GT(one.slabCollapses, one.log.size() * 8 / 10);
   EXPECT_EQ(one.slabCollapses, two.slabCollapses);
 }
@@ -149,7 +152,7 @@ TEST(Simplify, BoundaryIsPreserved) {
 TEST(Simplify, SlabsGiveValidLevelsAndTheSameQuality) {
   TetMesh m = harmonic(20);
   PackOptions o;
-  o.partitionMinVertices = 0;
+  o.slabMinVertices = 0;
   roundTrip("slabs", m, o);
   SimplifyResult slabs, whole;
   simplifyInSlabsAndWhole(m, 0, m.tetCount() / 20, slabs, whole);
@@ -184,11 +187,12 @@ TEST(Simplify, GradedMeshKeepsTheFarFieldWhereIsosurfacesAre) {
   // keep its far field too (volume RMS 0.31 against 0.43 with the volume), but on Blunt Fin, the
   // real graded grid, the volume still keeps the isosurfaces 3.4× closer at 30% of its tets
   // (2.9e-5 against 9.6e-5 of the diagonal, mean over five isovalues).
-  so.removedTetsExponent = 0;
+  SimplifyTuning tuning;
+  tuning.removedTetsExponent = 0;
   SimplifyResult volume, count;
-  ASSERT_TRUE(simplifyMesh(m, so, volume));
-  so.weighByVolume = false;
-  ASSERT_TRUE(simplifyMesh(m, so, count));
+  ASSERT_TRUE(simplifyMeshTuned(m, so, tuning, volume));
+  tuning.weighByVolume = false;
+  ASSERT_TRUE(simplifyMeshTuned(m, so, tuning, count));
   const TetMesh a = coarseMesh(m, volume), b = coarseMesh(m, count);
   const double va = volumeRms(m, a), vb = volumeRms(m, b), ra = fieldRms(m, a, 0), rb = fieldRms(m, b, 0);
   std::printf("volume RMS %.5f (vertices alone %.5f), RMS at the vertices %.5f (%.5f)\n", va, vb, ra, rb);
@@ -209,8 +213,9 @@ TEST(Simplify, CostPerRemovedTetGivesALowerErrorAtTheSameTets) {
     so.targetTets = m.tetCount() / share;
     SimplifyResult perTet, alike;
     ASSERT_TRUE(simplifyMesh(m, so, perTet));
-    so.removedTetsExponent = 0;
-    ASSERT_TRUE(simplifyMesh(m, so, alike));
+    SimplifyTuning tuning;
+    tuning.removedTetsExponent = 0;
+    ASSERT_TRUE(simplifyMeshTuned(m, so, tuning, alike));
     const TetMesh a = coarseMesh(m, perTet), b = coarseMesh(m, alike);
     const double ra = fieldRms(m, a, 0), rb = fieldRms(m, b, 0);
     std::printf("RMS at %u / %u tets: %.5f per removed tet, %.5f alike (%u / %u vertices)\n", a.tetCount(),
@@ -343,11 +348,12 @@ TEST(Legality, LinkConditionOnATunnelMatchesTheReference) {
   ASSERT_EQ(boundaryEuler(m), 0) << "a tunnel along z";
   SimplifyOptions o;
   o.targetVertices = 4;
-  o.verifyLinkCondition = true;
+  SimplifyTuning tuning;
+  tuning.verifyLinkCondition = true;
   SimplifyResult r;
-  ASSERT_TRUE(simplifyMesh(m, o, r));
+  ASSERT_TRUE(simplifyMeshTuned(m, o, tuning, r));
   EXPECT_GT(r.rejectedByLink, 0u);
-  EXPECT_EQ(r.linkMismatches, 0u);
+  EXPECT_EQ(tuning.linkMismatches, 0u);
   EXPECT_EQ(r.stopReason, "no legal collapse left");
   TetMesh base = baseMeshOf(m, r);
   ValidationReport v = validateMesh(base);

@@ -20,7 +20,7 @@
 #include "camera.h"
 #include "frame_policy.h"
 #include "pack/chunk_encode.h"
-#include "pack/generators.h"
+#include "io/generators.h"
 #include "pack/packer.h"
 #include "test_helpers.h"
 #include "viewer_memory.h"

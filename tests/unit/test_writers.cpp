@@ -1,4 +1,4 @@
-// Mesh writers (core/pack/mesh_io.h: .vtu; core/pack/ply_writer.h): our .vtu round-trips exactly
+// Mesh writers (core/io/mesh_io.h: .vtu; core/io/ply_writer.h): our .vtu round-trips exactly
 // through our reader and reads in meshio and VTK; the isosurface's .ply is binary with normals.
 #include <gtest/gtest.h>
 
@@ -7,9 +7,9 @@
 #include <cstdio>
 #include <cstring>
 
-#include "pack/generators.h"
-#include "pack/mesh_io.h"
-#include "pack/ply_writer.h"
+#include "io/generators.h"
+#include "io/mesh_io.h"
+#include "io/ply_writer.h"
 #include "test_helpers.h"
 
 namespace tetstream {

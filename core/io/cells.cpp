@@ -31,7 +31,7 @@
 #include <numeric>
 
 #include "adjacency.h"
-#include "pack/readers.h"
+#include "io/readers.h"
 
 namespace tetstream {
 namespace vtkio {
@@ -253,7 +253,7 @@ uint64_t nonManifoldCount(const std::vector<uint32_t>& tets, uint32_t nv) {
 // edge that can differ. Every tet with a face or edge at a vertex of R has a vertex in R, so
 // counting on the tets with a vertex in R, merged and apart, gives the same difference as counting
 // on the whole mesh twice: what lies outside them is the same either way, and what the cut makes
-// look like boundary there is too. (Blunt Fin, 39 merged vertices: 24 → 1.5 ms; post.vtk 2.2 → 0.7 ms.)
+// look like boundary there is too, at a fraction of the time when few vertices merge.
 // `mergedTets`: the whole mesh merged, counted instead when most cells are near a merged vertex;
 // the whole mesh apart is then left in `apart` (for the caller, when it does not merge).
 int64_t mergeDamage(const CellSoup& soup, const std::vector<uint32_t>& remap, const float* pos, uint32_t nv,

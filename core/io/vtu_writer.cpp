@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "pack/file_writer.h"
-#include "pack/readers.h"
+#include "io/file_writer.h"
+#include "io/readers.h"
 
 namespace tetstream {
 namespace {

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "mesh.h"
-#include "pack/mesh_io.h"
+#include "io/mesh_io.h"
 #include "status.h"
 
 namespace tetstream {
@@ -228,10 +228,6 @@ struct TextReader {
     size_t e = pos;
     while (e < s.size() && s[e] != ' ' && s[e] != '\t' && s[e] != '\r' && s[e] != '\n' && s[e] != '#') ++e;
     return s.substr(pos, e - pos);
-  }
-  // The rest of the current line is consumed (comment included).
-  void endLine() {
-    while (pos < s.size() && s[pos] != '\n') ++pos;
   }
   // Number of tokens left on the current line (before a comment).
   int tokensLeftOnLine() const {

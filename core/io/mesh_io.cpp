@@ -1,4 +1,4 @@
-#include "pack/mesh_io.h"
+#include "io/mesh_io.h"
 
 #include <bit>
 #include <cctype>
@@ -12,7 +12,7 @@
 #include <limits>
 #include <new>
 
-#include "pack/readers.h"
+#include "io/readers.h"
 
 namespace tetstream {
 namespace {

@@ -1,4 +1,4 @@
-#include "pack/file_writer.h"
+#include "io/file_writer.h"
 
 #include <cerrno>
 #include <cstring>

@@ -16,7 +16,7 @@
 #include <cstring>
 #include <set>
 
-#include "pack/readers.h"
+#include "io/readers.h"
 
 namespace tetstream {
 namespace {

@@ -19,7 +19,7 @@
 #include <pugixml.hpp>
 #include <set>
 
-#include "pack/readers.h"
+#include "io/readers.h"
 
 namespace tetstream {
 namespace {

@@ -1,8 +1,8 @@
 // PLY reference: http://paulbourke.net/dataformats/ply/. Vertex records are interleaved in one
 // buffer and faces in another, so the whole file is three fwrites.
-#include "pack/ply_writer.h"
+#include "io/ply_writer.h"
 
-#include "pack/file_writer.h"
+#include "io/file_writer.h"
 
 #include <bit>
 #include <cerrno>

@@ -8,7 +8,7 @@
 // and the .ele file uses the same numbers. Point attributes become fields attr0, attr1, ...;
 // boundary markers and region attributes are not read (a note says so). 10-node tets list their
 // corners first.
-#include "pack/readers.h"
+#include "io/readers.h"
 
 namespace tetstream {
 

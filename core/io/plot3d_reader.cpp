@@ -17,7 +17,7 @@
 #include <cmath>
 #include <cstring>
 
-#include "pack/readers.h"
+#include "io/readers.h"
 
 namespace tetstream {
 namespace {

@@ -16,7 +16,7 @@
 #include <limits>
 #include <map>
 
-#include "pack/readers.h"
+#include "io/readers.h"
 
 namespace tetstream {
 namespace {

@@ -13,7 +13,7 @@
 #include <cctype>
 #include <cmath>
 
-#include "pack/readers.h"
+#include "io/readers.h"
 
 namespace tetstream {
 namespace {
