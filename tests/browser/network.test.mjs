@@ -2,7 +2,7 @@
 //   - real nginx with the documented config (server/nginx.conf), skipped with a message when
 //     nginx is not installed; the project's own server; python3 -m http.server (no Range, no CORS)
 //   - viewer and data on different origins (CORS)
-//   - faults injected by the project's server (server/faults.mjs): a chunk failing twice with
+//   - faults injected into the project's server (tests/support/faults.mjs): a chunk failing twice with
 //     503, truncated, corrupted, missing (404), slow, stalled past the stall timer, its
 //     connection dropped; the browser going offline and back; a hostile manifest; a memory limit
 // For each: no page error, no bad data applied (the final surface equals `tetstream iso` on the
@@ -13,7 +13,7 @@ import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
-import { createServer } from '../../server/serve.mjs';
+import { createServer } from '../support/server.mjs';
 import { precompressDir } from '../../server/precompress.mjs';
 import { startNginx, startPythonHttpServer } from '../support/nginx.mjs';
 import {

@@ -1,6 +1,7 @@
 // The static server (server/serve.mjs) and the documented nginx config (server/nginx.conf):
 // no way out of the served folders, the headers the viewer and caches rely on, precompressed
-// viewer files, the simulated link and every kind of injected fault.
+// viewer files; and the test tools plugged into it (tests/support/server.mjs): the simulated
+// link and every kind of injected fault.
 import { test, describe, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import crypto from 'node:crypto';
@@ -8,8 +9,8 @@ import fs from 'node:fs';
 import path from 'node:path';
 import zlib from 'node:zlib';
 import { spawn, spawnSync } from 'node:child_process';
-import { createServer } from '../../server/serve.mjs';
-import { parseRate } from '../../server/link.mjs';
+import { createServer } from '../support/server.mjs';
+import { parseRate } from '../support/link.mjs';
 import { precompressDir } from '../../server/precompress.mjs';
 import { startNginx, startPythonHttpServer } from '../support/nginx.mjs';
 import { get, rawGet } from '../support/http.mjs';
@@ -345,13 +346,25 @@ describe('link simulation', () => {
 
   test('the CLI refuses bad options with a clear message', () => {
     const run = (...args) => spawnSync(process.execPath, [path.join(root, 'server/serve.mjs'), ...args], { encoding: 'utf8' });
+    const r = run('--port', 'http');
+    assert.equal(r.status, 2);
+    assert.match(r.stderr, /serve: --port: cannot read "http"/);
+    assert.match(run('/no/such/folder').stderr, /serve: DIR: no such folder/);
+    assert.match(run('--frobnicate').stderr, /unknown option --frobnicate/);
+    assert.match(run('--throttle', '10mbit').stderr, /unknown option --throttle/, 'the link is simulated by test support only');
+    const help = run('--help');
+    assert.equal(help.status, 0);
+    for (const o of ['--mount', '--max-connections']) assert.ok(help.stdout.includes(o), `--help mentions ${o}`);
+  });
+
+  test("the simulated link's command line (tests/support/serve_link.mjs) refuses bad options with a clear message", () => {
+    const run = (...args) => spawnSync(process.execPath, [path.join(root, 'tests/support/serve_link.mjs'), ...args], { encoding: 'utf8' });
     const r = run('--throttle', '10 mbits');
     assert.equal(r.status, 2);
     assert.match(r.stderr, /^serve: --throttle: cannot read "10 mbits"; write e\.g\. 10mbit/);
     assert.match(run('--latency', 'soon').stderr, /serve: --latency: cannot read "soon"/);
     assert.match(run('--fault', '{"kind":"melt","match":"x"}').stderr, /serve: --fault: fault 1: "kind" must be one of/);
     assert.match(run('--port', 'http').stderr, /serve: --port: cannot read "http"/);
-    assert.match(run('/no/such/folder').stderr, /serve: DIR: no such folder/);
     assert.match(run('--frobnicate').stderr, /unknown option --frobnicate/);
     const help = run('--help');
     assert.equal(help.status, 0);

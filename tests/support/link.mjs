@@ -1,5 +1,6 @@
-// Link simulation: a bandwidth cap shared by every response of a server (one token bucket, as a
-// real link is one pipe) and a latency before each response's first byte. Both are Transform
+// Link simulation for tests and benchmarks (server.mjs plugs it into the project's server): a
+// bandwidth cap shared by every response of a server (one token bucket, as a real link is one
+// pipe) and a latency before each response's first byte. Both are Transform
 // streams that the response body flows through (see tap.mjs), so backpressure holds end to end:
 // a throttled response reads its file only as fast as the link lets it out.
 import { Transform } from 'node:stream';

@@ -1,4 +1,5 @@
-// Fault injection for tests: make chosen requests fail the way real networks and servers fail.
+// Fault injection for tests: make chosen requests fail the way real networks and servers fail
+// (server.mjs plugs it into the project's server).
 //
 //   { match, kind, status, times, delayMs, afterBytes }
 //   match       string (a substring of the request path) or RegExp (tested against the path)
@@ -18,7 +19,7 @@ import { setTimeout as sleep } from 'node:timers/promises';
 
 const KINDS = new Set(['status', 'truncate', 'corrupt', 'drop', 'slow']);
 
-// Checks a fault list (from code or from --fault JSON) and fills in defaults; throws on mistakes.
+// Checks a fault list (from code or from serve_link.mjs --fault JSON) and fills in defaults; throws on mistakes.
 export function normalizeFaults(list) {
   if (!Array.isArray(list)) throw new Error('faults must be an array');
   return list.map((f, i) => {
