@@ -22,7 +22,9 @@
 //                       chunksReceived, chunksAllowed, bytesReceived, bytesDownloaded,
 //                       bytesTotal, rateBytesPerSec, secondsLeft, retries (requests made again
 //                       after a failure), chunksRefused (downloads that failed the size/hash
-//                       check), programBytesReceived / programBytesTotal (tetstream.wasm);
+//                       check), requestLog (the chunk loader's decisions, in order: which
+//                       chunk it requested and why; web/loader.js ChunkLoader.log),
+//                       programBytesReceived / programBytesTotal (tetstream.wasm);
 //                       memory: {heapBytes, dataBytes, gpuBytes, limitBytes, neededBytes,
 //                       allowedBytes}, memoryLimited; frame timing: maxFrameMs, maxFrameGapMs,
 //                       maxRefineMs, sliceCounts (work slices by duration, bins split at
@@ -107,6 +109,7 @@ function stats() {
   const extra = {
     retries: (loader ? loader.retries : 0) + (shell.pageRetries || 0),
     chunksRefused: loader ? loader.refused : 0,
+    requestLog: loader ? loader.log : [], // what the chunk loader decided (loader.js)
     programBytesReceived: shell.programBytes,
     programBytesTotal: shell.programTotal,
   };
