@@ -18,7 +18,7 @@ import { precompressDir } from '../../server/precompress.mjs';
 import { startNginx, startPythonHttpServer } from '../support/nginx.mjs';
 import {
   webDir, outDir, checkBuilds, launchBrowser, makePack, cliIso, readManifest, assertSurfaceMatches, openViewer,
-  waitForState, waitForLevel, frames, frameReport, MAX_FRAME_MS,
+  waitForState, waitForLevel, frames, frameReport,
 } from './support.mjs';
 
 let tmp, pack, manifest, browser, own, ownUrl, dataServer, dataUrl;

@@ -23,12 +23,6 @@ const chromiumArgs = [
   '--disable-background-networking', '--disable-component-update', '--disable-sync', '--disable-quic',
 ];
 
-// A frame callback is almost all drawing, and SwiftShader renders in software on the same two
-// cores as everything else: 20-130 ms a frame here, 345 ms once on a loaded CI machine. So this
-// bound only catches a stall; the viewer's own budget is checked on its work slices
-// (assertSlices). The real figures go to the test output (t.diagnostic).
-export const MAX_FRAME_MS = 500;
-
 // Listens on 127.0.0.1 with the project's server `files` behind a /slow/... route that serves
 // `slowTo`/... with every chunk `delayMs` late (a slow link, so a test can act mid-stream).
 // onRequest(req) sees every request first. Returns { server, baseUrl }.
@@ -133,16 +127,15 @@ export async function waitForLevel(page, timeout = 120000) {
   return page.evaluate(() => window.tetstream.stats());
 }
 
-// Refinement and interval tree work run in slices of 8 ms (4 while the user drags: wasm/main.cpp);
-// issue 3 allows a frame no more than ~30 ms of it. A single slice over that is the OS or the
-// browser taking the core on a busy machine, which no budget prevents: one was 70 ms in a run
-// whose other slices were 8-27 ms. A budget that does not hold shows in many slices.
+// Refinement and interval tree work run in slices that end at a deadline (8 ms; 4 while the user
+// drags: wasm/main.cpp). That a slice stops at its deadline, and how slices are binned by
+// duration, is checked on a clock the test drives (tests/unit/test_viewer_state.cpp). Here every
+// duration is the machine's (SwiftShader draws in software on the cores everything else uses),
+// so durations of slices and frames go to the test output (sliceReport, frameReport) and only
+// that the work ran in slices is asserted.
 export function assertSlices(s) {
   const total = s.sliceCounts.reduce((a, b) => a + b, 0);
-  const over = (ms) => s.sliceCounts.reduce((n, c, bin) => n + (bin > 0 && s.sliceEdgesMs[bin - 1] >= ms ? c : 0), 0);
   assert.ok(total > 0, 'refinement ran in slices');
-  assert.ok(over(16) * 2 < total, `most slices over 16 ms: ${sliceReport(s)}`);
-  assert.ok(over(30) <= Math.max(3, total / 10), `more than one slice in 10 over 30 ms: ${sliceReport(s)}`);
 }
 
 export function sliceReport(s) {

@@ -10,7 +10,7 @@ import os from 'node:os';
 import path from 'node:path';
 import { createServer } from '../support/server.mjs';
 import {
-  webDir, outDir, MAX_FRAME_MS, checkBuilds, launchBrowser, cli, readManifest as readManifestOf, assertClose,
+  webDir, outDir, checkBuilds, launchBrowser, cli, readManifest as readManifestOf, assertClose,
   openViewer as openViewerAt, listenWithSlowRoute, waitForState, waitForLevel, frameReport, assertSlices, frames, pictureDifference,
   cliIso as cliIsoOf,
 } from './support.mjs';
@@ -111,7 +111,6 @@ test('streams a multi-chunk pack to complete, matches the CLI surface, and the i
   t.diagnostic(`Harmonic 32³, ${manifest.chunks.length} chunks, ${s.splitsTotal} splits: first surface ` +
     `${s.firstSurfaceMs.toFixed(0)} ms after navigation start, complete after ${s.completeMs.toFixed(0)} ms`);
   t.diagnostic(frameReport(s));
-  assert.ok(s.maxFrameMs < MAX_FRAME_MS, `longest frame ${s.maxFrameMs} ms`);
   assertSlices(s);
   // Splits upload changed ranges: a whole buffer goes only when it has to grow (doubling).
   assert.ok(s.partialUploads > 0, 'changed ranges were uploaded');
@@ -204,7 +203,6 @@ test('the level moves between the base mesh and the newest level, by API and by 
   assert.equal(s.surfaceVertices, refBase.vertices);
   assertClose(s.surfaceArea, refBase.area, 1e-6, 'surface area at the base');
   t.diagnostic(`undoing ${full.splitsApplied} splits: ${frameReport(s)}`);
-  assert.ok(s.maxFrameMs < MAX_FRAME_MS, `longest frame ${s.maxFrameMs} ms`);
   assertSlices(s);
   await frames(page);
   await page.screenshot({ path: path.join(outDir, 'viewer-base.png') });
@@ -253,7 +251,6 @@ test('the level moves between the base mesh and the newest level, by API and by 
   assert.equal(s.triangles, full.triangles);
   assertClose(s.surfaceArea, full.surfaceArea, 1e-9, 'surface area back at the full level');
   t.diagnostic(`level moves: ${frameReport(s)}`);
-  assert.ok(s.maxFrameMs < MAX_FRAME_MS, `longest frame ${s.maxFrameMs} ms`);
   assertSlices(s);
   assert.deepEqual(problems, []);
   await page.close();
@@ -319,7 +316,6 @@ test('pause stops fetching, resume completes the stream', async (t) => {
   assert.equal(s.triangles, ref.triangles);
   assertClose(s.surfaceArea, ref.area, 1e-6, 'surface area after pause and resume');
   t.diagnostic(`slow link, paused ${q.chunksReceived} of ${manifest.chunks.length} chunks in: ${frameReport(s)}`);
-  assert.ok(s.maxFrameMs < MAX_FRAME_MS, `longest frame ${s.maxFrameMs} ms`);
   assertSlices(s);
   assert.deepEqual(problems, []);
   await page.close();
