@@ -1,15 +1,12 @@
-// The HTTP side of server/serve.mjs: mounts, headers, precompressed files, link simulation and
-// fault injection around serve-static (which does MIME types, ETag/Last-Modified, conditional
-// requests, Range and HEAD) and finalhandler (error pages). Node's http module parses HTTP.
+// The HTTP side of server/serve.mjs: mounts, headers and precompressed files around serve-static
+// (which does MIME types, ETag/Last-Modified, conditional requests, Range and HEAD) and
+// finalhandler (error pages). Node's http module parses HTTP.
 import http from 'node:http';
 import fs from 'node:fs';
 import path from 'node:path';
 import serveStatic from 'serve-static';
 import finalhandler from 'finalhandler';
 import { checkRequestPath, resolveInRoot } from './paths.mjs';
-import { TokenBucket, Throttle, Latency } from './link.mjs';
-import { normalizeFaults, takeFault, answerStatus, FaultStream } from './faults.mjs';
-import { tapBody } from './tap.mjs';
 
 // Files the viewer downloads that compress well: served from a precompressed sibling (X.br,
 // X.gz, written by server/precompress.mjs) when the client accepts it. Chunks (.tsc) are zstd
@@ -33,33 +30,34 @@ export const CACHE_REVALIDATE = 'no-cache';
 
 const LOG_LIMIT = 10000; // requestLog keeps the newest entries only: bounded memory on long runs
 
+// plugins: functions (req, res, { path, entry }) called in order for every request, once its
+// CORS headers are set and before it is served. `path` is the decoded request path (null when
+// the target is refused), `entry` its requestLog entry (a plugin may set entry.note, which --log
+// prints). A plugin may wrap `res` (to change how the body goes out) or answer the request
+// itself and return true (or a Promise of true): then nothing else serves it. This is the one
+// seam for behaviour that is not static file serving, so the server itself stays just that.
 export function createServer({
   mounts,
-  throttleBytesPerSec = 0,
-  latencyMs = 0,
-  faults = [],
+  plugins = [],
   maxConnections = 512,
   log = null, // a function called with each finished entry of requestLog (the CLI's --log)
 } = {}) {
   if (!Array.isArray(mounts) || !mounts.length) throw new Error('createServer: give at least one mount {prefix, dir}');
   const table = mounts.map(({ prefix, dir }) => makeMount(prefix, dir));
   table.sort((a, b) => b.prefix.length - a.prefix.length); // longest prefix first: /data/ wins over /
-  const bucket = throttleBytesPerSec > 0 ? new TokenBucket(throttleBytesPerSec) : null;
 
   const server = http.createServer((req, res) => {
-    handle(server, table, bucket, latencyMs, req, res).catch((e) => {
+    handle(server, table, plugins, req, res).catch((e) => {
       if (!res.headersSent) plain(res, 500, 'internal error');
       else res.destroy(e);
     });
   });
   server.requestLog = [];
-  server.faults = normalizeFaults(faults);
-  server.setFaults = (list) => { server.faults = normalizeFaults(list); };
   server.logger = log;
   // Bounded resource use: slow or idle clients cannot hold sockets for long, and the number of
   // sockets is capped (further connections are closed at once until some finish).
   server.headersTimeout = 10_000;
-  server.requestTimeout = 30_000; // receiving the request, not sending the (maybe throttled) response
+  server.requestTimeout = 30_000; // receiving the request, not sending the (maybe slow) response
   server.keepAliveTimeout = 5_000;
   server.timeout = 120_000; // a socket with no traffic at all for 2 minutes is closed
   server.maxConnections = maxConnections;
@@ -95,21 +93,15 @@ function makeMount(prefix, dir) {
   };
 }
 
-async function handle(server, table, bucket, latencyMs, req, res) {
+async function handle(server, table, plugins, req, res) {
   const entry = { time: Date.now(), method: req.method, url: req.url, status: null };
   logRequest(server, entry, res);
   setCorsHeaders(req, res);
 
   const checked = checkRequestPath(req.url);
-  const fault = checked.decoded ? takeFault(server.faults, req.method, checked.decoded) : null;
-  if (fault) entry.fault = fault.kind;
-
-  // Link simulation and body faults sit between the handlers and the socket (tap.mjs).
-  const shapers = [];
-  if (latencyMs > 0) shapers.push(new Latency(latencyMs));
-  if (bucket) shapers.push(new Throttle(bucket));
-  if (fault && fault.kind !== 'status') shapers.push(new FaultStream(fault, res));
-  tapBody(res, shapers);
+  for (const plugin of plugins) {
+    if (await plugin(req, res, { path: checked.decoded ?? null, entry })) return;
+  }
 
   if (req.method === 'OPTIONS') return preflight(req, res);
   if (req.method !== 'GET' && req.method !== 'HEAD') {
@@ -117,7 +109,6 @@ async function handle(server, table, bucket, latencyMs, req, res) {
     return plain(res, 405, 'method not allowed');
   }
   if (!checked.decoded) return plain(res, checked.status, checked.reason);
-  if (fault?.kind === 'status') return answerStatus(res, fault);
 
   const notFound = () => plain(res, 404, 'not found');
   const mount = table.find((m) => checked.rawPath.startsWith(m.prefix) || checked.rawPath + '/' === m.prefix);

@@ -1,21 +1,20 @@
 #!/usr/bin/env node
-// Static server for the viewer and packed datasets (development, demos, small deployments), with
-// a simulated slow link and fault injection for tests. `node server/serve.mjs --help` lists the
-// options; server/README.md explains them and how to deploy on nginx, object stores and CDNs.
-// In code: import { createServer } from './server/serve.mjs' (see app.mjs for the options).
+// Static server for the viewer and packed datasets (development, demos, small deployments).
+// `node server/serve.mjs --help` lists the options; server/README.md explains them and how to
+// deploy on nginx, object stores and CDNs. In code: import { createServer } from
+// './server/serve.mjs' (see app.mjs for the options); main(argv, { plugins }) runs the command
+// line with plugins installed.
 import fs from 'node:fs';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { createServer } from './app.mjs';
-import { parseRate, parseMs } from './link.mjs';
-import { normalizeFaults } from './faults.mjs';
 
 export { createServer };
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const defaultViewer = path.resolve(here, '../build/web');
 
-const HELP = `usage: node server/serve.mjs [options] [DIR]
+export const HELP = `usage: node server/serve.mjs [options] [DIR]
        npm run serve -- [options] [DIR]
 
 Serves DIR (default: the current folder) at /, or the folders given with --mount.
@@ -28,13 +27,6 @@ dataset.
   --mount /PREFIX=DIR   serve DIR under /PREFIX/ (repeatable; the longest prefix wins)
   --viewer DIR          the viewer folder used with a dataset DIR (default build/web)
   --no-viewer           serve a dataset DIR alone, at /
-  --throttle RATE       cap the bandwidth of all responses together, like one shared link:
-                        10mbit, 500kbit, 10Mbps (bits) or 2MB, 1.5mbyte, 64KiB (bytes), per second
-  --latency MS          wait MS milliseconds before the first byte of every response (50, 50ms, 0.2s)
-  --fault JSON          make matching requests fail (repeatable; an object or an array), e.g.
-                        '{"match":"chunks/00003","kind":"status","status":503,"times":2}'
-                        kinds: status, truncate, corrupt, drop, slow; fields: match (substring of
-                        the path) or regexp, status, times, delayMs, afterBytes (server/README.md)
   --max-connections N   sockets open at once (default 512; more are closed at once)
   --log                 print one line per request
   -h, --help            this text
@@ -44,10 +36,10 @@ application/octet-stream with Cache-Control immutable and never compressed; othe
 Cache-Control no-cache and ETag/Last-Modified revalidation; X.br / X.gz next to a .wasm or .js
 (server/precompress.mjs writes them) are sent to clients that accept them.`;
 
-class UsageError extends Error {}
+export class UsageError extends Error {}
 
 export function parseArgs(argv) {
-  const opts = { host: '127.0.0.1', port: 8080, mounts: [], viewer: defaultViewer, faults: [], throttleBytesPerSec: 0, latencyMs: 0, maxConnections: 512, log: false };
+  const opts = { host: '127.0.0.1', port: 8080, mounts: [], viewer: defaultViewer, maxConnections: 512, log: false };
   const positional = [];
   const value = (i, name) => {
     if (i >= argv.length) throw new UsageError(`${name}: missing value`);
@@ -55,9 +47,6 @@ export function parseArgs(argv) {
   };
   for (let i = 0; i < argv.length; i++) {
     const a = argv[i];
-    const wrap = (fn) => {
-      try { return fn(); } catch (e) { throw new UsageError(`${a}: ${e.message}`); }
-    };
     if (a === '--host') opts.host = value(++i, a);
     else if (a === '--port') {
       const v = value(++i, a);
@@ -70,17 +59,7 @@ export function parseArgs(argv) {
       opts.mounts.push({ prefix: v.slice(0, eq), dir: v.slice(eq + 1) });
     } else if (a === '--viewer') opts.viewer = value(++i, a);
     else if (a === '--no-viewer') opts.viewer = null;
-    else if (a === '--throttle') {
-      const v = value(++i, a);
-      opts.throttleBytesPerSec = wrap(() => parseRate(v));
-    } else if (a === '--latency') {
-      const v = value(++i, a);
-      opts.latencyMs = wrap(() => parseMs(v));
-    } else if (a === '--fault') {
-      const v = value(++i, a);
-      const parsed = wrap(() => JSON.parse(v));
-      opts.faults.push(...wrap(() => normalizeFaults(Array.isArray(parsed) ? parsed : [parsed])));
-    } else if (a === '--max-connections') {
+    else if (a === '--max-connections') {
       const v = value(++i, a);
       if (!/^[1-9]\d*$/.test(v)) throw new UsageError(`--max-connections: cannot read "${v}"; write a positive number`);
       opts.maxConnections = Number(v);
@@ -146,15 +125,12 @@ function viewerUrls(base, mounts, limit = 8) {
   return urls;
 }
 
-function formatRate(bytesPerSec) {
-  const mbit = (bytesPerSec * 8) / 1e6;
-  return mbit >= 1 ? `${+mbit.toFixed(2)} Mbit/s` : `${+(mbit * 1000).toFixed(1)} kbit/s`;
-}
-
-function main() {
+// Runs the command line. plugins: installed in the server (see app.mjs); notes: extra lines
+// printed under the mounts (what the plugins do).
+export function main(argv = process.argv.slice(2), { plugins = [], notes = [] } = {}) {
   let opts;
   try {
-    opts = parseArgs(process.argv.slice(2));
+    opts = parseArgs(argv);
   } catch (e) {
     console.error(`serve: ${e.message}`);
     process.exit(e instanceof UsageError ? 2 : 1);
@@ -165,7 +141,8 @@ function main() {
   }
   const server = createServer({
     ...opts,
-    log: opts.log ? (e) => console.log(`${new Date(e.time).toISOString()} ${e.method} ${e.url} ${e.status}${e.fault ? ` (fault: ${e.fault})` : ''}${e.aborted ? ' aborted' : ''} ${e.ms} ms`) : null,
+    plugins,
+    log: opts.log ? (e) => console.log(`${new Date(e.time).toISOString()} ${e.method} ${e.url} ${e.status}${e.note ? ` (${e.note})` : ''}${e.aborted ? ' aborted' : ''} ${e.ms} ms`) : null,
   });
   server.on('error', (e) => {
     console.error(`serve: ${e.code === 'EADDRINUSE' ? `port ${opts.port} on ${opts.host} is in use; try --port 0` : e.message}`);
@@ -180,13 +157,7 @@ function main() {
       console.log(`  ${m.prefix.padEnd(8)} -> ${path.resolve(m.dir)}`);
     }
     for (const n of opts.notes ?? []) console.log(`note: ${n}`);
-    if (opts.throttleBytesPerSec || opts.latencyMs) {
-      const parts = [];
-      if (opts.throttleBytesPerSec) parts.push(`${formatRate(opts.throttleBytesPerSec)} shared by all responses`);
-      if (opts.latencyMs) parts.push(`${opts.latencyMs} ms before each response`);
-      console.log(`simulated link: ${parts.join(', ')}`);
-    }
-    if (opts.faults.length) console.log(`fault injection: ${opts.faults.length} rule(s)`);
+    for (const n of notes) console.log(n);
     const urls = viewerUrls(base, opts.mounts);
     if (urls.length) {
       console.log('\nOpen in a browser (Ctrl-C stops the server):');

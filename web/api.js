@@ -17,6 +17,7 @@ export function stats() {
   const extra = {
     retries: (page.loader ? page.loader.retries : 0) + page.pageRetries,
     chunksRefused: page.loader ? page.loader.refused : 0,
+    requestLog: page.loader ? page.loader.log : [], // what the chunk loader decided (web/loader.js)
     programBytesReceived: page.programBytes,
     programBytesTotal: page.programTotal,
   };

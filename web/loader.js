@@ -32,13 +32,14 @@ export const MAX_IN_FLIGHT_BEFORE_BASE = 2;
 export const MAX_AHEAD = 12;                // chunks fetched past the next one the viewer needs
 export const MAX_AHEAD_BYTES = 64 << 20;    // ... and at most this much held in the page
 export const MAX_DAMAGED = 4;               // a chunk damaged this often in a row is broken at the source
+export const LOG_LIMIT = 2000;              // entries kept in ChunkLoader.log (the newest)
 
 const grouped = (n) => n.toLocaleString('en-US');
 
 // The network's timing of a finished request (Resource Timing; the project's server and the
 // documented nginx config send Timing-Allow-Origin for other origins): time to the first byte
 // and transfer time, which a busy main thread does not stretch as it does callback times.
-function networkTiming(url) {
+export function networkTiming(url) {
   if (typeof performance === 'undefined' || !performance.getEntriesByName || typeof location === 'undefined') return null;
   const entries = performance.getEntriesByName(new URL(url, location.href).href, 'resource');
   const e = entries[entries.length - 1];
@@ -46,14 +47,24 @@ function networkTiming(url) {
   return { firstByteMs: e.responseStart - e.startTime, transferMs: e.responseEnd - e.responseStart };
 }
 
+// What the loader waits on: the page's clock and timers (tests give a fake one).
+const pageClock = {
+  now: () => performance.now(),
+  setTimeout: (fn, ms) => setTimeout(fn, ms),
+  clearTimeout: (id) => clearTimeout(id),
+};
+
 export class ChunkLoader {
   // urls, names (as the manifest gives them, for messages), sizes: per chunk.
   // fail(message): the stream cannot go on (called once, after the chunks before the bad one
   // have been delivered). done(): every allowed chunk delivered, or stopped.
   // check, deliver, allowed: see attach(); given here, the loader is attached from the start.
+  // fetch, clock, timing: the network, the clock and timers, and the network's timing of a
+  // finished request (net.js fetchBytes, the page's clock, Resource Timing unless given).
   constructor({ urls, names = urls, sizes, allowed = urls.length, stallMs = STALL_SECONDS * 1000, check = null,
-    deliver = null, fail, done }) {
+    deliver = null, fail, done, fetch = fetchBytes, clock = pageClock, timing = networkTiming }) {
     Object.assign(this, { urls, names, sizes, allowed, stallMs, check, deliver, failed: fail, done });
+    Object.assign(this, { fetch, clock, timing });
     this.attached = !!check;
     this.warmed = this.attached;   // before: the program is still downloading, only the base
     this.programNearlyIn = false;  // its last bytes are coming: the first split chunk too
@@ -73,6 +84,25 @@ export class ChunkLoader {
     this.paused = false;
     this.stopped = false;
     this.failure = null;           // { index, message }: the first chunk that cannot be had
+    // What the loader decided, in order (the newest LOG_LIMIT entries), for the panel's
+    // diagnostics and for tests, which check decisions instead of timing them:
+    //   { event: 'request', index, reason, cause?, attempt, others, outstanding, lead, attached }
+    //     reason: 'first'; 'retry' (its backoff ran out; cause: what failed); 'online' (the
+    //     browser's online event ended its backoff); 'resume' (dropped by a pause). others: the
+    //     chunks under way then, outstanding: their bytes still to come, lead: see lead().
+    //   { event: 'response', index, bytes }   { event: 'failure', index, cause, transient }
+    //   { event: 'refused', index, cause }    { event: 'backoff', index, delayMs }
+    //   { event: 'online', waiting }          { event: 'pause' }   { event: 'resume' }
+    // Each has `seq`, its place in the whole log.
+    this.log = [];
+    this.logged = 0;
+    this.wokenOnline = new Set();  // waiting chunks the online event sent off
+    this.dropped = new Set();      // chunks a pause dropped while under way
+  }
+
+  note(entry) {
+    this.log.push({ seq: this.logged++, ...entry });
+    if (this.log.length > LOG_LIMIT) this.log.splice(0, this.log.length - LOG_LIMIT);
   }
 
   part(i) {
@@ -120,9 +150,9 @@ export class ChunkLoader {
   // the browser gives it, else callback times (the least time to a first byte seen, as a busy
   // main thread only adds to it).
   measure(i, entry, bytes) {
-    const t = networkTiming(this.urls[i]);
+    const t = this.timing(this.urls[i]);
     const firstByteMs = t ? t.firstByteMs : entry.firstByte - entry.start;
-    const transferMs = t ? t.transferMs : performance.now() - entry.firstByte;
+    const transferMs = t ? t.transferMs : this.clock.now() - entry.firstByte;
     if (entry.firstByte && firstByteMs > 0) this.firstByteMs = t || !this.firstByteMs ? firstByteMs : Math.min(this.firstByteMs, firstByteMs);
     if (transferMs > 0 && bytes >= MIN_LEAD_BYTES) this.rate = bytes / (transferMs / 1000);
   }
@@ -154,25 +184,35 @@ export class ChunkLoader {
       if (this.arrived.has(i) || this.inFlight.has(i) || this.waiting.has(i)) continue;
       if (i > this.next && ahead + this.sizes[i] > MAX_AHEAD_BYTES) break;
       if (this.inFlight.size > 0 && outstanding >= this.lead()) break;
+      this.fetchChunk(i, outstanding);
       ahead += this.sizes[i];
       outstanding += this.sizes[i];
-      this.fetchChunk(i);
     }
   }
 
-  fetchChunk(i) {
-    const entry = { controller: new AbortController(), received: 0, start: performance.now(), firstByte: 0 };
-    this.inFlight.set(i, entry);
+  // outstanding: bytes still to come of the requests under way (for the log).
+  fetchChunk(i, outstanding = 0) {
     const trouble = this.trouble.get(i);
+    let reason = 'first';
+    if (this.dropped.delete(i)) reason = 'resume';
+    else if (this.wokenOnline.delete(i)) reason = 'online';
+    else if (trouble) reason = 'retry';
+    this.note({
+      event: 'request', index: i, reason, ...(trouble ? { cause: causeOf(trouble.last) } : {}),
+      attempt: trouble ? trouble.failures + 1 : 1, others: [...this.inFlight.keys()], outstanding,
+      lead: this.lead(), attached: this.attached,
+    });
+    const entry = { controller: new AbortController(), received: 0, start: this.clock.now(), firstByte: 0 };
+    this.inFlight.set(i, entry);
     if (trouble) this.retries++;
-    fetchBytes(this.urls[i], {
+    this.fetch(this.urls[i], {
       signal: entry.controller.signal,
       stallMs: this.stallMs,
       limit: this.sizes[i],
       // After a failure, past any cache: a proxy or the browser may hold the damaged copy.
       cache: trouble ? 'reload' : 'default',
       onProgress: (n) => {
-        if (!entry.firstByte) entry.firstByte = performance.now();
+        if (!entry.firstByte) entry.firstByte = this.clock.now();
         entry.received += n;
         this.networkBytes += n;
         if (this.inFlight.size < MAX_IN_FLIGHT) this.pump(); // outstanding bytes dropped
@@ -180,6 +220,7 @@ export class ChunkLoader {
     }).then((bytes) => {
       if (this.inFlight.get(i) !== entry) return; // dropped meanwhile (pause, stop)
       this.inFlight.delete(i);
+      this.note({ event: 'response', index: i, bytes: bytes.length });
       this.measure(i, entry, bytes.length);
       if (this.attached) {
         this.accept(i, bytes);
@@ -191,6 +232,7 @@ export class ChunkLoader {
     }, (e) => {
       if (this.inFlight.get(i) === entry) this.inFlight.delete(i);
       if (e.kind === 'aborted' || this.stopped) return;
+      this.note({ event: 'failure', index: i, cause: causeOf(e), transient: !!e.transient });
       if (e.transient) this.retryLater(i, e);
       else this.failAt(i, `Could not download ${this.part(i)} of the dataset (${this.names[i]}): ${e.message}.`);
       this.pump();
@@ -209,6 +251,7 @@ export class ChunkLoader {
     }
     if (damage) {
       this.refused++;
+      this.note({ event: 'refused', index: i, cause: 'damaged' });
       this.retryLater(i, { kind: 'damaged', message: damage, transient: true });
     } else {
       this.trouble.delete(i);
@@ -229,18 +272,21 @@ export class ChunkLoader {
       return;
     }
     const delay = retryDelayMs(t.failures, error.retryAfterMs);
-    const timer = setTimeout(() => {
+    this.note({ event: 'backoff', index: i, delayMs: delay });
+    const timer = this.clock.setTimeout(() => {
       this.waiting.delete(i);
       this.pump();
     }, delay);
-    this.waiting.set(i, { at: performance.now() + delay, timer });
+    this.waiting.set(i, { at: this.clock.now() + delay, timer });
   }
 
   // The link is back (the browser's `online` event): every waiting chunk goes now.
   retryNow() {
+    this.note({ event: 'online', waiting: [...this.waiting.keys()] });
     for (const [i, w] of this.waiting) {
-      clearTimeout(w.timer);
+      this.clock.clearTimeout(w.timer);
       this.waiting.delete(i);
+      this.wokenOnline.add(i);
     }
     this.pump();
   }
@@ -258,7 +304,7 @@ export class ChunkLoader {
     }
     for (const [j, w] of [...this.waiting]) {
       if (j >= i) {
-        clearTimeout(w.timer);
+        this.clock.clearTimeout(w.timer);
         this.waiting.delete(j);
       }
     }
@@ -314,7 +360,7 @@ export class ChunkLoader {
 
   // What the network side is doing, in plain words, or '' when all is well: the earliest chunk
   // that failed and is waiting or being fetched again.
-  notice(now = performance.now()) {
+  notice(now = this.clock.now()) {
     if (this.stopped || this.failure || this.paused || !this.trouble.size) return '';
     const i = Math.min(...this.trouble.keys());
     const { last, failures } = this.trouble.get(i);
@@ -334,10 +380,14 @@ export class ChunkLoader {
   // resume, with their failure counts kept); what arrived completely is kept.
   setPaused(paused) {
     this.paused = paused;
+    this.note({ event: paused ? 'pause' : 'resume' });
     if (paused) {
-      for (const e of this.inFlight.values()) e.controller.abort();
+      for (const [i, e] of this.inFlight) {
+        e.controller.abort();
+        this.dropped.add(i);
+      }
       this.inFlight.clear();
-      for (const w of this.waiting.values()) clearTimeout(w.timer);
+      for (const w of this.waiting.values()) this.clock.clearTimeout(w.timer);
       this.waiting.clear();
     } else {
       this.pump();
@@ -349,10 +399,15 @@ export class ChunkLoader {
     this.stopped = true;
     for (const e of this.inFlight.values()) e.controller.abort();
     this.inFlight.clear();
-    for (const w of this.waiting.values()) clearTimeout(w.timer);
+    for (const w of this.waiting.values()) this.clock.clearTimeout(w.timer);
     this.waiting.clear();
     this.done();
   }
+}
+
+// What failed, for the log: 'http 503', 'network', 'stall', 'damaged'.
+function causeOf(e) {
+  return e.kind === 'http' ? `http ${e.status}` : e.kind;
 }
 
 // "2,345 of 16,384 bytes" / "its content does not match the manifest's hash", for check().

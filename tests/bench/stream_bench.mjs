@@ -19,8 +19,8 @@
 // the window size (default 1280 x 800).
 import fs from 'node:fs';
 import path from 'node:path';
-import { createServer } from '../../server/serve.mjs';
-import { parseRate, parseMs } from '../../server/link.mjs';
+import { createServer } from '../support/server.mjs';
+import { parseRate, parseMs } from '../support/link.mjs';
 import { precompressDir } from '../../server/precompress.mjs';
 import { root, webDir, cli, launchBrowser, checkBuilds, sliceReport } from '../browser/support.mjs';
 

@@ -1,6 +1,7 @@
 // The static server (server/serve.mjs) and the documented nginx config (server/nginx.conf):
 // no way out of the served folders, the headers the viewer and caches rely on, precompressed
-// viewer files, the simulated link and every kind of injected fault.
+// viewer files; and the test tools plugged into it (tests/support/server.mjs): the simulated
+// link and every kind of injected fault.
 import { test, describe, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import crypto from 'node:crypto';
@@ -8,11 +9,12 @@ import fs from 'node:fs';
 import path from 'node:path';
 import zlib from 'node:zlib';
 import { spawn, spawnSync } from 'node:child_process';
-import { createServer } from '../../server/serve.mjs';
-import { parseRate } from '../../server/link.mjs';
+import { createServer } from '../support/server.mjs';
+import { parseRate } from '../support/link.mjs';
 import { precompressDir } from '../../server/precompress.mjs';
 import { startNginx, startPythonHttpServer } from '../support/nginx.mjs';
-import { get, rawGet } from '../support/http.mjs';
+import { get, rawGet, open } from '../support/http.mjs';
+import { FakeClock } from '../support/clock.mjs';
 import { root, tempDir } from './helpers.mjs';
 
 const SECRET = `top-secret-${crypto.randomBytes(8).toString('hex')}`;
@@ -286,33 +288,46 @@ describe('link simulation', () => {
     assert.throws(() => parseRate('0'), /below/);
   });
 
+  // The link waits on a fake clock that jumps to the end of each wait it is asked for: the time
+  // on it when the bodies are in is the link time the throttle scheduled, whatever the speed of
+  // the machine.
   test('--throttle: 1 MiB at 2 MB/s takes at least 0.4 s; two responses share the rate', async () => {
-    const server = await listen({ mounts: [{ prefix: '/', dir: fx.data }], throttleBytesPerSec: 2e6 });
+    const clock = new FakeClock({ auto: true });
+    const server = await listen({ mounts: [{ prefix: '/', dir: fx.data }], throttleBytesPerSec: 2e6, clock });
     try {
       const t = `/ds/chunks/${CHUNK}`;
+      const start = clock.now();
       const one = await get(url(server), t);
       assert.ok(one.body.equals(fx.chunk));
-      assert.ok(one.totalMs >= 400, `1 MiB in ${one.totalMs.toFixed(0)} ms`);
+      const oneMs = clock.now() - start;
+      // 1 MiB at 2 MB/s is 524 ms; the link starts with one piece (16 KB, 8 ms) of credit.
+      assert.ok(oneMs >= 400 && oneMs <= 530, `1 MiB in ${oneMs.toFixed(0)} ms of link time`);
       // One link: two at once take as long as 2 MiB, not as long as 1 MiB.
-      const started = performance.now();
+      const started = clock.now();
       const both = await Promise.all([get(url(server), t), get(url(server), t)]);
-      const ms = performance.now() - started;
+      const ms = clock.now() - started;
       for (const r of both) assert.ok(r.body.equals(fx.chunk));
-      assert.ok(ms >= 900, `2 MiB in ${ms.toFixed(0)} ms`);
+      assert.ok(ms >= 900 && ms <= 1060, `2 MiB in ${ms.toFixed(0)} ms of link time`);
     } finally {
       await close(server);
     }
   });
 
   test('--latency: the first byte waits', async () => {
-    const server = await listen({ mounts: [{ prefix: '/', dir: fx.data }], latencyMs: 200 });
+    const clock = new FakeClock();
+    const server = await listen({ mounts: [{ prefix: '/', dir: fx.data }], latencyMs: 200, clock });
     try {
-      for (const t of ['/ds/manifest.json', '/ds/missing.json']) {
-        const r = await get(url(server), t);
-        assert.ok(r.headersMs >= 190, `${t}: first byte after ${r.headersMs.toFixed(0)} ms`);
+      for (const [t, method] of [['/ds/manifest.json', 'GET'], ['/ds/missing.json', 'GET'], ['/ds/manifest.json', 'HEAD']]) {
+        const r = open(url(server), t, { method });
+        // The response is held on a 200 ms wait (an empty HEAD body too), and nothing has come.
+        await clock.whenWaiting();
+        assert.deepEqual(clock.pending(), [200], `${method} ${t}: waits 200 ms before the first byte`);
+        await new Promise((resolve) => setImmediate(resolve));
+        assert.equal(r.headers, null, `${method} ${t}: nothing sent during the wait`);
+        clock.advance(200);
+        const done = await r.done;
+        assert.ok(done.status === 200 || done.status === 404, `${method} ${t}: ${done.status}`);
       }
-      const head = await get(url(server), '/ds/manifest.json', { method: 'HEAD' });
-      assert.ok(head.headersMs >= 190, 'an empty body waits too');
     } finally {
       await close(server);
     }
@@ -345,13 +360,25 @@ describe('link simulation', () => {
 
   test('the CLI refuses bad options with a clear message', () => {
     const run = (...args) => spawnSync(process.execPath, [path.join(root, 'server/serve.mjs'), ...args], { encoding: 'utf8' });
+    const r = run('--port', 'http');
+    assert.equal(r.status, 2);
+    assert.match(r.stderr, /serve: --port: cannot read "http"/);
+    assert.match(run('/no/such/folder').stderr, /serve: DIR: no such folder/);
+    assert.match(run('--frobnicate').stderr, /unknown option --frobnicate/);
+    assert.match(run('--throttle', '10mbit').stderr, /unknown option --throttle/, 'the link is simulated by test support only');
+    const help = run('--help');
+    assert.equal(help.status, 0);
+    for (const o of ['--mount', '--max-connections']) assert.ok(help.stdout.includes(o), `--help mentions ${o}`);
+  });
+
+  test("the simulated link's command line (tests/support/serve_link.mjs) refuses bad options with a clear message", () => {
+    const run = (...args) => spawnSync(process.execPath, [path.join(root, 'tests/support/serve_link.mjs'), ...args], { encoding: 'utf8' });
     const r = run('--throttle', '10 mbits');
     assert.equal(r.status, 2);
     assert.match(r.stderr, /^serve: --throttle: cannot read "10 mbits"; write e\.g\. 10mbit/);
     assert.match(run('--latency', 'soon').stderr, /serve: --latency: cannot read "soon"/);
     assert.match(run('--fault', '{"kind":"melt","match":"x"}').stderr, /serve: --fault: fault 1: "kind" must be one of/);
     assert.match(run('--port', 'http').stderr, /serve: --port: cannot read "http"/);
-    assert.match(run('/no/such/folder').stderr, /serve: DIR: no such folder/);
     assert.match(run('--frobnicate').stderr, /unknown option --frobnicate/);
     const help = run('--help');
     assert.equal(help.status, 0);
@@ -366,9 +393,10 @@ describe('fault injection', () => {
   let server;
   let base;
   const t = `/ds/chunks/${CHUNK}`;
+  const clock = new FakeClock(); // the waits of 'slow' and 'drop'
   before(async () => {
     fx = makeFixture();
-    server = await listen({ mounts: [{ prefix: '/', dir: fx.data }] });
+    server = await listen({ mounts: [{ prefix: '/', dir: fx.data }], clock });
     base = url(server);
   });
   after(() => close(server));
@@ -437,9 +465,28 @@ describe('fault injection', () => {
 
   test('slow: the headers come, the body waits delayMs', async () => {
     server.setFaults([{ match: CHUNK, kind: 'slow', delayMs: 400, times: 1 }]);
-    const r = await get(base, t);
-    assert.ok(r.body.equals(fx.chunk));
-    assert.ok(r.firstByteMs - r.headersMs >= 380, `body ${(r.firstByteMs - r.headersMs).toFixed(0)} ms after the headers`);
+    const r = open(base, t);
+    await r.response;
+    await clock.whenWaiting();
+    assert.deepEqual(clock.pending(), [400], 'the body waits 400 ms');
+    assert.equal(r.received, 0, 'the headers came, no body yet');
+    clock.advance(400);
+    const done = await r.done;
+    assert.ok(done.body.equals(fx.chunk));
+  });
+
+  test('hold: the headers and afterBytes come, the rest waits for release()', async () => {
+    server.setFaults([{ match: CHUNK, kind: 'hold', afterBytes: 1000, times: 1 }]);
+    const rule = server.faults[0];
+    const r = open(base, t);
+    await rule.whenHeld(1);
+    await r.response;
+    await r.bytes(1000);
+    assert.equal(r.finished, false, 'held');
+    rule.release();
+    const done = await r.done;
+    assert.ok(done.body.equals(fx.chunk));
+    assert.ok((await get(base, t)).body.equals(fx.chunk), 'times: 1');
   });
 
   test('regexp given as a string (the --fault JSON form); drop after a delay', async () => {
@@ -447,9 +494,14 @@ describe('fault injection', () => {
     assert.equal((await get(base, `/ds/chunks/${SMALL}`)).status, 500);
     assert.equal((await get(base, `/ds/chunks/${SMALL}`)).status, 200);
     server.setFaults([{ match: SMALL, kind: 'drop', afterBytes: 10, delayMs: 300, times: 1 }]);
-    const r = await get(base, `/ds/chunks/${SMALL}`);
-    assert.ok(r.error && r.body.length === 10);
-    assert.ok(r.totalMs >= 290, `dropped after ${r.totalMs.toFixed(0)} ms`);
+    const r = open(base, `/ds/chunks/${SMALL}`);
+    await clock.whenWaiting();
+    assert.deepEqual(clock.pending(), [300], 'dropped after a 300 ms wait');
+    await r.bytes(10);
+    assert.equal(r.finished, false, 'the connection is still open during the wait');
+    clock.advance(300);
+    const done = await r.done;
+    assert.ok(done.error && done.body.length === 10);
   });
 
   test('bad fault lists are refused', () => {

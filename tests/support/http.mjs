@@ -55,3 +55,51 @@ export function rawGet(base, target) {
       Buffer.from(` HTTP/1.1\r\nHost: ${hostname}\r\nConnection: close\r\n\r\n`)]));
   });
 }
+
+// A GET (or `method`) whose progress a test can watch: { headers (null until they come), received
+// (body bytes so far), finished, response (Promise of the response), bytes(n) (Promise: resolves
+// once n body bytes are in), done (Promise of what get() returns) }.
+export function open(base, target, { method = 'GET', headers = {} } = {}) {
+  const { hostname, port } = new URL(base);
+  const watch = { headers: null, received: 0, finished: false };
+  const waiters = [];
+  const wake = () => {
+    for (const w of waiters.filter((x) => watch.received >= x.n || watch.finished)) {
+      waiters.splice(waiters.indexOf(w), 1);
+      w.resolve();
+    }
+  };
+  watch.bytes = (n) => new Promise((resolve) => { waiters.push({ n, resolve }); wake(); });
+  let gotResponse;
+  watch.response = new Promise((resolve) => { gotResponse = resolve; });
+  watch.done = new Promise((resolve) => {
+    const req = http.request({ host: hostname, port, path: target, method, headers, agent: false });
+    const end = (result) => {
+      watch.finished = true;
+      wake();
+      resolve(result);
+    };
+    req.on('error', (e) => end({ status: 0, headers: {}, body: Buffer.alloc(0), error: e }));
+    req.on('response', (res) => {
+      watch.headers = res.headers;
+      gotResponse(res);
+      const parts = [];
+      let error = null;
+      res.on('data', (d) => {
+        parts.push(d);
+        watch.received += d.length;
+        wake();
+      });
+      res.on('error', (e) => { error = e; });
+      res.on('close', () => end({
+        status: res.statusCode,
+        headers: res.headers,
+        body: Buffer.concat(parts),
+        complete: res.complete,
+        error: error ?? (res.complete ? null : new Error('connection closed before the body was complete')),
+      }));
+    });
+    req.end();
+  });
+  return watch;
+}

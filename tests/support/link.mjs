@@ -1,9 +1,10 @@
-// Link simulation: a bandwidth cap shared by every response of a server (one token bucket, as a
-// real link is one pipe) and a latency before each response's first byte. Both are Transform
+// Link simulation for tests and benchmarks (server.mjs plugs it into the project's server): a
+// bandwidth cap shared by every response of a server (one token bucket, as a real link is one
+// pipe) and a latency before each response's first byte. Both are Transform
 // streams that the response body flows through (see tap.mjs), so backpressure holds end to end:
 // a throttled response reads its file only as fast as the link lets it out.
 import { Transform } from 'node:stream';
-import { setTimeout as sleep } from 'node:timers/promises';
+import { realClock } from './clock.mjs';
 
 // "10mbit", "500kbit", "2MB", "1.5mbyte", "1.25MB/s", "10Mbps", "64KiB", "1000000" (bytes).
 // Upper-case B or "byte" means bytes, "bit" or "bps" means bits; a bare lower-case "b" ("2mb")
@@ -44,8 +45,9 @@ export function parseMs(text) {
 // so far. Reservations are granted in call order, so concurrent responses share the rate fairly
 // (piece by piece) and the total never exceeds it. Idle time builds at most `burst` bytes of credit.
 export class TokenBucket {
-  constructor(bytesPerSec, { burst } = {}) {
+  constructor(bytesPerSec, { burst, clock = realClock } = {}) {
     this.rate = bytesPerSec;
+    this.clock = clock;
     // Pieces small enough that several responses interleave smoothly, large enough that timers
     // (about 1 ms resolution) do not dominate: 1/50 s of the link, between 1 KB and 16 KB.
     this.piece = Math.max(1024, Math.min(16384, Math.floor(bytesPerSec / 50)));
@@ -54,7 +56,7 @@ export class TokenBucket {
   }
 
   // Reserves n bytes of link time; returns how many ms to wait before sending them.
-  reserve(n, now = performance.now()) {
+  reserve(n, now = this.clock.now()) {
     this.free = Math.max(this.free, now - this.burstMs) + (n / this.rate) * 1000;
     return Math.max(0, this.free - now);
   }
@@ -78,7 +80,7 @@ export class Throttle extends Transform {
     for (let at = 0; at < chunk.length; at += this.bucket.piece) {
       const piece = chunk.subarray(at, at + this.bucket.piece);
       const wait = this.bucket.reserve(piece.length);
-      if (wait >= 1) await sleep(wait, null, { signal: this.abort.signal });
+      if (wait >= 1) await this.bucket.clock.sleep(wait, this.abort.signal);
       this.push(piece);
     }
   }
@@ -91,9 +93,10 @@ export class Throttle extends Transform {
 
 // Holds the first byte (or, for an empty body, the end) for `ms`: one round trip of a real link.
 export class Latency extends Transform {
-  constructor(ms) {
+  constructor(ms, clock = realClock) {
     super();
     this.ms = ms;
+    this.clock = clock;
     this.waited = false;
     this.abort = new AbortController();
   }
@@ -101,7 +104,7 @@ export class Latency extends Transform {
   #wait() {
     if (this.waited) return Promise.resolve();
     this.waited = true;
-    return sleep(this.ms, null, { signal: this.abort.signal });
+    return this.clock.sleep(this.ms, this.abort.signal);
   }
 
   _transform(chunk, _encoding, callback) {

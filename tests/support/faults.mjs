@@ -1,4 +1,5 @@
-// Fault injection for tests: make chosen requests fail the way real networks and servers fail.
+// Fault injection for tests: make chosen requests fail the way real networks and servers fail
+// (server.mjs plugs it into the project's server).
 //
 //   { match, kind, status, times, delayMs, afterBytes }
 //   match       string (a substring of the request path) or RegExp (tested against the path)
@@ -9,16 +10,19 @@
 //               'drop'      send `afterBytes` (default half the body), wait `delayMs` (default 0),
 //                           then destroy the socket: the client sees the connection die mid-body
 //               'slow'      send the headers, then hold the body for `delayMs` (default 2000)
+//               'hold'      send the headers and the first `afterBytes` (default 0) of the body,
+//                           then hold the rest until the test calls rule.release(); rule.held
+//                           counts the responses that got there, rule.whenHeld(n) waits for n
 //   times       how many matching GET requests are affected (default: every one); counts down
 //
 // Only GET requests are affected (not HEAD, not CORS preflights). The first fault whose `match`
 // fits and whose `times` is not used up applies; the list may be changed while the server runs.
 import { Transform } from 'node:stream';
-import { setTimeout as sleep } from 'node:timers/promises';
+import { realClock } from './clock.mjs';
 
-const KINDS = new Set(['status', 'truncate', 'corrupt', 'drop', 'slow']);
+const KINDS = new Set(['status', 'truncate', 'corrupt', 'drop', 'slow', 'hold']);
 
-// Checks a fault list (from code or from --fault JSON) and fills in defaults; throws on mistakes.
+// Checks a fault list (from code or from serve_link.mjs --fault JSON) and fills in defaults; throws on mistakes.
 export function normalizeFaults(list) {
   if (!Array.isArray(list)) throw new Error('faults must be an array');
   return list.map((f, i) => {
@@ -44,8 +48,27 @@ export function normalizeFaults(list) {
       afterBytes: num('afterBytes', (v) => Number.isInteger(v) && v >= 0),
     };
     out.hits = 0; // how many requests this fault has affected
+    if (out.kind === 'hold') addGate(out);
     return out;
   });
+}
+
+// A 'hold' rule's gate: responses wait on `opened` until release(); whenHeld(n) resolves once n
+// responses have reached it, so a test acts on an event, not after a guessed time.
+function addGate(rule) {
+  let open;
+  rule.opened = new Promise((resolve) => { open = resolve; });
+  rule.release = () => open();
+  rule.held = 0;
+  const watchers = [];
+  rule.arrive = () => {
+    rule.held += 1;
+    for (const w of watchers.filter((x) => x.n <= rule.held)) {
+      watchers.splice(watchers.indexOf(w), 1);
+      w.resolve();
+    }
+  };
+  rule.whenHeld = (n = 1) => (rule.held >= n ? Promise.resolve() : new Promise((resolve) => watchers.push({ n, resolve })));
 }
 
 // Finds the fault for a request path and uses up one of its `times`.
@@ -74,10 +97,11 @@ export function answerStatus(res, fault) {
 // The body-changing faults, as the last stream before the socket (see tap.mjs). The declared
 // length is read from the response when the first byte arrives, so it works for 200 and 206.
 export class FaultStream extends Transform {
-  constructor(fault, res) {
+  constructor(fault, res, clock = realClock) {
     super();
     this.fault = fault;
     this.res = res;
+    this.clock = clock;
     this.offset = 0; // body bytes seen so far
     this.total = null;
     this.stopped = false;
@@ -100,15 +124,24 @@ export class FaultStream extends Transform {
       return callback();
     }
     if (kind === 'corrupt') return callback(null, this.#flip(chunk, begin));
+    if (kind === 'hold' && !this.released) {
+      const keep = Math.max(0, Math.min(chunk.length, this.limit - begin));
+      if (keep > 0) this.push(chunk.subarray(0, keep));
+      if (begin + chunk.length < this.limit) return callback();
+      return this.#hold().then(() => callback(null, keep < chunk.length ? chunk.subarray(keep) : undefined), () => callback());
+    }
     if (kind === 'slow' && begin === 0) {
       this.res.flushHeaders();
-      return sleep(this.fault.delayMs ?? 2000, null, { signal: this.abort.signal })
+      return this.clock.sleep(this.fault.delayMs ?? 2000, this.abort.signal)
         .then(() => callback(null, chunk), () => callback());
     }
     callback(null, chunk);
   }
 
   _flush(callback) {
+    if (this.fault.kind === 'hold' && !this.released) {
+      return this.#hold().then(() => callback(), () => callback());
+    }
     // A dropped response never ends cleanly: the socket dies instead (an empty body drops too).
     if (this.fault.kind === 'drop') {
       if (!this.stopped) {
@@ -129,6 +162,8 @@ export class FaultStream extends Transform {
       if (!this.res.headersSent) this.res.setHeader('Content-Length', half);
     } else if (this.fault.kind === 'drop') {
       this.limit = this.fault.afterBytes ?? half;
+    } else if (this.fault.kind === 'hold') {
+      this.limit = this.fault.afterBytes ?? 0;
     }
     this.mid = Number.isFinite(this.total) ? Math.floor(this.total / 2) : 0;
   }
@@ -141,13 +176,25 @@ export class FaultStream extends Transform {
     return out;
   }
 
+  // Sends the headers (and what was pushed), tells the rule, waits for its release.
+  async #hold() {
+    if (this.total === null) this.#start();
+    this.res.flushHeaders();
+    this.fault.arrive();
+    await new Promise((resolve, reject) => {
+      this.abort.signal.addEventListener('abort', reject, { once: true });
+      this.fault.opened.then(resolve);
+    });
+    this.released = true;
+  }
+
   // Lets what was sent reach the kernel, waits delayMs, then kills the connection.
   async #drop() {
     try {
       await new Promise((resolve) => setImmediate(resolve));
       const socket = this.res.socket;
       if (socket && socket.writableLength > 0) await new Promise((resolve) => socket.once('drain', resolve));
-      if (this.fault.delayMs) await sleep(this.fault.delayMs, null, { signal: this.abort.signal });
+      if (this.fault.delayMs) await this.clock.sleep(this.fault.delayMs, this.abort.signal);
       this.res.dropped = true;
       (this.res.socket ?? socket)?.destroy();
     } catch { /* the client left first */ }

@@ -1,0 +1,221 @@
+// The chunk loader (web/loader.js) on a network and a clock the test drives: what it decides
+// (which request goes when, and why) read from its log, never timed. The browser tests
+// (tests/browser/network.test.mjs) run the same loader against real servers.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { ChunkLoader, LOG_LIMIT } from '../../web/loader.js';
+import { FetchError } from '../../web/net.js';
+
+globalThis.navigator ??= { onLine: true }; // notice() reads it
+
+// Timers that fire only when the test moves the time on.
+class FakeTimers {
+  constructor() {
+    this.time = 1000; // a page's clock is never at 0
+    this.timers = new Map();
+    this.ids = 0;
+  }
+  now() { return this.time; }
+  setTimeout(fn, ms) {
+    this.timers.set(++this.ids, { end: this.time + ms, fn });
+    return this.ids;
+  }
+  clearTimeout(id) { this.timers.delete(id); }
+  advance(ms) {
+    this.time += ms;
+    for (const [id, t] of [...this.timers].sort((a, b) => a[1].end - b[1].end)) {
+      if (t.end > this.time) continue;
+      this.timers.delete(id);
+      t.fn();
+    }
+  }
+}
+
+// Requests stay open until the test answers them: send(r, n) passes n more bytes, finish(r)
+// completes the body, fail(r, error) breaks it.
+class FakeNetwork {
+  constructor() {
+    this.requests = [];
+    this.fetch = (url, opts) => new Promise((resolve, reject) => {
+      const r = { url, index: Number(/(\d+)$/.exec(url)[1]), opts, received: 0, open: true, resolve, reject };
+      this.requests.push(r);
+      opts.signal.addEventListener('abort', () => {
+        r.open = false;
+        reject(new FetchError('cancelled', { kind: 'aborted' }));
+      });
+    });
+  }
+  open() { return this.requests.filter((r) => r.open); }
+  send(r, n) {
+    r.received += n;
+    r.opts.onProgress(n);
+  }
+  finish(r) {
+    r.open = false;
+    r.resolve(new Uint8Array(r.received));
+  }
+  fail(r, error) {
+    r.open = false;
+    r.reject(error);
+  }
+}
+
+const settle = () => new Promise((resolve) => setImmediate(resolve));
+
+function makeLoader({ chunks = 8, size = 64 << 10, timing, ...rest } = {}) {
+  const clock = new FakeTimers();
+  const net = new FakeNetwork();
+  const delivered = [];
+  const result = { failed: null, done: false };
+  const loader = new ChunkLoader({
+    urls: Array.from({ length: chunks }, (_, i) => `chunk-${i}`),
+    sizes: new Array(chunks).fill(size),
+    check: () => null,
+    deliver: (i) => delivered.push(i) > 0,
+    fail: (message) => { result.failed = message; },
+    done: () => { result.done = true; },
+    fetch: net.fetch,
+    clock,
+    timing: timing ?? (() => null),
+    ...rest,
+  });
+  return { loader, net, clock, delivered, result, size };
+}
+
+// A link that sends one response at a time, in request order, `piece` bytes a step: what a
+// slow link does with responses that do not overlap.
+async function runLink({ loader, net, size, result }, piece = 4096) {
+  loader.pump();
+  for (let steps = 0; !result.done && steps < 10000; steps++) {
+    await settle();
+    const r = net.open()[0];
+    if (!r) continue;
+    net.send(r, Math.min(piece, size - r.received));
+    if (r.received === size) net.finish(r);
+  }
+  assert.ok(result.done, 'the stream ended');
+}
+
+const requests = (loader) => loader.log.filter((e) => e.event === 'request');
+
+test('over a slow link the chunks are requested one after another, not as a batch', async () => {
+  // 150 KB/s, 30 ms to the first byte (as Resource Timing would report them).
+  const link = { firstByteMs: 30, transferMs: (64 << 10) / 150 };
+  const run = makeLoader({ timing: () => link });
+  await runLink(run);
+  assert.deepEqual(run.delivered, [0, 1, 2, 3, 4, 5, 6, 7]);
+  assert.equal(run.result.failed, null);
+  // Once a response has been measured, the lead is what the link delivers while a request waits
+  // for its first byte, with the margin: 150 KB/s × 30 ms × 1.25.
+  const firstResponse = run.loader.log.find((e) => e.event === 'response').seq;
+  const later = requests(run.loader).filter((e) => e.seq > firstResponse);
+  assert.ok(later.length >= 3, `requests after the first response: ${later.length}`);
+  for (const e of later) {
+    assert.ok(Math.abs(e.lead - 150e3 * 0.030 * 1.25) < 1e-6, `lead of ${JSON.stringify(e)}`);
+    assert.ok(e.others.length <= 1, `at most the one before it under way: ${JSON.stringify(e)}`);
+    assert.ok(e.outstanding < e.lead, `issued near the end of the one before: ${JSON.stringify(e)}`);
+    assert.equal(e.reason, 'first');
+  }
+});
+
+test('over a fast link several requests are under way together (the lead covers the round trip)', async () => {
+  // 10 MB/s, 30 ms to the first byte: 375 KB arrive while a request waits.
+  const link = { firstByteMs: 30, transferMs: (64 << 10) / 10000 };
+  const run = makeLoader({ chunks: 16, timing: () => link });
+  await runLink(run);
+  const firstResponse = run.loader.log.find((e) => e.event === 'response').seq;
+  const later = requests(run.loader).filter((e) => e.seq > firstResponse);
+  assert.ok(later.some((e) => e.others.length >= 2), `batched: ${JSON.stringify(later.map((e) => e.others.length))}`);
+  for (const e of later) assert.ok(e.others.length === 0 || e.outstanding < e.lead, JSON.stringify(e));
+});
+
+test('a 503 is fetched again when its backoff has run out, not before', async () => {
+  const run = makeLoader({ chunks: 2 });
+  run.loader.pump();
+  await settle();
+  const first = run.net.open().find((r) => r.index === 0);
+  run.net.fail(first, new FetchError('HTTP 503 (Service Unavailable)', { kind: 'http', status: 503, transient: true }));
+  await settle();
+  const backoff = run.loader.log.findLast((e) => e.event === 'backoff' && e.index === 0);
+  assert.ok(backoff.delayMs >= 500 && backoff.delayMs <= 1000, `first backoff: ${backoff.delayMs} ms`);
+  assert.match(run.loader.notice(), /^The server answered HTTP 503 \(Service Unavailable\): retrying part 1 of 2 in (1 s|a moment)\.$/);
+  run.clock.advance(backoff.delayMs - 1);
+  assert.equal(run.net.open().filter((r) => r.index === 0).length, 0, 'still waiting 1 ms before its end');
+  run.clock.advance(1);
+  const again = requests(run.loader).at(-1);
+  assert.deepEqual([again.index, again.reason, again.cause, again.attempt], [0, 'retry', 'http 503', 2]);
+  assert.equal(run.loader.retries, 1);
+  // The second failure waits longer: 1 to 2 s.
+  run.net.fail(run.net.open().find((r) => r.index === 0), new FetchError('HTTP 503', { kind: 'http', status: 503, transient: true }));
+  await settle();
+  const second = run.loader.log.findLast((e) => e.event === 'backoff' && e.index === 0);
+  assert.ok(second.seq > backoff.seq && second.delayMs >= 1000 && second.delayMs <= 2000, `second backoff: ${second.delayMs} ms`);
+  run.loader.stop();
+});
+
+test('a stalled or dropped request is fetched again, with its cause in the log', async () => {
+  const run = makeLoader({ chunks: 1 });
+  run.loader.pump();
+  await settle();
+  run.net.fail(run.net.open()[0], new FetchError('no data for 10 s', { kind: 'stall', transient: true }));
+  await settle();
+  run.clock.advance(1000);
+  run.net.fail(run.net.open()[0], new FetchError('connection lost', { kind: 'network', transient: true }));
+  await settle();
+  run.clock.advance(2000);
+  const r = run.net.open()[0];
+  run.net.send(r, run.size);
+  run.net.finish(r);
+  await settle();
+  assert.ok(run.result.done);
+  assert.deepEqual(requests(run.loader).map((e) => [e.reason, e.cause]),
+    [['first', undefined], ['retry', 'stall'], ['retry', 'network']]);
+  assert.deepEqual(run.loader.log.filter((e) => e.event === 'failure').map((e) => e.cause), ['stall', 'network']);
+});
+
+test('the online event sends every waiting chunk at once, ending its backoff', async () => {
+  const run = makeLoader({ chunks: 3 });
+  run.loader.pump();
+  await settle();
+  for (const r of run.net.open()) run.net.fail(r, new FetchError('connection lost', { kind: 'network', transient: true }));
+  await settle();
+  assert.equal(run.net.open().length, 0, 'all waiting on their backoff');
+  const waiting = [...run.loader.waiting.keys()];
+  assert.ok(waiting.length >= 1);
+  run.loader.retryNow(); // the clock has not moved
+  const online = run.loader.log.find((e) => e.event === 'online');
+  assert.deepEqual(online.waiting, waiting);
+  const after = requests(run.loader).filter((e) => e.seq > online.seq);
+  assert.deepEqual(after.map((e) => e.index), waiting);
+  for (const e of after) assert.deepEqual([e.reason, e.cause], ['online', 'network']);
+  assert.equal(run.loader.waiting.size, 0);
+  run.clock.advance(60000); // the cancelled backoffs send nothing more
+  assert.equal(requests(run.loader).length, waiting.length * 2);
+  run.loader.stop();
+});
+
+test('a pause drops the requests under way and sends none until resumed', async () => {
+  const run = makeLoader({ chunks: 4 });
+  run.loader.pump();
+  await settle();
+  const underWay = run.net.open().map((r) => r.index);
+  assert.ok(underWay.length >= 1);
+  run.loader.setPaused(true);
+  await settle();
+  assert.equal(run.net.open().length, 0, 'dropped');
+  run.clock.advance(60000);
+  await settle();
+  const pause = run.loader.log.find((e) => e.event === 'pause');
+  assert.deepEqual(run.loader.log.filter((e) => e.seq > pause.seq).map((e) => e.event), [], 'nothing while paused');
+  run.loader.setPaused(false);
+  const resumed = requests(run.loader).filter((e) => e.seq > pause.seq);
+  assert.deepEqual(resumed.map((e) => [e.index, e.reason]), underWay.map((i) => [i, 'resume']));
+  run.loader.stop();
+});
+
+test('the log keeps the newest entries only', () => {
+  const run = makeLoader({ chunks: 1 });
+  for (let k = 0; k < LOG_LIMIT + 10; k++) run.loader.note({ event: 'pause' });
+  assert.equal(run.loader.log.length, LOG_LIMIT);
+  assert.equal(run.loader.log[0].seq, 10);
+});
