@@ -19,7 +19,9 @@ namespace {
 void sortedFace(std::span<const uint32_t> tets, size_t h, uint32_t s[3]) {
   const uint32_t* v = &tets[h & ~size_t(3)];
   const uint8_t* f = kTetFaces[h & 3];
-  s[0] = v[f[0]]; s[1] = v[f[1]]; s[2] = v[f[2]];
+  s[0] = v[f[0]];
+  s[1] = v[f[1]];
+  s[2] = v[f[2]];
   if (s[0] > s[1]) std::swap(s[0], s[1]);
   if (s[1] > s[2]) std::swap(s[1], s[2]);
   if (s[0] > s[1]) std::swap(s[0], s[1]);
@@ -37,7 +39,10 @@ uint64_t pairFaces(std::span<const uint32_t> tets, uint32_t lo, uint32_t hi, std
     if (s[0] >= lo && s[0] < hi) ++start[s[0] - lo + 1];
   }
   for (size_t v = 0; v < hi - lo; ++v) start[v + 1] += start[v];
-  struct Entry { uint64_t key; uint32_t halfFace; };
+  struct Entry {
+    uint64_t key;
+    uint32_t halfFace;
+  };
   std::vector<Entry> entries(start.back());
   std::vector<uint32_t> fill(start.begin(), start.end() - 1);
   for (size_t h = 0; h < halfFaces; ++h) {
@@ -49,7 +54,9 @@ uint64_t pairFaces(std::span<const uint32_t> tets, uint32_t lo, uint32_t hi, std
   for (size_t v = 0; v < hi - lo; ++v) {
     Entry* b = entries.data() + start[v];
     Entry* e = entries.data() + start[v + 1];
-    std::sort(b, e, [](const Entry& x, const Entry& y) { return x.key < y.key || (x.key == y.key && x.halfFace < y.halfFace); });
+    std::sort(b, e, [](const Entry& x, const Entry& y) {
+      return x.key < y.key || (x.key == y.key && x.halfFace < y.halfFace);
+    });
     for (Entry* run = b; run < e;) {
       Entry* end = run + 1;
       while (end < e && end->key == run->key) ++end;

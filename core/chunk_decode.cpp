@@ -1,17 +1,18 @@
-#include "chunk.h"
+#include <zstd.h>
 
 #include <bit>
 #include <cmath>
 #include <cstring>
 
-#include <zstd.h>
-
+#include "chunk.h"
 #include "hash.h"
 
 namespace tetstream {
 namespace {
 
-uint32_t readU32(const uint8_t* p) { return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24; }
+uint32_t readU32(const uint8_t* p) {
+  return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
+}
 uint16_t readU16(const uint8_t* p) { return uint16_t(p[0] | p[1] << 8); }
 
 // Copies n little-endian 32-bit words; memcpy is correct on the little-endian targets we build
@@ -40,12 +41,14 @@ Result openChunk(ChunkDecoder& dec, const ChunkInfo& info, uint32_t index, std::
   unsigned long long declared = ZSTD_getFrameContentSize(file.data(), file.size());
   if (declared == ZSTD_CONTENTSIZE_ERROR) return fail(Status::DecompressFailed, name + ": not a zstd frame");
   if (declared != info.rawBytes)
-    return fail(Status::SizeMismatch, name + ": zstd frame declares " +
-                                          (declared == ZSTD_CONTENTSIZE_UNKNOWN ? std::string("no size") : std::to_string(declared)) +
-                                          ", manifest says " + std::to_string(info.rawBytes) + " bytes");
+    return fail(Status::SizeMismatch,
+                name + ": zstd frame declares " +
+                    (declared == ZSTD_CONTENTSIZE_UNKNOWN ? std::string("no size") : std::to_string(declared)) +
+                    ", manifest says " + std::to_string(info.rawBytes) + " bytes");
   // The manifest parser enforces this too; checked again here because it guards an allocation.
   if (info.rawBytes > maxRawBytesFor(info.bytes))
-    return fail(Status::TooLarge, name + ": declares " + std::to_string(info.rawBytes) + " bytes after decompression, more than " +
+    return fail(Status::TooLarge, name + ": declares " + std::to_string(info.rawBytes) +
+                                      " bytes after decompression, more than " +
                                       std::to_string(maxRawBytesFor(info.bytes)) + " allowed for its size");
   if (!dec.dctx) dec.dctx = ZSTD_createDCtx();
   if (!dec.dctx) return fail(Status::TooLarge, name + ": out of memory for the zstd context");
@@ -65,7 +68,8 @@ Result openChunk(ChunkDecoder& dec, const ChunkInfo& info, uint32_t index, std::
   if (kind != uint16_t(info.kind))
     return fail(Status::Corrupt, name + ": chunk kind " + std::to_string(kind) + " where the manifest expects " +
                                      std::to_string(int(info.kind)));
-  if (readU32(h + 8) != index) return fail(Status::Corrupt, name + ": header says it is chunk " + std::to_string(readU32(h + 8)));
+  if (readU32(h + 8) != index)
+    return fail(Status::Corrupt, name + ": header says it is chunk " + std::to_string(readU32(h + 8)));
   payload = std::span<const uint8_t>(dec.raw).subspan(kChunkHeaderBytes);
   return Result::success();
 }
@@ -78,7 +82,8 @@ Result decodeBaseMesh(std::span<const uint8_t> payload, const Manifest& m, TetMe
   const ChunkInfo& c = m.chunks.at(0);
   if (V != c.vertices || T != c.tets)
     return fail(Status::Corrupt, "base chunk: " + std::to_string(V) + " vertices / " + std::to_string(T) +
-                                     " tets, manifest says " + std::to_string(c.vertices) + " / " + std::to_string(c.tets));
+                                     " tets, manifest says " + std::to_string(c.vertices) + " / " +
+                                     std::to_string(c.tets));
   if (F != m.fields.size()) return fail(Status::Corrupt, "base chunk: field count differs from the manifest");
   if (flags != 0) return fail(Status::Unsupported, "base chunk: unknown flags " + std::to_string(flags));
   const uint64_t expected = kBaseHeaderBytes + 12 * V + 4 * F * V + 16 * T;
@@ -103,8 +108,8 @@ Result decodeBaseMesh(std::span<const uint8_t> payload, const Manifest& m, TetMe
     const uint32_t* v = &mesh.tets[4 * t];
     for (int k = 0; k < 4; ++k)
       if (v[k] >= V)
-        return fail(Status::OutOfRange, "base chunk: tet " + std::to_string(t) + " uses vertex " + std::to_string(v[k]) +
-                                            " of " + std::to_string(V));
+        return fail(Status::OutOfRange, "base chunk: tet " + std::to_string(t) + " uses vertex " +
+                                            std::to_string(v[k]) + " of " + std::to_string(V));
     if (v[0] == v[1] || v[0] == v[2] || v[0] == v[3] || v[1] == v[2] || v[1] == v[3] || v[2] == v[3])
       return fail(Status::Corrupt, "base chunk: tet " + std::to_string(t) + " repeats a vertex");
   }

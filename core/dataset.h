@@ -26,15 +26,16 @@ namespace tetstream {
 struct Dataset {
   Manifest manifest;
   Quantizer quant;
-  ProgressiveMesh pm;              // the current level (empty until the base is received)
+  ProgressiveMesh pm;  // the current level (empty until the base is received)
   ChunkDecoder decoder;
-  uint32_t chunksReceived = 0;     // verified chunks, base included
-  uint64_t bytesReceived = 0;      // compressed bytes of the verified chunks
+  uint32_t chunksReceived = 0;                 // verified chunks, base included
+  uint64_t bytesReceived = 0;                  // compressed bytes of the verified chunks
   std::vector<std::vector<uint8_t>> payloads;  // per received chunk: split records (empty for the base)
   std::vector<uint32_t> chunkFirstSplit;       // per received chunk, plus one past the last
-  std::vector<uint32_t> recordStart;           // per split decoded so far, plus the next: where its record starts in each column (SplitReader::tell)
-  uint32_t splitsDecoded = 0;                  // splits read at least once (the frontier)
-  SplitReader reader;                          // scratch
+  std::vector<uint32_t> recordStart;  // per split decoded so far, plus the next: where its record starts in each column
+                                      // (SplitReader::tell)
+  uint32_t splitsDecoded = 0;         // splits read at least once (the frontier)
+  SplitReader reader;                 // scratch
 
   uint32_t splitsReceived() const { return chunkFirstSplit.empty() ? 0 : chunkFirstSplit.back(); }
   uint32_t splitsApplied() const { return pm.splitsApplied(); }

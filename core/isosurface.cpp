@@ -35,8 +35,8 @@ struct Extraction {
     unsigned mask = (s[0] > iso) | (s[1] > iso) << 1 | (s[2] > iso) << 2 | (s[3] > iso) << 3;
     const MarchingCase& mc = kMarchingTets[mask];
     if (mc.triangleCount == 0) return;
-    bool flip = tetVolume(pos + 3 * size_t(v[0]), pos + 3 * size_t(v[1]), pos + 3 * size_t(v[2]),
-                          pos + 3 * size_t(v[3])) < 0;
+    bool flip =
+        tetVolume(pos + 3 * size_t(v[0]), pos + 3 * size_t(v[1]), pos + 3 * size_t(v[2]), pos + 3 * size_t(v[3])) < 0;
     for (int t = 0; t < mc.triangleCount; ++t) {
       uint32_t tri[3];
       for (int k = 0; k < 3; ++k) {
@@ -74,8 +74,8 @@ void computeVertexNormals(IsoSurface& s) {
 
 }  // namespace
 
-void extractIsosurface(const TetMesh& mesh, std::span<const float> field, float isovalue,
-                       IsoExtractor& scratch, IsoSurface& out, std::span<const uint32_t> tetSubset) {
+void extractIsosurface(const TetMesh& mesh, std::span<const float> field, float isovalue, IsoExtractor& scratch,
+                       IsoSurface& out, std::span<const uint32_t> tetSubset) {
   assert(field.size() == mesh.vertexCount());
   out.clear();
   scratch.vertexOfEdge.clear();
@@ -97,7 +97,10 @@ double surfaceArea(const IsoSurface& s) {
     const float* b = p + 3 * size_t(s.indices[i + 1]);
     const float* c = p + 3 * size_t(s.indices[i + 2]);
     double u[3], v[3];
-    for (int k = 0; k < 3; ++k) { u[k] = double(b[k]) - a[k]; v[k] = double(c[k]) - a[k]; }
+    for (int k = 0; k < 3; ++k) {
+      u[k] = double(b[k]) - a[k];
+      v[k] = double(c[k]) - a[k];
+    }
     double cx = u[1] * v[2] - u[2] * v[1], cy = u[2] * v[0] - u[0] * v[2], cz = u[0] * v[1] - u[1] * v[0];
     area += 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz);
   }

@@ -17,13 +17,17 @@
 namespace tetstream {
 
 struct IsoSurface {
-  std::vector<float> positions;  // 3 per surface vertex
-  std::vector<float> normals;    // 3 per surface vertex, unit length (0 for isolated points)
-  std::vector<uint32_t> indices; // 3 per triangle
+  std::vector<float> positions;   // 3 per surface vertex
+  std::vector<float> normals;     // 3 per surface vertex, unit length (0 for isolated points)
+  std::vector<uint32_t> indices;  // 3 per triangle
 
   uint32_t vertexCount() const { return uint32_t(positions.size() / 3); }
   uint32_t triangleCount() const { return uint32_t(indices.size() / 3); }
-  void clear() { positions.clear(); normals.clear(); indices.clear(); }
+  void clear() {
+    positions.clear();
+    normals.clear();
+    indices.clear();
+  }
 };
 
 // The surface vertex on mesh edge (a, b), one end above λ and one at or below. Both extractors
@@ -64,9 +68,8 @@ struct IsoExtractor {
 // Extracts the isosurface field == isovalue from all tetrahedra of `mesh`, or only from those
 // listed in `tetSubset` when it is non-empty. `field` has one value per mesh vertex.
 // Preconditions (asserted): field.size() == mesh.vertexCount(), every tet index is in range.
-void extractIsosurface(const TetMesh& mesh, std::span<const float> field, float isovalue,
-                       IsoExtractor& scratch, IsoSurface& out,
-                       std::span<const uint32_t> tetSubset = {});
+void extractIsosurface(const TetMesh& mesh, std::span<const float> field, float isovalue, IsoExtractor& scratch,
+                       IsoSurface& out, std::span<const uint32_t> tetSubset = {});
 
 // Sum of triangle areas, in double.
 double surfaceArea(const IsoSurface& s);

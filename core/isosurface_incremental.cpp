@@ -476,8 +476,8 @@ void IncrementalIsosurface::toIsoSurface(IsoSurface& out) const {
 size_t IncrementalIsosurface::memoryBytes() const {
   auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   return tree_.memoryBytes() + map_.memoryBytes() + bytes(tetRecord_) + bytes(records_) + bytes(freeRecords_) +
-         bytes(indices_) + bytes(triangleOwner_) + bytes(triangleChanged_) + bytes(positions_) + bytes(normals_) + bytes(colours_) +
-         bytes(vertices_) + bytes(freeVertices_) + bytes(touched_) + bytes(changedVertices_) +
+         bytes(indices_) + bytes(triangleOwner_) + bytes(triangleChanged_) + bytes(positions_) + bytes(normals_) +
+         bytes(colours_) + bytes(vertices_) + bytes(freeVertices_) + bytes(touched_) + bytes(changedVertices_) +
          bytes(changedTriangles_) + bytes(cutTets_) + bytes(cutBits_);
 }
 

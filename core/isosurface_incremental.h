@@ -62,14 +62,13 @@ class IncrementalIsosurface {
   // there is none yet (first call, after reset()) or its tet count differs from the mesh's,
   // otherwise only queries it. Precondition (asserted): field.size() == mesh.vertexCount().
   // `colour` (empty, or one value per mesh vertex) is interpolated at each surface vertex.
-  void rebuild(const TetMesh& mesh, std::span<const float> field, float isovalue,
-               std::span<const float> colour = {});
+  void rebuild(const TetMesh& mesh, std::span<const float> field, float isovalue, std::span<const float> colour = {});
 
   // Recomputes the triangles of the listed tets (T_new and T_moved of a split or its undo, and
-  // every tet around p_j when the split changes p_j's value; see the contract above), updates the interval tree for them, releases unused surface vertices and
-  // renormalises the touched vertices' normals. No allocation once the arrays are warm.
-  // Precondition (asserted): rebuild() was called since the last reset().
-  // `colour` as for rebuild() (the same field every time, or recolour() after switching).
+  // every tet around p_j when the split changes p_j's value; see the contract above), updates the interval tree for
+  // them, releases unused surface vertices and renormalises the touched vertices' normals. No allocation once the
+  // arrays are warm. Precondition (asserted): rebuild() was called since the last reset(). `colour` as for rebuild()
+  // (the same field every time, or recolour() after switching).
   void updateTets(const TetMesh& mesh, std::span<const float> field, std::span<const uint32_t> changedTets,
                   std::span<const float> colour = {});
 
@@ -148,7 +147,7 @@ class IncrementalIsosurface {
   bool treeBuilt_ = false;  // rebuild() has run since reset()
   bool deferred_ = false;   // see setTreeDeferred
   uint32_t coverage_ = 0;   // the tree holds tets [0, coverage_)
-  bool bulk_ = false;  // inside rebuild(): no per-slot change tracking
+  bool bulk_ = false;       // inside rebuild(): no per-slot change tracking
   IntervalTree tree_;
   FlatMap map_;
 

@@ -1,7 +1,6 @@
 #include "manifest.h"
 
 #include <cmath>
-
 #include <nlohmann/json.hpp>
 
 #include "hash.h"
@@ -25,14 +24,20 @@ bool nestingWithin(std::string_view s, int limit) {
   bool inString = false, escaped = false;
   for (char c : s) {
     if (inString) {
-      if (escaped) escaped = false;
-      else if (c == '\\') escaped = true;
-      else if (c == '"') inString = false;
+      if (escaped)
+        escaped = false;
+      else if (c == '\\')
+        escaped = true;
+      else if (c == '"')
+        inString = false;
       continue;
     }
-    if (c == '"') inString = true;
-    else if (c == '{' || c == '[') { if (++depth > limit) return false; }
-    else if (c == '}' || c == ']') --depth;
+    if (c == '"')
+      inString = true;
+    else if (c == '{' || c == '[') {
+      if (++depth > limit) return false;
+    } else if (c == '}' || c == ']')
+      --depth;
   }
   return true;
 }
@@ -45,23 +50,33 @@ struct Reader {
   const json* member(const json& obj, const char* key, const std::string& path) {
     if (!error.empty()) return nullptr;
     auto it = obj.find(key);
-    if (it == obj.end()) { error = "missing key '" + path + key + "'"; return nullptr; }
+    if (it == obj.end()) {
+      error = "missing key '" + path + key + "'";
+      return nullptr;
+    }
     return &*it;
   }
   bool string(const json& obj, const char* key, const std::string& path, std::string& out) {
     const json* v = member(obj, key, path);
     if (!v) return false;
-    if (!v->is_string()) { error = "'" + path + key + "' must be a string"; return false; }
+    if (!v->is_string()) {
+      error = "'" + path + key + "' must be a string";
+      return false;
+    }
     out = v->get_ref<const std::string&>();
     return true;
   }
   bool integer(const json& obj, const char* key, const std::string& path, uint64_t lo, uint64_t hi, uint64_t& out) {
     const json* v = member(obj, key, path);
     if (!v) return false;
-    if (!v->is_number_unsigned()) { error = "'" + path + key + "' must be a non-negative integer"; return false; }
+    if (!v->is_number_unsigned()) {
+      error = "'" + path + key + "' must be a non-negative integer";
+      return false;
+    }
     out = v->get<uint64_t>();
     if (out < lo || out > hi) {
-      error = "'" + path + key + "' = " + std::to_string(out) + " is outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+      error = "'" + path + key + "' = " + std::to_string(out) + " is outside [" + std::to_string(lo) + ", " +
+              std::to_string(hi) + "]";
       return false;
     }
     return true;
@@ -69,18 +84,30 @@ struct Reader {
   bool number(const json& obj, const char* key, const std::string& path, double& out) {
     const json* v = member(obj, key, path);
     if (!v) return false;
-    if (!v->is_number()) { error = "'" + path + key + "' must be a number"; return false; }
+    if (!v->is_number()) {
+      error = "'" + path + key + "' must be a number";
+      return false;
+    }
     out = v->get<double>();
-    if (!std::isfinite(out)) { error = "'" + path + key + "' must be finite"; return false; }
+    if (!std::isfinite(out)) {
+      error = "'" + path + key + "' must be finite";
+      return false;
+    }
     return true;
   }
   bool vec3(const json& obj, const char* key, const std::string& path, float out[3]) {
     const json* v = member(obj, key, path);
     if (!v) return false;
-    if (!v->is_array() || v->size() != 3) { error = "'" + path + key + "' must be an array of 3 numbers"; return false; }
+    if (!v->is_array() || v->size() != 3) {
+      error = "'" + path + key + "' must be an array of 3 numbers";
+      return false;
+    }
     for (int k = 0; k < 3; ++k) {
       const json& x = (*v)[size_t(k)];
-      if (!x.is_number() || !std::isfinite(x.get<double>())) { error = "'" + path + key + "' must hold finite numbers"; return false; }
+      if (!x.is_number() || !std::isfinite(x.get<double>())) {
+        error = "'" + path + key + "' must hold finite numbers";
+        return false;
+      }
       out[k] = float(x.get<double>());
     }
     return true;
@@ -214,7 +241,8 @@ Result parseManifest(std::string_view text, Manifest& m) {
     r.number(c, "fieldError", path, ci.fieldError);
     // Measured errors (format 1 files written before them lack the keys: -1, not shown).
     for (auto [key, out] : {std::pair{"fieldRms", &ci.fieldRms}, std::pair{"fieldMax", &ci.fieldMax}})
-      if (c.contains(key) && r.number(c, key, path, *out) && *out < 0) r.error = "'" + path + key + "' must not be negative";
+      if (c.contains(key) && r.number(c, key, path, *out) && *out < 0)
+        r.error = "'" + path + key + "' must not be negative";
     if (!r.error.empty()) return bad(r.error);
     if (!validChunkFileName(ci.file)) return bad("'" + path + "file' is not a plain name under chunks/");
     if (kind != (i == 0 ? "base" : "splits"))
@@ -231,7 +259,8 @@ Result parseManifest(std::string_view text, Manifest& m) {
       return bad("'" + path + "rawBytes' claims more than 64 times 'bytes' (+1 MiB)");
     if (i > 0) {
       const ChunkInfo& prev = m.chunks.back();
-      if (uint64_t(prev.vertices) + s != v) return bad("'" + path + "vertices' must equal the previous count plus 'splits'");
+      if (uint64_t(prev.vertices) + s != v)
+        return bad("'" + path + "vertices' must equal the previous count plus 'splits'");
       if (t < prev.tets) return bad("'" + path + "tets' decreases");
     }
     m.chunks.push_back(std::move(ci));
@@ -255,8 +284,10 @@ std::string writeManifest(const Manifest& m) {
   for (const FieldInfo& f : m.fields) fields.push_back({{"name", f.name}, {"min", f.range.min}, {"max", f.range.max}});
   doc["fields"] = fields;
   doc["isoField"] = m.isoField;
-  if (m.lossless) doc["quantization"] = {{"lossless", true}};
-  else doc["quantization"] = {{"positionBits", m.positionBits}, {"fieldBits", m.fieldBits}};
+  if (m.lossless)
+    doc["quantization"] = {{"lossless", true}};
+  else
+    doc["quantization"] = {{"positionBits", m.positionBits}, {"fieldBits", m.fieldBits}};
   json chunks = json::array();
   for (const ChunkInfo& c : m.chunks) {
     chunks.push_back({{"file", c.file},

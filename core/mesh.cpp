@@ -35,7 +35,11 @@ Range computeRange(std::span<const float> values) {
   bool any = false;
   for (float v : values) {
     if (!std::isfinite(v)) continue;
-    if (!any) { r.min = r.max = v; any = true; continue; }
+    if (!any) {
+      r.min = r.max = v;
+      any = true;
+      continue;
+    }
     if (v < r.min) r.min = v;
     if (v > r.max) r.max = v;
   }
@@ -49,8 +53,8 @@ double tetVolume(const float* a, const float* b, const float* c, const float* d)
     v[k] = double(c[k]) - a[k];
     w[k] = double(d[k]) - a[k];
   }
-  double det = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-               u[2] * (v[0] * w[1] - v[1] * w[0]);
+  double det =
+      u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) + u[2] * (v[0] * w[1] - v[1] * w[0]);
   return det / 6.0;
 }
 

@@ -19,8 +19,8 @@ struct ScalarField {
 
 struct TetMesh {
   std::string name;
-  std::vector<float> positions;   // 3 * vertexCount
-  std::vector<uint32_t> tets;     // 4 * tetCount
+  std::vector<float> positions;  // 3 * vertexCount
+  std::vector<uint32_t> tets;    // 4 * tetCount
   std::vector<ScalarField> fields;
 
   uint32_t vertexCount() const { return uint32_t(positions.size() / 3); }

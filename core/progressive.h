@@ -19,7 +19,8 @@ namespace tetstream {
 
 // Per-vertex corner lists in one flat array. Block sizes go 8, 12, 16, 24, 32, 48, ... (steps of
 // about 1.5); a full block moves to the next size, and freed blocks are kept by size for reuse,
-// so the pool holds about 1.3 slots per corner and never needs compacting. Order within a list is not meaningful (starOf and neighboursOf sort).
+// so the pool holds about 1.3 slots per corner and never needs compacting. Order within a list is not meaningful
+// (starOf and neighboursOf sort).
 class StarPool {
  public:
   void clear();

@@ -6,8 +6,8 @@
 namespace tetstream {
 
 bool SliceTracker::setPlane(std::array<float, 3> normal, float offset) {
-  const double len = std::sqrt(double(normal[0]) * normal[0] + double(normal[1]) * normal[1] +
-                               double(normal[2]) * normal[2]);
+  const double len =
+      std::sqrt(double(normal[0]) * normal[0] + double(normal[1]) * normal[1] + double(normal[2]) * normal[2]);
   if (!(len > 0) || !std::isfinite(len) || !std::isfinite(offset)) return false;
   std::array<float, 3> n;
   for (int k = 0; k < 3; ++k) n[size_t(k)] = float(normal[size_t(k)] / len);

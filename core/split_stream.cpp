@@ -28,7 +28,8 @@ bool SplitReader::atEnd() const {
 Result beginSplits(SplitReader& r, std::span<const uint8_t> payload, const ChunkInfo& info, const Manifest& m) {
   ByteReader header{payload, 0};
   uint32_t count = 0, flags = 0;
-  if (!header.u32(count) || !header.u32(flags)) return fail(Status::Truncated, "split chunk: payload shorter than its header");
+  if (!header.u32(count) || !header.u32(flags))
+    return fail(Status::Truncated, "split chunk: payload shorter than its header");
   if (count != info.splits)
     return corrupt(std::to_string(count) + " splits where the manifest says " + std::to_string(info.splits));
   if (flags & ~(kSplitFlagLossless | kSplitFlagKeptValues | kSplitFlagKeptIsoValue | kSplitFlagColumns |
@@ -45,7 +46,8 @@ Result beginSplits(SplitReader& r, std::span<const uint8_t> payload, const Chunk
       if (!header.u32(n)) return fail(Status::Truncated, "split chunk: payload shorter than its header");
     size_t at = header.pos;
     for (uint32_t k = 0; k < kSplitColumns; ++k) {
-      if (length[k] > payload.size() - at) return fail(Status::Truncated, "split chunk: a column runs past the payload end");
+      if (length[k] > payload.size() - at)
+        return fail(Status::Truncated, "split chunk: a column runs past the payload end");
       r.in[k] = ByteReader{payload.subspan(at, length[k]), 0};
       at += length[k];
     }
@@ -53,7 +55,8 @@ Result beginSplits(SplitReader& r, std::span<const uint8_t> payload, const Chunk
   } else {
     r.in[0] = ByteReader{payload.subspan(header.pos), 0};
   }
-  if ((flags & kSplitFlagKeptValues) && (flags & kSplitFlagKeptIsoValue)) return corrupt("both kinds of kept values flagged");
+  if ((flags & kSplitFlagKeptValues) && (flags & kSplitFlagKeptIsoValue))
+    return corrupt("both kinds of kept values flagged");
   r.lossless = flags & kSplitFlagLossless;
   r.keptFirst = r.keptCount = 0;
   if (flags & kSplitFlagKeptValues) r.keptCount = uint32_t(m.fields.size());
@@ -76,7 +79,8 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
   uint32_t u;
   if (!r.column(SplitColumn::KeptVertex).varint(u)) return fail(Status::Truncated, "split chunk: record ends early");
   const int64_t j64 = int64_t(r.prevJ) + unzigzag(u);
-  if (j64 < 0 || j64 >= V) return fail(Status::OutOfRange, "split chunk: kept vertex " + std::to_string(j64) + " does not exist");
+  if (j64 < 0 || j64 >= V)
+    return fail(Status::OutOfRange, "split chunk: kept vertex " + std::to_string(j64) + " does not exist");
   const uint32_t j = uint32_t(j64);
 
   // T_moved: a bit per tet around j, in ascending tet order, or (a marker byte says which)
@@ -96,7 +100,8 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
     if (!movedIn.bytes((r.star.size() + 7) / 8, mask)) return fail(Status::Truncated, "split chunk: record ends early");
     for (size_t k = 0; k < r.star.size(); ++k)
       if (mask[k >> 3] >> (k & 7) & 1) r.moved.push_back(r.star[k]);
-    if (r.star.size() % 8 && mask[r.star.size() / 8] >> (r.star.size() % 8)) return corrupt("mask bits beyond the star");
+    if (r.star.size() % 8 && mask[r.star.size() / 8] >> (r.star.size() % 8))
+      return corrupt("mask bits beyond the star");
   }
 
   // T_new: (i, j, a, b), vertices named by index into j's sorted neighbours, or past the end
@@ -104,7 +109,8 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
   neighboursOf(pm, j, r.candidates);
   if (r.impliedMoved || r.ringWalk) r.link.build(pm.mesh, j, r.star, r.candidates);
   uint32_t header;
-  if (!r.column(SplitColumn::NewTetCount).varint(header)) return fail(Status::Truncated, "split chunk: record ends early");
+  if (!r.column(SplitColumn::NewTetCount).varint(header))
+    return fail(Status::Truncated, "split chunk: record ends early");
   const uint32_t m = header >> 2, mode = header & 3;
   if (m > kMaxNewTetsPerSplit) return corrupt(std::to_string(m) + " new tets in one split");
   if (mode > uint32_t(RingMode::Path)) return corrupt("unknown new-tet list mode");
@@ -124,7 +130,8 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
     for (uint32_t n = 0; n < m; ++n) {
       uint32_t a, b;
       if (!read(a) || !read(b)) return fail(Status::Truncated, "split chunk: record ends early");
-      if (!valid(a) || !valid(b) || a == b) return fail(Status::OutOfRange, "split chunk: a new tet has an invalid vertex");
+      if (!valid(a) || !valid(b) || a == b)
+        return fail(Status::OutOfRange, "split chunk: a new tet has an invalid vertex");
       r.newTets.insert(r.newTets.end(), {i, j, a, b});
     }
   } else {
@@ -185,12 +192,15 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
     };
     const float* pj = &pm.mesh.positions[3 * size_t(j)];
     for (int k = 0; k < 3; ++k)
-      if (!predicted(positionIn, q.position[k], pj[k], position[k])) return corrupt("a position leaves the grid or the record ends early");
+      if (!predicted(positionIn, q.position[k], pj[k], position[k]))
+        return corrupt("a position leaves the grid or the record ends early");
     for (size_t f = 0; f < F; ++f)
-      if (!predicted(valuesIn, q.field[f], pm.mesh.fields[f].values[j], r.fields[f])) return corrupt("a field value leaves its range or the record ends early");
+      if (!predicted(valuesIn, q.field[f], pm.mesh.fields[f].values[j], r.fields[f]))
+        return corrupt("a field value leaves its range or the record ends early");
     for (uint32_t k = 0; k < r.keptCount; ++k) {
       const size_t f = r.keptFirst + k;
-      if (!predicted(valuesIn, q.field[f], pm.mesh.fields[f].values[j], r.jFields[k])) return corrupt("a field value leaves its range or the record ends early");
+      if (!predicted(valuesIn, q.field[f], pm.mesh.fields[f].values[j], r.jFields[k]))
+        return corrupt("a field value leaves its range or the record ends early");
     }
   }
   if (r.remaining == 1 && !r.atEnd()) return corrupt("bytes after the last split");

@@ -51,7 +51,7 @@ struct SplitReader {
   bool columns = false;
   bool impliedMoved = false;  // kSplitFlagImpliedMoved
   bool ringWalk = false;      // kSplitFlagRingWalk
-  uint32_t remaining = 0;  // records left in the chunk
+  uint32_t remaining = 0;     // records left in the chunk
   uint32_t prevJ = 0;
   bool lossless = false;
   // Records carry j's kept values of fields [keptFirst, keptFirst + keptCount) (from the flags).
@@ -59,7 +59,7 @@ struct SplitReader {
   // scratch, reused across records
   std::vector<uint32_t> star, candidates, moved, newTets, ring;
   std::vector<float> fields, jFields;  // jFields: keptCount values
-  VertexLink link;  // of j, for ring walks and T_moved
+  VertexLink link;                     // of j, for ring walks and T_moved
 
   ByteReader& column(SplitColumn c) { return in[columns ? uint32_t(c) : 0]; }
   // Where the next record starts (one offset per column), and going back there.

@@ -76,7 +76,8 @@ inline double tetConditionNumber(const double* a, const double* b, const double*
     v[k] = c[k] - a[k];
     w[k] = d[k] - a[k];
   }
-  double det = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) + u[2] * (v[0] * w[1] - v[1] * w[0]);
+  double det =
+      u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) + u[2] * (v[0] * w[1] - v[1] * w[0]);
   if (det == 0) return std::numeric_limits<double>::infinity();
   return std::sqrt(l2) * std::sqrt(a2) / std::abs(det);
 }

@@ -37,7 +37,10 @@ ValidationReport validateMesh(const TetMesh& m, FaceAdjacency* adjacency) {
   r.noTets = T == 0;
   for (uint32_t i = 0; i < V; ++i)
     for (int k = 0; k < 3; ++k)
-      if (!std::isfinite(m.positions[3 * size_t(i) + k])) { ++r.nonFinitePositions; break; }
+      if (!std::isfinite(m.positions[3 * size_t(i) + k])) {
+        ++r.nonFinitePositions;
+        break;
+      }
   for (const ScalarField& f : m.fields)
     for (float x : f.values) r.nonFiniteFieldValues += !std::isfinite(x);
 
@@ -45,7 +48,10 @@ ValidationReport validateMesh(const TetMesh& m, FaceAdjacency* adjacency) {
   std::vector<uint8_t> used(V, 0);
   for (uint32_t t = 0; t < T; ++t) {
     const uint32_t* v = &m.tets[4 * size_t(t)];
-    if (!(v[0] < V && v[1] < V && v[2] < V && v[3] < V)) { ++r.outOfRangeIndices; continue; }
+    if (!(v[0] < V && v[1] < V && v[2] < V && v[3] < V)) {
+      ++r.outOfRangeIndices;
+      continue;
+    }
     for (int k = 0; k < 4; ++k) used[v[k]] = 1;
   }
   for (uint8_t u : used) r.unusedVertices += !u;
@@ -63,9 +69,12 @@ ValidationReport validateMesh(const TetMesh& m, FaceAdjacency* adjacency) {
       if (!geometryOk) continue;
       double vol6 = 6.0 * tetVolume(m, t);
       double l2 = longestEdgeSquared(m.positions.data(), v);
-      if (std::abs(vol6) <= 1e-9 * l2 * std::sqrt(l2)) ++r.zeroVolumeTets;
-      else if (vol6 > 0) ++r.positiveTets;
-      else ++r.negativeTets;
+      if (std::abs(vol6) <= 1e-9 * l2 * std::sqrt(l2))
+        ++r.zeroVolumeTets;
+      else if (vol6 > 0)
+        ++r.positiveTets;
+      else
+        ++r.negativeTets;
     }
     r.invertedTets = std::min(r.positiveTets, r.negativeTets);
   };
@@ -108,11 +117,16 @@ ValidationReport validateMesh(const TetMesh& m, FaceAdjacency* adjacency) {
   if (!indicesOk || T == 0) {
     shapes();
   } else {
-    auto besideFaces = [&] { shapes(); countDuplicates(); };
+    auto besideFaces = [&] {
+      shapes();
+      countDuplicates();
+    };
 #if !defined(__EMSCRIPTEN__)
     std::jthread side;  // (joins on the way out, an exception included)
-    if (T >= kSecondThreadTets) side = std::jthread(besideFaces);
-    else besideFaces();
+    if (T >= kSecondThreadTets)
+      side = std::jthread(besideFaces);
+    else
+      besideFaces();
 #else
     besideFaces();
 #endif
@@ -123,14 +137,16 @@ ValidationReport validateMesh(const TetMesh& m, FaceAdjacency* adjacency) {
   note(r.findings, r.outOfRangeIndices, "tetrahedra reference a vertex that does not exist");
   note(r.findings, r.repeatedVertexTets, "tetrahedra use the same vertex twice");
   note(r.findings, r.nonFinitePositions, "vertices have NaN or infinite coordinates");
-  note(r.findings, r.invertedTets, std::string("tetrahedra are inverted (oriented against the other ") +
-                                       std::to_string(std::max(r.positiveTets, r.negativeTets)) + ")");
+  note(r.findings, r.invertedTets,
+       std::string("tetrahedra are inverted (oriented against the other ") +
+           std::to_string(std::max(r.positiveTets, r.negativeTets)) + ")");
   note(r.findings, r.zeroVolumeTets, "tetrahedra have zero volume (flat)");
   note(r.findings, r.duplicateTets, "tetrahedra duplicate another one");
   note(r.findings, r.unusedVertices, "vertices are not used by any tetrahedron");
   note(r.findings, r.nonFiniteFieldValues, "field values are NaN or infinite");
   note(r.findings, r.nonManifoldFaces, "faces are shared by more than two tetrahedra (non-manifold)");
-  note(r.findings, r.nonManifoldBoundaryEdges, "boundary edges are not shared by exactly two boundary faces (non-manifold boundary)");
+  note(r.findings, r.nonManifoldBoundaryEdges,
+       "boundary edges are not shared by exactly two boundary faces (non-manifold boundary)");
   return r;
 }
 

@@ -18,12 +18,12 @@ struct ValidationReport {
   bool noTets = false;
   // Flaws a robust tool copes with.
   uint64_t positiveTets = 0, negativeTets = 0;
-  uint64_t invertedTets = 0;        // oriented against the mesh's majority orientation
-  uint64_t zeroVolumeTets = 0;      // |6V| <= 1e-9 * (longest edge)^3
-  uint64_t duplicateTets = 0;       // same four vertices as an earlier tet
+  uint64_t invertedTets = 0;    // oriented against the mesh's majority orientation
+  uint64_t zeroVolumeTets = 0;  // |6V| <= 1e-9 * (longest edge)^3
+  uint64_t duplicateTets = 0;   // same four vertices as an earlier tet
   uint64_t unusedVertices = 0;
   uint64_t nonFiniteFieldValues = 0;
-  uint64_t nonManifoldFaces = 0;    // faces shared by more than two tets
+  uint64_t nonManifoldFaces = 0;  // faces shared by more than two tets
   uint64_t boundaryFaces = 0;
   uint64_t nonManifoldBoundaryEdges = 0;
   std::vector<std::string> findings;  // one line per non-zero count, in plain words

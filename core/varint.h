@@ -50,7 +50,8 @@ struct ByteReader {
   }
   bool u32(uint32_t& v) {
     if (data.size() - pos < 4) return false;
-    v = uint32_t(data[pos]) | uint32_t(data[pos + 1]) << 8 | uint32_t(data[pos + 2]) << 16 | uint32_t(data[pos + 3]) << 24;
+    v = uint32_t(data[pos]) | uint32_t(data[pos + 1]) << 8 | uint32_t(data[pos + 2]) << 16 |
+        uint32_t(data[pos + 3]) << 24;
     pos += 4;
     return true;
   }

@@ -57,10 +57,11 @@ class VertexLink {
   bool usable_ = false;
   std::vector<uint8_t> local_;      // per mesh vertex: its place in neighbours (valid for those only)
   std::vector<uint64_t> triangle_;  // per star tet: its link triangle's vertices
-  std::vector<uint32_t> corners_;   // per star tet: p, q, r (its vertices but j, in stored order), and (j, p, q, r)'s sign bit
-  std::vector<uint8_t> side_;       // per star tet: 1 when a ring edge says it came from p_i
-  uint64_t adjacent_[kMaxLink];     // per link vertex: its neighbours in the link
-  uint64_t ringOut_[kMaxLink];      // per link vertex: where ring edges from it go
+  std::vector<uint32_t>
+      corners_;  // per star tet: p, q, r (its vertices but j, in stored order), and (j, p, q, r)'s sign bit
+  std::vector<uint8_t> side_;    // per star tet: 1 when a ring edge says it came from p_i
+  uint64_t adjacent_[kMaxLink];  // per link vertex: its neighbours in the link
+  uint64_t ringOut_[kMaxLink];   // per link vertex: where ring edges from it go
 };
 
 }  // namespace tetstream

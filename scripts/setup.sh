@@ -8,7 +8,7 @@ ROOT=$PWD
 DEPS=$ROOT/build/_deps
 
 APT_PACKAGES=(
-  build-essential cmake pkg-config
+  build-essential cmake pkg-config clang-format
   emscripten                       # wasm toolchain (3.1.6), brings node-acorn, binaryen, lld
   libglm-dev libzstd-dev zstd zlib1g-dev libxxhash-dev
   libpugixml-dev libcli11-dev nlohmann-json3-dev libgtest-dev libstb-dev

@@ -4,6 +4,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh
+bash scripts/format.sh --check
 
 echo "test: native unit tests (labels fast and slow; npm run test:fast runs the fast ones only)"
 ctest --test-dir build/native --output-on-failure -j2

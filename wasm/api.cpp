@@ -85,14 +85,10 @@ EMSCRIPTEN_KEEPALIVE int ts_offer_chunk(int index, uint8_t* bytes, int len) {
   const ChunkCheck c = offerChunk(g_app.state, uint32_t(index), bytes, size_t(len));
   workOnChange();
   switch (c) {
-    case ChunkCheck::Ok:
-      return 1;
-    case ChunkCheck::WrongSize:
-      return 2;
-    case ChunkCheck::WrongHash:
-      return 3;
-    case ChunkCheck::NoSuchChunk:
-      return 0;
+    case ChunkCheck::Ok: return 1;
+    case ChunkCheck::WrongSize: return 2;
+    case ChunkCheck::WrongHash: return 3;
+    case ChunkCheck::NoSuchChunk: return 0;
   }
   return 0;
 }

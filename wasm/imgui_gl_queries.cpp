@@ -38,9 +38,12 @@ extern "C" void tetstreamImGuiGetIntegerv(GLenum name, GLint* data) {
 // A shader is taken as compiled, without a log: the backend's program, whose link status is
 // still asked, fails to link if one did not compile, and the backend then prints its log.
 extern "C" void tetstreamImGuiGetShaderiv(GLuint shader, GLenum name, GLint* data) {
-  if (name == GL_COMPILE_STATUS) *data = GL_TRUE;
-  else if (name == GL_INFO_LOG_LENGTH) *data = 0;
-  else glGetShaderiv(shader, name, data);
+  if (name == GL_COMPILE_STATUS)
+    *data = GL_TRUE;
+  else if (name == GL_INFO_LOG_LENGTH)
+    *data = 0;
+  else
+    glGetShaderiv(shader, name, data);
 }
 
 // The log of a program found linked is not read (the backend prints any log it gets).

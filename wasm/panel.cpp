@@ -81,7 +81,8 @@ void downloadSection(ViewerState& s, float width, float pixelsPerCssPixel) {
     ImGui::TextUnformatted("download paused");
   } else {
     const double left = net.secondsLeft;
-    std::string line = net.bytesPerSecond > 0 ? formatBytes(uint64_t(net.bytesPerSecond)) + "/s" : std::string("waiting for data");
+    std::string line =
+        net.bytesPerSecond > 0 ? formatBytes(uint64_t(net.bytesPerSecond)) + "/s" : std::string("waiting for data");
     if (left >= 1)
       line += ", about " + duration(left) + " left";
     else if (left >= 0)
@@ -94,8 +95,8 @@ void downloadSection(ViewerState& s, float width, float pixelsPerCssPixel) {
   s.telemetry.screen.pauseButton = {lo.x * k, lo.y * k, (hi.x - lo.x) * k, (hi.y - lo.y) * k};
   if (ImGui::IsItemHovered())
     ImGui::SetTooltip(net.paused ? "Downloads the remaining parts."
-                               : "Stops downloading at once. What has arrived is still applied\n"
-                                 "up to the level chosen below.");
+                                 : "Stops downloading at once. What has arrived is still applied\n"
+                                   "up to the level chosen below.");
 }
 
 void levelSection(ViewerState& s, float width, float pixelsPerCssPixel) {
@@ -129,7 +130,8 @@ void levelSection(ViewerState& s, float width, float pixelsPerCssPixel) {
   else if (!s.level.live)
     ImGui::TextDisabled("held here");
   else if (ds.chunksReceived < s.chunksTotal && s.state != LoadState::Error)
-    ImGui::TextDisabled(s.network.paused ? "follows new data once the download resumes" : "follows new data as it arrives");
+    ImGui::TextDisabled(s.network.paused ? "follows new data once the download resumes"
+                                         : "follows new data as it arrives");
 
   const uint32_t nv = ds.pm.mesh.vertexCount(), nt = ds.pm.mesh.tetCount();
   char pct[32];
@@ -148,7 +150,8 @@ void levelSection(ViewerState& s, float width, float pixelsPerCssPixel) {
     if (level->fieldMax == 0)
       std::snprintf(buf, sizeof buf, "none (full mesh)");
     else if (span > 0)
-      std::snprintf(buf, sizeof buf, "RMS %.2g%%, max %.2g%% of range", 100 * level->fieldRms / span, 100 * level->fieldMax / span);
+      std::snprintf(buf, sizeof buf, "RMS %.2g%%, max %.2g%% of range", 100 * level->fieldRms / span,
+                    100 * level->fieldMax / span);
     else
       std::snprintf(buf, sizeof buf, "RMS %.3g, max %.3g", level->fieldRms, level->fieldMax);
     row("field error", buf);
@@ -182,7 +185,8 @@ void memorySection(const ViewerState& s) {
   if (s.memory.chunksAllowed < s.chunksTotal && s.state != LoadState::Error && s.memory.chunksAllowed > 0) {
     const Manifest& m = s.dataset.manifest;
     char buf[160];
-    std::snprintf(buf, sizeof buf, "Too big for this page: streaming will stop after part %u of %u (%.1f%% of the vertices).",
+    std::snprintf(buf, sizeof buf,
+                  "Too big for this page: streaming will stop after part %u of %u (%.1f%% of the vertices).",
                   s.memory.chunksAllowed, s.chunksTotal,
                   m.vertices ? 100.0 * m.chunks[s.memory.chunksAllowed - 1].vertices / m.vertices : 0.0);
     coloredWrapped(kWarning, buf);
@@ -202,7 +206,8 @@ void colourBar(const ViewerState& s, float width, float pixelsPerCssPixel) {
     auto c1 = mapColour(s.colour.map, float(i + 1) / kBands, 0, 1);
     ImU32 a = ImGui::ColorConvertFloat4ToU32(ImVec4(c0[0], c0[1], c0[2], 1));
     ImU32 b = ImGui::ColorConvertFloat4ToU32(ImVec4(c1[0], c1[1], c1[2], 1));
-    dl->AddRectFilledMultiColor(ImVec2(lo.x + w * i / kBands, lo.y), ImVec2(lo.x + w * (i + 1) / kBands + 0.5f, lo.y + h), a, b, b, a);
+    dl->AddRectFilledMultiColor(ImVec2(lo.x + w * i / kBands, lo.y),
+                                ImVec2(lo.x + w * (i + 1) / kBands + 0.5f, lo.y + h), a, b, b, a);
   }
   dl->AddRect(ImVec2(lo.x - 1, lo.y - 1), ImVec2(lo.x + w + 1, lo.y + h + 1), IM_COL32(200, 200, 200, 160));
   const ImU32 text = ImGui::GetColorU32(ImGuiCol_Text);
@@ -238,7 +243,8 @@ void colourSection(ViewerState& s, float width, float pixelsPerCssPixel) {
     float range[2] = {s.colour.min, s.colour.max};
     const Range fr = m.fields[size_t(s.colour.field)].range;
     const float speed = float(fr.max - fr.min) / 500.f;
-    if (ImGui::DragFloat2("range", range, speed > 0 ? speed : 0.01f, 0, 0, "%.4g")) setColourRange(s, range[0], range[1]);
+    if (ImGui::DragFloat2("range", range, speed > 0 ? speed : 0.01f, 0, 0, "%.4g"))
+      setColourRange(s, range[0], range[1]);
     ImGui::SameLine();
     if (ImGui::SmallButton("fit")) fitColourRange(s);
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("the range of the values on the visible surface (F)");
@@ -309,7 +315,8 @@ PanelActions drawPanel(ViewerState& s, float uiScale, float pixelsPerCssPixel) {
   if (s.state == LoadState::Complete) ImGui::TextDisabled("complete: every part received and applied");
   if (s.state == LoadState::Error) coloredWrapped(kError, (s.memory.limited ? "Stopped: " : "Error: ") + s.error);
   if (ImGui::SmallButton("copy link")) actions.copyLink = true;
-  if (ImGui::IsItemHovered()) ImGui::SetTooltip("Copies a link that opens this view: dataset, fields, colours, slice,\nlevel and camera (L).");
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("Copies a link that opens this view: dataset, fields, colours, slice,\nlevel and camera (L).");
   ImGui::SameLine();
   if (ImGui::SmallButton("screenshot")) actions.screenshot = true;
   if (ImGui::IsItemHovered()) ImGui::SetTooltip("Saves the picture as a PNG (S).");
@@ -365,16 +372,17 @@ PanelActions drawPanel(ViewerState& s, float uiScale, float pixelsPerCssPixel) {
   if (int(s.sliceOn) != lastSliceOn) ImGui::SetNextItemOpen(!s.sliceOn);
   lastSliceOn = int(s.sliceOn);
   if (ImGui::TreeNodeEx("timings", ImGuiTreeNodeFlags_NoTreePushOnOpen)) {
-  ImGui::TextDisabled("frames every %.1f ms, longest frame %.0f ms", s.telemetry.frameMs, s.telemetry.maxFrameMs);
-  if (s.telemetry.refineSteps)
-    ImGui::TextDisabled("last refinement %.1f ms (%u splits)", s.telemetry.refineMs, s.telemetry.refineSteps);
-  ImGui::TextDisabled("last full extraction %.1f ms", s.telemetry.extractMs);
-  if (s.telemetry.firstSurfaceMs >= 0) {
-    if (s.telemetry.completeMs >= 0)
-      ImGui::TextDisabled("first surface at %.2f s, complete at %.1f s", s.telemetry.firstSurfaceMs / 1000, s.telemetry.completeMs / 1000);
-    else
-      ImGui::TextDisabled("first surface at %.2f s", s.telemetry.firstSurfaceMs / 1000);
-  }
+    ImGui::TextDisabled("frames every %.1f ms, longest frame %.0f ms", s.telemetry.frameMs, s.telemetry.maxFrameMs);
+    if (s.telemetry.refineSteps)
+      ImGui::TextDisabled("last refinement %.1f ms (%u splits)", s.telemetry.refineMs, s.telemetry.refineSteps);
+    ImGui::TextDisabled("last full extraction %.1f ms", s.telemetry.extractMs);
+    if (s.telemetry.firstSurfaceMs >= 0) {
+      if (s.telemetry.completeMs >= 0)
+        ImGui::TextDisabled("first surface at %.2f s, complete at %.1f s", s.telemetry.firstSurfaceMs / 1000,
+                            s.telemetry.completeMs / 1000);
+      else
+        ImGui::TextDisabled("first surface at %.2f s", s.telemetry.firstSurfaceMs / 1000);
+    }
   }
   ImGui::TextDisabled("drag rotates, right-drag pans, wheel zooms; ? for keys");
 

@@ -2,11 +2,10 @@
 // frame loop (drawing only when something changed and the GPU has finished the last frame), the
 // refinement work slices between frames, and WebGL context loss. The exported functions are in
 // api.cpp; the JS surface is described in docs/js-api.md.
-#include <emscripten.h>
-#include <emscripten/html5.h>
-
 #include <GLES3/gl3.h>
 #include <GLFW/glfw3.h>
+#include <emscripten.h>
+#include <emscripten/html5.h>
 
 #include <algorithm>
 #include <array>
@@ -21,6 +20,7 @@
 #include "frame_policy.h"
 #include "imgui.h"
 #include "panel.h"
+#include "platform_calls.h"
 
 namespace tetstream::viewer {
 
@@ -71,7 +71,7 @@ void syncCanvasSize() {
   // Browser.setCanvasSize resizes the backing store and notifies GLFW (window size callbacks,
   // glfwGetWindowSize). glfwSetWindowSize would do the same but turns a canvas exactly as big
   // as the screen into a fullscreen request.
-  EM_ASM({ Browser.setCanvasSize($0, $1); }, w, h);
+  tsjs_set_canvas_size(w, h);
   g_app.canvas.width = w;
   g_app.canvas.height = h;
   if (!g_app.view.moved) g_app.view.camera.reset(aspect());
@@ -124,8 +124,10 @@ void onCursorPos(GLFWwindow*, double x, double y) {
 EM_BOOL onWheel(int, const EmscriptenWheelEvent* e, void*) {
   requestRedraw();
   double steps = e->deltaY;
-  if (e->deltaMode == DOM_DELTA_PIXEL) steps /= 100.0;  // 100 px make a notch
-  else if (e->deltaMode == DOM_DELTA_LINE) steps /= 3.0;
+  if (e->deltaMode == DOM_DELTA_PIXEL)
+    steps /= 100.0;  // 100 px make a notch
+  else if (e->deltaMode == DOM_DELTA_LINE)
+    steps /= 3.0;
   steps = std::clamp(-steps, -5.0, 5.0);  // positive = toward the user = zoom in
   if (ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureMouse)
     ImGui::GetIO().MouseWheel += float(steps);
@@ -164,10 +166,18 @@ void onChar(GLFWwindow*, unsigned int c) {
   const Manifest& m = s.dataset.manifest;
   switch (c) {
     case '?': s.view.showHelp = !s.view.showHelp; break;
-    case 'r': case 'R': resetView(); break;
-    case 'b': case 'B': s.view.showBoundary = !s.view.showBoundary; break;
-    case 'p': case 'P': setSliceEnabled(s, !s.sliceOn); break;
-    case 'x': case 'X': case 'y': case 'Y': case 'z': case 'Z': {
+    case 'r':
+    case 'R': resetView(); break;
+    case 'b':
+    case 'B': s.view.showBoundary = !s.view.showBoundary; break;
+    case 'p':
+    case 'P': setSliceEnabled(s, !s.sliceOn); break;
+    case 'x':
+    case 'X':
+    case 'y':
+    case 'Y':
+    case 'z':
+    case 'Z': {
       const int k = (c | 0x20) - 'x';
       std::array<float, 3> axis{0, 0, 0};
       axis[size_t(k)] = 1;
@@ -177,13 +187,18 @@ void onChar(GLFWwindow*, unsigned int c) {
     }
     case '[': nudgeSlice(-1); break;
     case ']': nudgeSlice(1); break;
-    case 'c': case 'C':
+    case 'c':
+    case 'C':
       if (!m.fields.empty()) setColourField(s, s.colour.field + 1 >= int(m.fields.size()) ? -1 : s.colour.field + 1);
       break;
-    case 'm': case 'M': setColourMap(s, ColourMap((int(s.colour.map) + 1) % kColourMapCount)); break;
-    case 'f': case 'F': fitColourRange(s); break;
-    case 'l': case 'L': EM_ASM({ if (Module.onCopyLink) Module.onCopyLink(); }); break;
-    case 's': case 'S': EM_ASM({ if (Module.onScreenshot) Module.onScreenshot(); }); break;
+    case 'm':
+    case 'M': setColourMap(s, ColourMap((int(s.colour.map) + 1) % kColourMapCount)); break;
+    case 'f':
+    case 'F': fitColourRange(s); break;
+    case 'l':
+    case 'L': tsjs_copy_link(); break;
+    case 's':
+    case 'S': tsjs_screenshot(); break;
     case ' ':
       if (downloading(s) || s.network.paused) requestPauseToggle(s);
       break;
@@ -206,7 +221,7 @@ void notifyPause() {
   ViewerState& s = g_app.state;
   if (!s.pauseToggleRequested) return;
   s.pauseToggleRequested = false;
-  EM_ASM({ if (Module.onPauseChange) Module.onPauseChange(!!$0); }, !s.network.paused);
+  tsjs_pause_change(!s.network.paused);
 }
 
 namespace {
@@ -245,8 +260,8 @@ void drawFrame() {
     s.view.showHelp = !s.view.showHelp;
     requestRedraw();
   }
-  if (actions.copyLink) EM_ASM({ if (Module.onCopyLink) Module.onCopyLink(); });
-  if (actions.screenshot) EM_ASM({ if (Module.onScreenshot) Module.onScreenshot(); });
+  if (actions.copyLink) tsjs_copy_link();
+  if (actions.screenshot) tsjs_screenshot();
   ImGui::Render();
 
   if (s.dirty.surface) {
@@ -290,7 +305,7 @@ void drawFrame() {
   if (a.pacing.captureRequested) {
     // Read back in the same task as the drawing (the drawing buffer is not preserved after).
     a.pacing.captureRequested = false;
-    EM_ASM({ if (Module.onCapture) Module.onCapture(); });
+    tsjs_capture();
   }
 
   // The surface's draw calls are submitted; the browser presents them when this callback returns.
@@ -323,22 +338,12 @@ void noteComplete(ViewerState& s) {
   if (s.state == LoadState::Complete && s.telemetry.completeMs < 0) s.telemetry.completeMs = emscripten_get_now();
 }
 
-bool interacting() {
-  return g_app.drag.button >= 0 || (ImGui::GetCurrentContext() && ImGui::IsAnyItemActive());
-}
+bool interacting() { return g_app.drag.button >= 0 || (ImGui::GetCurrentContext() && ImGui::IsAnyItemActive()); }
 
 void queueWork() {
   if (g_app.pacing.workQueued) return;
   g_app.pacing.workQueued = true;
-  // A message to a MessageChannel port runs as its own task soon after, without setTimeout's
-  // 4 ms clamp; rendering, input and network callbacks get their turns in between.
-  EM_ASM({
-    if (!Module.tsWorkChannel) {
-      Module.tsWorkChannel = new MessageChannel();
-      Module.tsWorkChannel.port1.onmessage = () => Module._ts_work();
-    }
-    Module.tsWorkChannel.port2.postMessage(0);
-  });
+  tsjs_queue_work();  // a task of its own soon after (platform_calls.js)
 }
 
 // New work (a chunk, a level, resuming) starts at once rather than at the next frame, which on a
@@ -381,12 +386,13 @@ void frame() {
   syncCanvasSize();
   noteComplete(s);
   if (refining(s) || treePending(s)) queueWork();
-  if (downloading(s) && start - a.pacing.lastDrawStart >= kProgressRedrawMs) requestRedraw(1);  // progress and rate move
+  if (downloading(s) && start - a.pacing.lastDrawStart >= kProgressRedrawMs)
+    requestRedraw(1);  // progress and rate move
   // Draw only when something changed: on a software GL (SwiftShader) or a slow GPU a frame can
   // take tens of milliseconds of main-thread time that downloading and decoding need more.
   const bool overPanel = ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureMouse;  // keep the panel live
   const bool refinedOnly = a.canvas.softwareGl && refining(s) && !interacting() && !overPanel && !s.dirty.bounds &&
-                          s.telemetry.firstSurfaceMs >= 0 && start - a.pacing.lastDrawStart < kSoftwareRefineRedrawMs;
+                           s.telemetry.firstSurfaceMs >= 0 && start - a.pacing.lastDrawStart < kSoftwareRefineRedrawMs;
   if (((s.dirty.surface || s.dirty.hull || s.dirty.slice) && !refinedOnly) || s.dirty.bounds || a.drag.button >= 0)
     requestRedraw();
   if (a.pacing.reducedShown && !reducedWanted(s)) requestRedraw(1);  // the still frame, full size
@@ -419,7 +425,7 @@ constexpr const char* kImGuiGlsl = "#version 300 es";
 EM_BOOL onContextLost(int, const void*, void*) {
   g_app.state.contextLost = true;
   g_app.pacing.gpuFence = nullptr;  // (a sync object of the lost context)
-  return EM_TRUE;            // (the event's default is prevented: the browser may restore it)
+  return EM_TRUE;                   // (the event's default is prevented: the browser may restore it)
 }
 
 EM_BOOL onContextRestored(int, const void*, void*) {
@@ -473,19 +479,9 @@ bool initPlatform(std::string& error) {
   // first (the canvas's multisampling is fixed when its context is made), which on SwiftShader
   // cost the main thread ~350 ms and, asked from a worker, made a third context in the GPU process
   // just as the first frames were drawn.
-  g_app.canvas.softwareGl = EM_ASM_INT({
-    try {
-      const gl = Module.canvas.getContext('webgl2');
-      const info = gl && gl.getExtension('WEBGL_debug_renderer_info');
-      const name = String(info ? gl.getParameter(info.UNMASKED_RENDERER_WEBGL) : 0);
-      Module.glRendererName = name;
-      return /swiftshader|llvmpipe|softpipe|software/i.test(name) ? 1 : 0;
-    } catch (e) {
-      return 0;
-    }
-  }) != 0;
+  g_app.canvas.softwareGl = tsjs_software_gl() != 0;
   g_app.state.telemetry.softwareGl = g_app.canvas.softwareGl;
-  const int antialias = EM_ASM_INT({ return typeof Module.antialias === 'boolean' ? (Module.antialias ? 1 : 0) : -1; });
+  const int antialias = tsjs_antialias();
   g_app.renderer.samples = antialias == 1 || (antialias < 0 && !g_app.canvas.softwareGl) ? 4 : 0;
   g_app.state.telemetry.samples = g_app.renderer.samples;
   emscripten_set_webglcontextlost_callback("#canvas", nullptr, EM_FALSE, onContextLost);
@@ -503,10 +499,7 @@ bool initPlatform(std::string& error) {
   }
   // (The renderer's name, already asked: WebGL's version strings would each wait for the GPU
   // process, for a line on the console.)
-  EM_ASM({
-    console.log('tetstream viewer: WebGL 2 on ' + (Module.glRendererName || 'an unnamed renderer') +
-                ($0 ? ' (software), ' : ', ') + ($1 ? $1 + 'x multisampling' : 'no multisampling'));
-  }, g_app.canvas.softwareGl, g_app.renderer.samples);
+  tsjs_log_renderer(g_app.canvas.softwareGl, g_app.renderer.samples);
   warmUpRenderer(g_app.renderer, g_app.canvas.softwareGl);
 
   IMGUI_CHECKVERSION();

@@ -4,10 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <glm/gtc/type_ptr.hpp>
 #include <span>
 #include <tuple>
-
-#include <glm/gtc/type_ptr.hpp>
 
 namespace tetstream::viewer {
 namespace {
@@ -147,7 +146,8 @@ GLuint linkStatus(const Program& p, std::string& error) {
   glGetProgramiv(p.program, GL_LINK_STATUS, &ok);
   if (!ok) {
     char log[2048];
-    for (const auto& [shader, what] : {std::pair{p.vertex, "vertex shader: "}, std::pair{p.fragment, "fragment shader: "}}) {
+    for (const auto& [shader, what] :
+         {std::pair{p.vertex, "vertex shader: "}, std::pair{p.fragment, "fragment shader: "}}) {
       GLint compiled = 0;
       glGetShaderiv(shader, GL_COMPILE_STATUS, &compiled);
       if (compiled) continue;
@@ -231,9 +231,9 @@ void sync(Renderer& r, GLenum target, GpuBuffer& buf, const void* data, uint32_t
 
 uint64_t gpuBufferBytes(const Renderer& r) {
   uint64_t n = 0;
-  for (const GpuBuffer* b : {&r.iso.positions, &r.iso.normals, &r.iso.colours, &r.iso.indices, &r.slice.positions,
-                             &r.slice.normals, &r.slice.colours, &r.slice.indices, &r.hullPositions, &r.hullNormals,
-                             &r.lines})
+  for (const GpuBuffer* b :
+       {&r.iso.positions, &r.iso.normals, &r.iso.colours, &r.iso.indices, &r.slice.positions, &r.slice.normals,
+        &r.slice.colours, &r.slice.indices, &r.hullPositions, &r.hullNormals, &r.lines})
     n += b->bytes;
   return n + r.reduced.bytes + r.multisampled.bytes;
 }
@@ -344,8 +344,10 @@ void uploadSlice(Renderer& r, const IncrementalIsosurface& s) { uploadTo(r, r.sl
 void uploadHull(Renderer& r, const HullTracker& h) {
   const bool full = h.fullUploadNeeded();
   glBindVertexArray(0);
-  sync(r, GL_ARRAY_BUFFER, r.hullPositions, h.trianglePositions().data(), h.triangleCount(), 36, h.changedTriangles(), full);
-  sync(r, GL_ARRAY_BUFFER, r.hullNormals, h.triangleNormals().data(), h.triangleCount(), 36, h.changedTriangles(), full);
+  sync(r, GL_ARRAY_BUFFER, r.hullPositions, h.trianglePositions().data(), h.triangleCount(), 36, h.changedTriangles(),
+       full);
+  sync(r, GL_ARRAY_BUFFER, r.hullNormals, h.triangleNormals().data(), h.triangleCount(), 36, h.changedTriangles(),
+       full);
   sync(r, GL_ARRAY_BUFFER, r.lines, h.lineVertices().data(), h.lineCount(), 24, h.changedLines(), full);
   r.hullVertexCount = int32_t(3 * h.triangleCount());
   r.lineVertexCount = int32_t(2 * h.lineCount());
@@ -445,11 +447,14 @@ void bindTarget(OffscreenTarget& t, int width, int height, int samples) {
   }
   glBindFramebuffer(GL_FRAMEBUFFER, t.framebuffer);
   if (t.width == width && t.height == height && t.samples == samples) return;
-  for (const auto& [buffer, format, attachment] : {std::tuple{t.colour, GLenum(GL_RGBA8), GLenum(GL_COLOR_ATTACHMENT0)},
-                                                   std::tuple{t.depth, GLenum(GL_DEPTH_COMPONENT24), GLenum(GL_DEPTH_ATTACHMENT)}}) {
+  for (const auto& [buffer, format, attachment] :
+       {std::tuple{t.colour, GLenum(GL_RGBA8), GLenum(GL_COLOR_ATTACHMENT0)},
+        std::tuple{t.depth, GLenum(GL_DEPTH_COMPONENT24), GLenum(GL_DEPTH_ATTACHMENT)}}) {
     glBindRenderbuffer(GL_RENDERBUFFER, buffer);
-    if (samples > 0) glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, format, width, height);
-    else glRenderbufferStorage(GL_RENDERBUFFER, format, width, height);
+    if (samples > 0)
+      glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, format, width, height);
+    else
+      glRenderbufferStorage(GL_RENDERBUFFER, format, width, height);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, attachment, GL_RENDERBUFFER, buffer);
   }
   // No glCheckFramebufferStatus: in WebGL it waits for the GPU process to catch up (hundreds of

@@ -8,10 +8,9 @@
 // Needs a current GL context; everything else about the viewer lives in GL-free files.
 #pragma once
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <string>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 #include "colourmap.h"
 #include "isosurface_incremental.h"
@@ -56,9 +55,9 @@ struct Renderer {
   uint32_t isoProgram = 0, hullProgram = 0, lineProgram = 0, backgroundProgram = 0;
   uint32_t hullVao = 0, lineVao = 0, emptyVao = 0;
   SurfaceGpu iso, slice;
-  uint32_t colourMapTexture = 0;                   // 256x1 RGBA8, the current colour map
-  int colourMapLoaded = -1;                        // the ColourMap in it
-  GpuBuffer hullPositions, hullNormals, lines;     // elements: triangles, triangles, segments
+  uint32_t colourMapTexture = 0;                // 256x1 RGBA8, the current colour map
+  int colourMapLoaded = -1;                     // the ColourMap in it
+  GpuBuffer hullPositions, hullNormals, lines;  // elements: triangles, triangles, segments
   int32_t isoColourBy = -1, isoColourRange = -1, isoUnlit = -1;
   int32_t isoView = -1, isoProj = -1, hullView = -1, hullProj = -1, lineViewProj = -1;
   int32_t hullVertexCount = 0, lineVertexCount = 0;

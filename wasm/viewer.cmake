@@ -39,6 +39,7 @@ add_executable(tetstream_viewer
   ${CMAKE_CURRENT_LIST_DIR}/panel.cpp
 )
 target_link_libraries(tetstream_viewer PRIVATE tetstream_core tetstream_imgui)
+set_target_properties(tetstream_viewer PROPERTIES LINK_DEPENDS ${CMAKE_CURRENT_LIST_DIR}/platform_calls.js)
 tetstream_warnings(tetstream_viewer)
 # GLM 0.9.9.8 (type_half.inl) uses `volatile float f; f *= f;`, deprecated in C++20.
 target_compile_options(tetstream_viewer PRIVATE -Wno-deprecated-volatile)
@@ -55,6 +56,8 @@ target_link_options(tetstream_viewer PRIVATE
   -sENVIRONMENT=web -sFILESYSTEM=0
   # The ts_* functions are exported by EMSCRIPTEN_KEEPALIVE (api.cpp); these are the rest.
   -sEXPORTED_FUNCTIONS=_main,_malloc,_free
+  # The program's calls into the page, written in JavaScript (platform_calls.h).
+  --js-library ${CMAKE_CURRENT_LIST_DIR}/platform_calls.js
   -sEXPORTED_RUNTIME_METHODS=callMain,ccall,cwrap,UTF8ToString,HEAPU8
   $<$<CONFIG:Release>:-O3>
   $<$<CONFIG:Debug>:-sASSERTIONS=1>

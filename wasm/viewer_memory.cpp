@@ -8,14 +8,16 @@ namespace tetstream::viewer {
 namespace {
 
 // Per-element costs in bytes (see the header for where they come from).
-constexpr double kPerVertex = 12 + 9 + 4 + 1;  // position; star block (start, size, class); the de-duplication stamp (seen); link numbering (vertex_link.h)
+constexpr double kPerVertex =
+    12 + 9 + 4 +
+    1;  // position; star block (start, size, class); the de-duplication stamp (seen); link numbering (vertex_link.h)
 constexpr double kPerFieldValue = 4;
-constexpr double kPerTet = 16 + 23;         // vertex ids; 4 corners in the star pool at 1.4 slots each
-constexpr double kPerSplit = 4 + 4 + 24;    // undo log (splitJ, splitTetsBefore); record offsets (one per column)
-constexpr double kPerSplitKept = 4;         // undo log: j's isoField value before the split (FORMAT.md §4, flag bit 2)
-constexpr double kSurfacePerTet = 56;       // isosurface + interval tree, measured 49 plus margin
+constexpr double kPerTet = 16 + 23;       // vertex ids; 4 corners in the star pool at 1.4 slots each
+constexpr double kPerSplit = 4 + 4 + 24;  // undo log (splitJ, splitTetsBefore); record offsets (one per column)
+constexpr double kPerSplitKept = 4;       // undo log: j's isoField value before the split (FORMAT.md §4, flag bit 2)
+constexpr double kSurfacePerTet = 56;     // isosurface + interval tree, measured 49 plus margin
 constexpr double kHullPerTriangle = 110;
-constexpr double kFixed = 1 << 20;          // zstd context, scratch, the JSON of the manifest
+constexpr double kFixed = 1 << 20;  // zstd context, scratch, the JSON of the manifest
 
 }  // namespace
 
@@ -55,8 +57,8 @@ uint32_t chunksThatFit(const Manifest& m, uint64_t budgetBytes) {
 uint64_t datasetMemoryBytes(const Dataset& ds) {
   auto bytes = [](const auto& v) { return uint64_t(v.capacity() * sizeof(v[0])); };
   const ProgressiveMesh& pm = ds.pm;
-  uint64_t n = bytes(pm.mesh.positions) + bytes(pm.mesh.tets) + pm.stars.bytes() +
-               bytes(pm.splitJ) + bytes(pm.splitTetsBefore) + bytes(pm.splitJValues) + bytes(pm.seen);
+  uint64_t n = bytes(pm.mesh.positions) + bytes(pm.mesh.tets) + pm.stars.bytes() + bytes(pm.splitJ) +
+               bytes(pm.splitTetsBefore) + bytes(pm.splitJValues) + bytes(pm.seen);
   for (const ScalarField& f : pm.mesh.fields) n += bytes(f.values);
   for (const auto& p : ds.payloads) n += bytes(p);
   n += bytes(ds.payloads) + bytes(ds.chunkFirstSplit) + bytes(ds.recordStart) + bytes(ds.decoder.raw);

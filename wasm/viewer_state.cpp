@@ -6,7 +6,6 @@
 #include <cstdio>
 #include <functional>
 #include <limits>
-
 #include <nlohmann/json.hpp>
 
 #include "adjacency.h"
@@ -230,8 +229,8 @@ ChunkCheck offerChunk(ViewerState& s, uint32_t index, uint8_t* bytes, size_t siz
 
 Result addChunk(ViewerState& s, uint32_t index, std::span<const uint8_t> bytes, bool hashChecked) {
   if (s.state != LoadState::Loading && s.state != LoadState::Streaming) {
-    Result r = fail(Status::BadArgument, std::string("chunk ") + std::to_string(index) + " arrived while the viewer is " +
-                                             loadStateName(s.state));
+    Result r = fail(Status::BadArgument, std::string("chunk ") + std::to_string(index) +
+                                             " arrived while the viewer is " + loadStateName(s.state));
     if (s.state != LoadState::Error) failLoad(s, r.message);
     return r;
   }
@@ -246,8 +245,10 @@ Result addChunk(ViewerState& s, uint32_t index, std::span<const uint8_t> bytes, 
   // arrays are sized for the last level that will come (reserveLevel), so that much is asked
   // for first; if the browser will not give it now, the arrays grow as levels come instead.
   const uint64_t need = s.memory.baseBytes + estimateLevelBytes(ds.manifest, index + 1);
-  const bool reserveAll = index == 0 && (!s.memory.reserveHeap ||
-                                         s.memory.reserveHeap(s.memory.baseBytes + estimateLevelBytes(ds.manifest, s.memory.chunksAllowed)));
+  const bool reserveAll =
+      index == 0 &&
+      (!s.memory.reserveHeap ||
+       s.memory.reserveHeap(s.memory.baseBytes + estimateLevelBytes(ds.manifest, s.memory.chunksAllowed)));
   if (s.memory.reserveHeap && !reserveAll && !s.memory.reserveHeap(need)) {
     s.memory.limited = true;
     Result r = fail(Status::TooLarge, "The browser did not give the viewer the " + formatBytes(need) +
@@ -440,7 +441,6 @@ void failLoad(ViewerState& s, std::string_view message) {
   s.error = message.empty() ? "Unknown error." : std::string(message);
 }
 
-
 uint64_t memoryInUse(const ViewerState& s) {
   return datasetMemoryBytes(s.dataset) + s.surface.memoryBytes() + s.hull.memoryBytes() + s.slice.memoryBytes();
 }
@@ -504,9 +504,10 @@ std::string viewJson(const ViewerState& s) {
       {"colourField", s.colour.field >= 0 ? json(m.fields[size_t(s.colour.field)].name) : json(nullptr)},
       {"colourMap", colourMapName(s.colour.map)},
       {"colourRange", json::array({s.colour.min, s.colour.max})},
-      {"slice", {{"on", s.sliceOn},
-                 {"normal", json::array({s.slice.normal()[0], s.slice.normal()[1], s.slice.normal()[2]})},
-                 {"offset", s.slice.offset()}}},
+      {"slice",
+       {{"on", s.sliceOn},
+        {"normal", json::array({s.slice.normal()[0], s.slice.normal()[1], s.slice.normal()[2]})},
+        {"offset", s.slice.offset()}}},
       {"level", targetLevel(s)},
       {"showBoundary", s.view.showBoundary},
   };

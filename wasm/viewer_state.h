@@ -1,8 +1,8 @@
 // The viewer's model: the dataset streamed so far, the level of detail shown, the chosen field
 // and isovalue, colouring, the slice, the isosurface and domain hull kept up to date by local
 // edits, and the loading state; with the memory budget (viewer_memory.h) and the telemetry
-// (telemetry.h) as parts of their own. No GL, no ImGui, no Emscripten: it compiles natively so the viewer's logic can be
-// unit-tested and debugged without a browser.
+// (telemetry.h) as parts of their own. No GL, no ImGui, no Emscripten: it compiles natively so the viewer's logic can
+// be unit-tested and debugged without a browser.
 //
 // Flow (driven by wasm/api.cpp from the JS calls in docs/js-api.md):
 //   openManifest(bytes)          state idle/error -> loading (or error)
@@ -210,12 +210,12 @@ ChunkCheck offerChunk(ViewerState& s, uint32_t index, uint8_t* bytes, size_t siz
 uint64_t memoryInUse(const ViewerState& s);
 
 // Derived figures for panel and stats.
-double levelFraction(const ViewerState& s);      // vertices shown / vertices of the full mesh
-double targetLevel(const ViewerState& s);        // the level asked for, as levelFraction; 1 while live
-double fieldErrorBound(const ViewerState& s);    // manifest estimate for the last complete chunk
+double levelFraction(const ViewerState& s);         // vertices shown / vertices of the full mesh
+double targetLevel(const ViewerState& s);           // the level asked for, as levelFraction; 1 while live
+double fieldErrorBound(const ViewerState& s);       // manifest estimate for the last complete chunk
 const ChunkInfo* levelChunk(const ViewerState& s);  // the last complete chunk (its measured errors), or null
-bool downloading(const ViewerState& s);          // chunks still to fetch, not paused, no error
-bool refining(const ViewerState& s);             // splits to apply or undo toward the target
+bool downloading(const ViewerState& s);             // chunks still to fetch, not paused, no error
+bool refining(const ViewerState& s);                // splits to apply or undo toward the target
 
 // The interval tree (paper §4.2) is not kept while a level streams in: each split would cost a
 // third more, for isovalue changes that meanwhile test every tet (~10 ms at 1.5M tets in

@@ -19,14 +19,15 @@ void addLevelOptions(CLI::App* sub, LevelOption& level) {
 
 void addReadOptions(CLI::App* sub, ReadOptions& read) {
   sub->add_option("--q,--solution", read.solution,
-                   "PLOT3D Q file for a grid (default: a sibling such as bluntfinq.bin for bluntfinxyz.bin), or a "
-                   "Medit .sol (default: NAME.sol)");
+                  "PLOT3D Q file for a grid (default: a sibling such as bluntfinq.bin for bluntfinxyz.bin), or a "
+                  "Medit .sol (default: NAME.sol)");
 }
 
 Result loadInput(const std::string& path, Input& in, const LevelOption& level, const ReadOptions& read) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) {
-    if (!isPackedDir(path)) return fail(Status::IoError, path + ": a folder without manifest.json is not a packed dataset");
+    if (!isPackedDir(path))
+      return fail(Status::IoError, path + ": a folder without manifest.json is not a packed dataset");
     if (!read.solution.empty()) return fail(Status::BadArgument, "--q applies to mesh files, not to packed datasets");
     Dataset ds;
     uint32_t maxVertices = ~0u;

@@ -1,16 +1,15 @@
 // Shared pieces of the tetstream subcommands: loading any input (mesh file or packed folder),
 // error reporting (plain text on stderr, JSON on stdout with --json) and timing.
 #pragma once
+#include <CLI/CLI.hpp>
 #include <chrono>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
-
+#include "io/mesh_io.h"
 #include "manifest.h"
 #include "mesh.h"
-#include "io/mesh_io.h"
 #include "status.h"
 
 namespace tetstream::cli {
@@ -28,11 +27,11 @@ void addLevelOptions(CLI::App* sub, LevelOption& level);
 struct Input {
   TetMesh mesh;
   bool packed = false;
-  Manifest manifest;                // when packed
-  uint32_t chunksApplied = 0;       // when packed: complete chunks
-  uint32_t splitsApplied = 0;       // when packed: vertex splits applied
-  std::vector<std::string> notes;   // what the reader did (converted fields, skipped cells)
-  std::string format;               // mesh files: what the reader read (ReadReport::format)
+  Manifest manifest;               // when packed
+  uint32_t chunksApplied = 0;      // when packed: complete chunks
+  uint32_t splitsApplied = 0;      // when packed: vertex splits applied
+  std::vector<std::string> notes;  // what the reader did (converted fields, skipped cells)
+  std::string format;              // mesh files: what the reader read (ReadReport::format)
 };
 
 // --q FILE: the solution file of a PLOT3D grid (Q) or of a Medit mesh (.sol).
@@ -52,7 +51,10 @@ void printJson(const json& j);
 
 class Stopwatch {
  public:
-  double ms() const { return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0_).count(); }
+  double ms() const {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0_).count();
+  }
+
  private:
   std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
 };

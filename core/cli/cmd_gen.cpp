@@ -10,24 +10,35 @@
 namespace tetstream::cli {
 
 Runner addGen(CLI::App& app) {
-  struct Opts { std::string kind, out; uint32_t n = 32; bool json = false; };
+  struct Opts {
+    std::string kind, out;
+    uint32_t n = 32;
+    bool json = false;
+  };
   auto o = std::make_shared<Opts>();
   CLI::App* sub = app.add_subcommand("gen", "Generate a built-in dataset as a .vtu file");
   sub->add_option("kind", o->kind, "harmonic (the paper's analytic dataset) or distance (|p|, spheres)")
-      ->required()->check(CLI::IsMember({"harmonic", "distance"}));
+      ->required()
+      ->check(CLI::IsMember({"harmonic", "distance"}));
   sub->add_option("--n", o->n, "vertices per axis of the grid; (n-1)^3*6 tets, n=64 gives 1.5M")
-      ->check(CLI::Range(2u, 1024u))->capture_default_str();
+      ->check(CLI::Range(2u, 1024u))
+      ->capture_default_str();
   sub->add_option("-o,--output", o->out, "output .vtu file")->required();
   sub->add_flag("--json", o->json, "print the result as JSON on stdout");
   return [o] {
     Stopwatch sw;
     TetMesh m = makeGridMesh(o->n);
-    if (o->kind == "harmonic") addHarmonicField(m);
-    else addDistanceField(m);
+    if (o->kind == "harmonic")
+      addHarmonicField(m);
+    else
+      addDistanceField(m);
     m.name = o->kind;
     if (Result r = writeMesh(o->out, m); !r) return reportError(r, o->json);
     if (o->json) {
-      printJson({{"file", o->out}, {"vertices", m.vertexCount()}, {"tets", m.tetCount()}, {"field", m.fields[0].name},
+      printJson({{"file", o->out},
+                 {"vertices", m.vertexCount()},
+                 {"tets", m.tetCount()},
+                 {"field", m.fields[0].name},
                  {"ms", sw.ms()}});
     } else {
       std::printf("wrote %s: %s, %u vertices, %u tets, field '%s' (%.0f ms)\n", o->out.c_str(), o->kind.c_str(),

@@ -9,7 +9,12 @@
 namespace tetstream::cli {
 
 Runner addInfo(CLI::App& app) {
-  struct Opts { std::string input; bool json = false; LevelOption level; ReadOptions read; };
+  struct Opts {
+    std::string input;
+    bool json = false;
+    LevelOption level;
+    ReadOptions read;
+  };
   auto o = std::make_shared<Opts>();
   CLI::App* sub = app.add_subcommand("info", "Counts, fields and ranges, and validation findings");
   sub->add_option("input", o->input, "mesh file or packed dataset folder")->required();
@@ -30,26 +35,43 @@ Runner addInfo(CLI::App& app) {
         Range r = computeRange(f.values);
         fields.push_back({{"name", f.name}, {"min", r.min}, {"max", r.max}});
       }
-      json j = {{"input", o->input}, {"packed", in.packed}, {"name", m.name}, {"vertices", m.vertexCount()},
-                {"tets", m.tetCount()}, {"bounds", {{"min", b.min}, {"max", b.max}}}, {"fields", fields},
-                {"validation", {{"ok", v.findings.empty()}, {"fatal", v.fatal()},
-                                {"invertedTets", v.invertedTets}, {"zeroVolumeTets", v.zeroVolumeTets},
-                                {"duplicateTets", v.duplicateTets}, {"unusedVertices", v.unusedVertices},
-                                {"nonFinitePositions", v.nonFinitePositions}, {"nonFiniteFieldValues", v.nonFiniteFieldValues},
-                                {"outOfRangeIndices", v.outOfRangeIndices}, {"repeatedVertexTets", v.repeatedVertexTets},
-                                {"nonManifoldFaces", v.nonManifoldFaces}, {"boundaryFaces", v.boundaryFaces},
-                                {"nonManifoldBoundaryEdges", v.nonManifoldBoundaryEdges}, {"findings", v.findings}}},
+      json j = {{"input", o->input},
+                {"packed", in.packed},
+                {"name", m.name},
+                {"vertices", m.vertexCount()},
+                {"tets", m.tetCount()},
+                {"bounds", {{"min", b.min}, {"max", b.max}}},
+                {"fields", fields},
+                {"validation",
+                 {{"ok", v.findings.empty()},
+                  {"fatal", v.fatal()},
+                  {"invertedTets", v.invertedTets},
+                  {"zeroVolumeTets", v.zeroVolumeTets},
+                  {"duplicateTets", v.duplicateTets},
+                  {"unusedVertices", v.unusedVertices},
+                  {"nonFinitePositions", v.nonFinitePositions},
+                  {"nonFiniteFieldValues", v.nonFiniteFieldValues},
+                  {"outOfRangeIndices", v.outOfRangeIndices},
+                  {"repeatedVertexTets", v.repeatedVertexTets},
+                  {"nonManifoldFaces", v.nonManifoldFaces},
+                  {"boundaryFaces", v.boundaryFaces},
+                  {"nonManifoldBoundaryEdges", v.nonManifoldBoundaryEdges},
+                  {"findings", v.findings}}},
                 {"notes", in.notes}};
       if (!in.packed) {
         j["inputFormat"] = in.format;
         j["readMs"] = readMs;
       }
       if (in.packed) {
-        j["format"] = {{"formatVersion", in.manifest.formatVersion}, {"generator", in.manifest.generator},
-                       {"chunks", in.manifest.chunks.size()}, {"chunksApplied", in.chunksApplied},
-                       {"splitsApplied", in.splitsApplied}, {"fullVertices", in.manifest.vertices},
+        j["format"] = {{"formatVersion", in.manifest.formatVersion},
+                       {"generator", in.manifest.generator},
+                       {"chunks", in.manifest.chunks.size()},
+                       {"chunksApplied", in.chunksApplied},
+                       {"splitsApplied", in.splitsApplied},
+                       {"fullVertices", in.manifest.vertices},
                        {"fullTets", in.manifest.tets},
-                       {"bytes", in.manifest.totalBytes()}, {"isoField", in.manifest.isoField}};
+                       {"bytes", in.manifest.totalBytes()},
+                       {"isoField", in.manifest.isoField}};
       }
       printJson(j);
       return 0;
@@ -58,7 +80,8 @@ Runner addInfo(CLI::App& app) {
     std::printf("  name      %s\n", m.name.c_str());
     if (!in.packed) std::printf("  read      %s in %.0f ms\n", in.format.c_str(), readMs);
     std::printf("  vertices  %u\n  tets      %u\n", m.vertexCount(), m.tetCount());
-    std::printf("  bounds    [%g, %g, %g] .. [%g, %g, %g]\n", b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2]);
+    std::printf("  bounds    [%g, %g, %g] .. [%g, %g, %g]\n", b.min[0], b.min[1], b.min[2], b.max[0], b.max[1],
+                b.max[2]);
     for (const ScalarField& f : m.fields) {
       Range r = computeRange(f.values);
       std::printf("  field     %-24s [%g, %g]\n", f.name.c_str(), r.min, r.max);

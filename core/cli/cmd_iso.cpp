@@ -5,13 +5,19 @@
 
 #include "cli_common.h"
 #include "commands.h"
-#include "isosurface.h"
 #include "io/ply_writer.h"
+#include "isosurface.h"
 
 namespace tetstream::cli {
 
 Runner addIso(CLI::App& app) {
-  struct Opts { std::string input, field, out; double value = 0; bool json = false; LevelOption level; ReadOptions read; };
+  struct Opts {
+    std::string input, field, out;
+    double value = 0;
+    bool json = false;
+    LevelOption level;
+    ReadOptions read;
+  };
   auto o = std::make_shared<Opts>();
   CLI::App* sub = app.add_subcommand("iso", "Extract an isosurface (marching tetrahedra)");
   sub->add_option("input", o->input, "mesh file or packed dataset folder")->required();
@@ -27,7 +33,8 @@ Runner addIso(CLI::App& app) {
     Result r;
     int f = chooseField(in, o->field, r);
     if (f < 0) return reportError(r, o->json);
-    if (!std::isfinite(o->value)) return reportError(fail(Status::BadArgument, "--value must be a finite number"), o->json);
+    if (!std::isfinite(o->value))
+      return reportError(fail(Status::BadArgument, "--value must be a finite number"), o->json);
     IsoExtractor scratch;
     IsoSurface surface;
     Stopwatch sw;
@@ -35,11 +42,16 @@ Runner addIso(CLI::App& app) {
     double ms = sw.ms();
     double area = surfaceArea(surface);
     if (!o->out.empty())
-      if (Result w = writePly(o->out, surface.positions, surface.normals, surface.indices); !w) return reportError(w, o->json);
+      if (Result w = writePly(o->out, surface.positions, surface.normals, surface.indices); !w)
+        return reportError(w, o->json);
     if (o->json) {
-      printJson({{"field", in.mesh.fields[size_t(f)].name}, {"isovalue", float(o->value)},
-                 {"tets", in.mesh.tetCount()}, {"triangles", surface.triangleCount()},
-                 {"vertices", surface.vertexCount()}, {"area", area}, {"ms", ms}});
+      printJson({{"field", in.mesh.fields[size_t(f)].name},
+                 {"isovalue", float(o->value)},
+                 {"tets", in.mesh.tetCount()},
+                 {"triangles", surface.triangleCount()},
+                 {"vertices", surface.vertexCount()},
+                 {"area", area},
+                 {"ms", ms}});
     } else {
       std::printf("isosurface %s = %g on %u tets: %u triangles, %u vertices, area %.6g (%.1f ms)\n",
                   in.mesh.fields[size_t(f)].name.c_str(), o->value, in.mesh.tetCount(), surface.triangleCount(),

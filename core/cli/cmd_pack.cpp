@@ -43,7 +43,8 @@ class ProgressLine {
     const char* unit = phase_ == "simplify" ? "collapses" : phase_ == "encode" ? "splits" : nullptr;
     if (planned && secs > 0.2) {
       if (unit) std::snprintf(rate, sizeof rate, ", %.0fk %s/s", done / secs / 1000, unit);
-      if (fraction > 0.02 && fraction < 1) std::snprintf(eta, sizeof eta, ", %.0f s left", secs * (1 - fraction) / fraction);
+      if (fraction > 0.02 && fraction < 1)
+        std::snprintf(eta, sizeof eta, ", %.0f s left", secs * (1 - fraction) / fraction);
     }
     const int filled = int(fraction * 30 + 0.5);
     std::fprintf(stderr, "\r  %-9s [%.*s%*s] %5.1f%%  %.1f s%s%s   ", phase, filled, "##############################",
@@ -88,13 +89,19 @@ Runner addPack(CLI::App& app) {
   sub->add_option("-o,--output", o->out, "output folder (created; an earlier pack there is replaced)")->required();
   sub->add_option("--field", o->field, "field that steers simplification and is shown first (default: the first)");
   sub->add_option("--name", o->name, "dataset name shown in the viewer (default: the file name)");
-  sub->add_option("--weights", o->weights, "cost weights G,F,S: boundary geometry, field, tet shape (default 100,1,0.005)")
-      ->delimiter(',')->expected(3);
+  sub->add_option("--weights", o->weights,
+                  "cost weights G,F,S: boundary geometry, field, tet shape (default 100,1,0.005)")
+      ->delimiter(',')
+      ->expected(3);
   auto* bf = sub->add_option("--base-fraction", o->baseFraction, "base mesh size as a fraction of the vertices")
-                 ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+                 ->check(CLI::Range(0.0, 1.0))
+                 ->capture_default_str();
   auto* bv = sub->add_option("--base-vertices", o->baseVertices, "base mesh size in vertices");
-  auto* bt = sub->add_option("--base-tets", o->baseTets, "base mesh size in tets (with --base-fraction 0: the only target)");
-  auto* me = sub->add_option("--max-error", o->maxError, "stop simplifying when the next collapse would leave a field error above E (relative to the field's range)")
+  auto* bt =
+      sub->add_option("--base-tets", o->baseTets, "base mesh size in tets (with --base-fraction 0: the only target)");
+  auto* me = sub->add_option("--max-error", o->maxError,
+                             "stop simplifying when the next collapse would leave a field error above E (relative to "
+                             "the field's range)")
                  ->check(CLI::PositiveNumber);
   bv->excludes(bf);
   me->excludes(bf);
@@ -107,12 +114,16 @@ Runner addPack(CLI::App& app) {
                 "a smaller stream (1-14% on the test datasets) for a longer pack (3-6%) and ~20% more memory: "
                 "inside each chunk the splits go by kept vertex, not by cost");
   sub->add_option("--chunk-kb", o->chunkKb, "largest split chunk in KB; the first chunks are smaller")
-      ->check(CLI::Range(1u, 65536u))->capture_default_str();
+      ->check(CLI::Range(1u, 65536u))
+      ->capture_default_str();
   sub->add_option("--zstd-level", o->level, "zstd compression level")->check(CLI::Range(1, 22))->capture_default_str();
-  sub->add_option("--max-memory", o->maxMemoryGb, "refuse meshes that need more memory than this, in GB (default: 90% of RAM)")
+  sub->add_option("--max-memory", o->maxMemoryGb,
+                  "refuse meshes that need more memory than this, in GB (default: 90% of RAM)")
       ->check(CLI::PositiveNumber);
-  sub->add_option("--threads", o->threads, "threads for simplification and for measuring each level's error (1 or 2; the output is the same)")
-      ->check(CLI::Range(1, 2))->capture_default_str();
+  sub->add_option("--threads", o->threads,
+                  "threads for simplification and for measuring each level's error (1 or 2; the output is the same)")
+      ->check(CLI::Range(1, 2))
+      ->capture_default_str();
   sub->add_flag("--json", o->json, "print the result as JSON on stdout");
   return [o, me, bv, bt] {
     Stopwatch total;
@@ -123,7 +134,8 @@ Runner addPack(CLI::App& app) {
       bar.finishLine();
       return reportError(r, o->json);
     }
-    if (in.packed) return reportError(fail(Status::BadArgument, o->input + " is already packed; give a mesh file"), o->json);
+    if (in.packed)
+      return reportError(fail(Status::BadArgument, o->input + " is already packed; give a mesh file"), o->json);
     bar.update("read", 1, 1);
     double readMs = total.ms();
     const uint32_t inputVertices = in.mesh.vertexCount();
@@ -159,17 +171,42 @@ Runner addPack(CLI::App& app) {
     json notes = in.notes;
     for (const std::string& n : s.notes) notes.push_back(n);
     if (o->json) {
-      printJson({{"output", o->out}, {"name", m.name}, {"vertices", m.vertices}, {"tets", m.tets},
-                 {"inputVertices", inputVertices}, {"inputFormat", in.format}, {"field", m.isoField}, {"lossless", m.lossless},
-                 {"positionBits", m.positionBits}, {"baseVertices", s.baseVertices}, {"baseTets", s.baseTets},
-                 {"splits", s.splits}, {"chunks", m.chunks.size()}, {"bytes", bytes}, {"baseBytes", baseBytes},
-                 {"bitsPerTet", bitsPerTet}, {"bytesPerSplit", bytesPerSplit}, {"movedMasks", s.movedMasks},
-                 {"baseFieldError", m.chunks[0].fieldError}, {"baseFieldRms", m.chunks[0].fieldRms},
-                 {"baseFieldMax", m.chunks[0].fieldMax}, {"stopReason", s.stopReason},
-                 {"flatTetsRemoved", s.flatTetsRemoved}, {"flatTetsLeft", s.flatTetsLeft},
-                 {"queuePops", s.queuePops}, {"slabCollapses", s.slabCollapses}, {"requeued", s.requeued}, {"costEvaluations", s.costEvaluations},
-                 {"readMs", readMs}, {"prepareMs", s.prepareMs}, {"simplifyMs", s.simplifyMs}, {"encodeMs", s.encodeMs}, {"writeMs", s.writeMs},
-                 {"ms", total.ms()}, {"peakMemoryMB", peakMemoryMB()}, {"notes", notes}});
+      printJson({{"output", o->out},
+                 {"name", m.name},
+                 {"vertices", m.vertices},
+                 {"tets", m.tets},
+                 {"inputVertices", inputVertices},
+                 {"inputFormat", in.format},
+                 {"field", m.isoField},
+                 {"lossless", m.lossless},
+                 {"positionBits", m.positionBits},
+                 {"baseVertices", s.baseVertices},
+                 {"baseTets", s.baseTets},
+                 {"splits", s.splits},
+                 {"chunks", m.chunks.size()},
+                 {"bytes", bytes},
+                 {"baseBytes", baseBytes},
+                 {"bitsPerTet", bitsPerTet},
+                 {"bytesPerSplit", bytesPerSplit},
+                 {"movedMasks", s.movedMasks},
+                 {"baseFieldError", m.chunks[0].fieldError},
+                 {"baseFieldRms", m.chunks[0].fieldRms},
+                 {"baseFieldMax", m.chunks[0].fieldMax},
+                 {"stopReason", s.stopReason},
+                 {"flatTetsRemoved", s.flatTetsRemoved},
+                 {"flatTetsLeft", s.flatTetsLeft},
+                 {"queuePops", s.queuePops},
+                 {"slabCollapses", s.slabCollapses},
+                 {"requeued", s.requeued},
+                 {"costEvaluations", s.costEvaluations},
+                 {"readMs", readMs},
+                 {"prepareMs", s.prepareMs},
+                 {"simplifyMs", s.simplifyMs},
+                 {"encodeMs", s.encodeMs},
+                 {"writeMs", s.writeMs},
+                 {"ms", total.ms()},
+                 {"peakMemoryMB", peakMemoryMB()},
+                 {"notes", notes}});
       return 0;
     }
     for (const auto& n : notes) std::printf("note: %s\n", n.get<std::string>().c_str());
@@ -181,20 +218,25 @@ Runner addPack(CLI::App& app) {
     if (const ChunkInfo& b = m.chunks[0]; b.fieldRms >= 0) {
       const int iso = m.findField(m.isoField);
       const double range = iso >= 0 ? m.fields[size_t(iso)].range.max - m.fields[size_t(iso)].range.min : 0.0;
-      auto share = [&](double e) { return range > 0 ? " (" + formatPercent(e / range) + " of the range)" : std::string(); };
+      auto share = [&](double e) {
+        return range > 0 ? " (" + formatPercent(e / range) + " of the range)" : std::string();
+      };
       std::printf("  error     base field error at the input's vertices: RMS %.3g%s, largest %.3g%s\n", b.fieldRms,
                   share(b.fieldRms).c_str(), b.fieldMax, share(b.fieldMax).c_str());
     }
     std::printf("  stream    %u splits in %zu chunk%s, %.2f MB in all, %.1f bits/tet, %.1f bytes/split\n", s.splits,
                 m.chunks.size() - 1, m.chunks.size() == 2 ? "" : "s", bytes / 1e6, bitsPerTet, bytesPerSplit);
     std::printf("  values    %s\n", m.lossless ? "lossless float32"
-                                                : ("quantized, " + std::to_string(m.positionBits) + "-bit positions, " +
-                                                   std::to_string(m.fieldBits) + "-bit fields").c_str());
+                                               : ("quantized, " + std::to_string(m.positionBits) + "-bit positions, " +
+                                                  std::to_string(m.fieldBits) + "-bit fields")
+                                                     .c_str());
     std::printf("  stopped   %s", s.stopReason.c_str());
     if (s.flatTetsRemoved || s.flatTetsLeft)
       std::printf("; flat input tets: %u removed, %u left", s.flatTetsRemoved, s.flatTetsLeft);
-    std::printf("\n  time      read %.0f ms, prepare %.0f ms, simplify %.0f ms, encode %.0f ms, write %.0f ms; peak memory %.0f MB\n",
-                readMs, s.prepareMs, s.simplifyMs, s.encodeMs, s.writeMs, peakMemoryMB());
+    std::printf(
+        "\n  time      read %.0f ms, prepare %.0f ms, simplify %.0f ms, encode %.0f ms, write %.0f ms; peak memory "
+        "%.0f MB\n",
+        readMs, s.prepareMs, s.simplifyMs, s.encodeMs, s.writeMs, peakMemoryMB());
     return 0;
   };
 }

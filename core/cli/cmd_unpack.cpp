@@ -9,7 +9,11 @@
 namespace tetstream::cli {
 
 Runner addUnpack(CLI::App& app) {
-  struct Opts { std::string input, out; bool json = false; LevelOption level; };
+  struct Opts {
+    std::string input, out;
+    bool json = false;
+    LevelOption level;
+  };
   auto o = std::make_shared<Opts>();
   CLI::App* sub = app.add_subcommand("unpack", "Write the mesh of one level of a packed dataset (all fields) as .vtu");
   sub->add_option("input", o->input, "packed dataset folder")->required();
@@ -20,13 +24,18 @@ Runner addUnpack(CLI::App& app) {
     Stopwatch sw;
     Input in;
     if (Result r = loadInput(o->input, in, o->level); !r) return reportError(r, o->json);
-    if (!in.packed) return reportError(fail(Status::BadArgument, o->input + " is not a packed dataset folder"), o->json);
+    if (!in.packed)
+      return reportError(fail(Status::BadArgument, o->input + " is not a packed dataset folder"), o->json);
     if (Result r = writeMesh(o->out, in.mesh); !r) return reportError(r, o->json);
     const TetMesh& m = in.mesh;
     if (o->json) {
-      printJson({{"output", o->out}, {"vertices", m.vertexCount()}, {"tets", m.tetCount()},
-                 {"chunksApplied", in.chunksApplied}, {"splitsApplied", in.splitsApplied},
-                 {"fraction", double(m.vertexCount()) / in.manifest.vertices}, {"ms", sw.ms()}});
+      printJson({{"output", o->out},
+                 {"vertices", m.vertexCount()},
+                 {"tets", m.tetCount()},
+                 {"chunksApplied", in.chunksApplied},
+                 {"splitsApplied", in.splitsApplied},
+                 {"fraction", double(m.vertexCount()) / in.manifest.vertices},
+                 {"ms", sw.ms()}});
     } else {
       std::printf("wrote %s: %u vertices (%.1f%%), %u tets, %zu field(s), %u chunk(s) + %u splits applied\n",
                   o->out.c_str(), m.vertexCount(), 100.0 * m.vertexCount() / in.manifest.vertices, m.tetCount(),

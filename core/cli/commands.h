@@ -1,9 +1,8 @@
 // The subcommands of `tetstream`. Each registers its options on the CLI11 app and returns a
 // runner that yields the process exit code.
 #pragma once
-#include <functional>
-
 #include <CLI/CLI.hpp>
+#include <functional>
 
 namespace tetstream::cli {
 

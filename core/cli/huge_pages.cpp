@@ -85,10 +85,11 @@ void useHugePages(char** argv, const std::string& input) {
   if (microsecondsPerFreshPage() < kCheapPageMicroseconds) return;
   constexpr std::uintmax_t kSmallInputBytes = 4u << 20;
   std::error_code error;
-  const std::uintmax_t bytes = std::filesystem::is_regular_file(input, error) ? std::filesystem::file_size(input, error) : 0;
+  const std::uintmax_t bytes =
+      std::filesystem::is_regular_file(input, error) ? std::filesystem::file_size(input, error) : 0;
   const bool small = !error && bytes > 0 && bytes < kSmallInputBytes;
-  const std::string value = (tunables && *tunables ? std::string(tunables) + ":" : std::string()) + "glibc.malloc.hugetlb=1" +
-                            (small ? smallInputTunables(tunables) : std::string());
+  const std::string value = (tunables && *tunables ? std::string(tunables) + ":" : std::string()) +
+                            "glibc.malloc.hugetlb=1" + (small ? smallInputTunables(tunables) : std::string());
   if (setenv("GLIBC_TUNABLES", value.c_str(), 1) != 0 || setenv("TETSTREAM_RESTARTED", "1", 1) != 0) return;
   std::fflush(nullptr);
   execv("/proc/self/exe", argv);  // returns only if it failed: go on with small pages

@@ -23,9 +23,9 @@
 //    points no cell lists) are dropped and the rest renumbered in order.
 #include <algorithm>
 #include <array>
-#include <compare>
 #include <bit>
 #include <cmath>
+#include <compare>
 #include <cstdio>
 #include <limits>
 #include <numeric>
@@ -53,7 +53,12 @@ constexpr ShapeFaces kFaces[4] = {
     {5, {{4, {0, 3, 2, 1}}, {3, {0, 1, 4}}, {3, {1, 2, 4}}, {3, {2, 3, 4}}, {3, {3, 0, 4}}}},
     {5, {{3, {0, 1, 2}}, {3, {3, 5, 4}}, {4, {0, 3, 4, 1}}, {4, {1, 4, 5, 2}}, {4, {2, 5, 3, 0}}}},
     {6,
-     {{4, {0, 3, 2, 1}}, {4, {4, 5, 6, 7}}, {4, {0, 1, 5, 4}}, {4, {1, 2, 6, 5}}, {4, {2, 3, 7, 6}}, {4, {3, 0, 4, 7}}}},
+     {{4, {0, 3, 2, 1}},
+      {4, {4, 5, 6, 7}},
+      {4, {0, 1, 5, 4}},
+      {4, {1, 2, 6, 5}},
+      {4, {2, 3, 7, 6}},
+      {4, {3, 0, 4, 7}}}},
 };
 constexpr const char* kShapeNames[4][2] = {
     {"tetrahedron", "tetrahedra"}, {"pyramid", "pyramids"}, {"wedge", "wedges"}, {"hexahedron", "hexahedra"}};
@@ -322,10 +327,14 @@ VtkCellInfo vtkCellInfo(int64_t type) {
     case 32: return {true, S::Wedge, 18};
     case 33: return {true, S::Hex, 24};
     case 37: return {true, S::Pyramid, 19};
-    case 71: case 78: return {true, S::Tet, 0};
-    case 72: case 79: return {true, S::Hex, 0};
-    case 73: case 80: return {true, S::Wedge, 0};
-    case 74: case 81: return {true, S::Pyramid, 0};
+    case 71:
+    case 78: return {true, S::Tet, 0};
+    case 72:
+    case 79: return {true, S::Hex, 0};
+    case 73:
+    case 80: return {true, S::Wedge, 0};
+    case 74:
+    case 81: return {true, S::Pyramid, 0};
     default: return {};
   }
 }
@@ -424,7 +433,8 @@ Result finishMesh(const std::string& label, TetMesh& mesh, CellSoup& soup, std::
                   ReadReport& report) {
   const uint64_t nv64 = mesh.positions.size() / 3;
   if (nv64 > kMaxVertices)
-    return fail(Status::TooLarge, label + ": " + std::to_string(nv64) + " points; tetstream indexes vertices with 32 bits");
+    return fail(Status::TooLarge,
+                label + ": " + std::to_string(nv64) + " points; tetstream indexes vertices with 32 bits");
   const uint32_t nv = uint32_t(nv64);
 
   for (const auto& [name, r] : soup.reduced)
@@ -496,9 +506,9 @@ Result finishMesh(const std::string& label, TetMesh& mesh, CellSoup& soup, std::
         const uint64_t differing = averageMerged(mesh, remap);
         report.notes.push_back("merged " + plural(coincident, "duplicate vertex", "duplicate vertices") +
                                " (exactly the same coordinates) into the first copy" +
-                               (differing ? "; " + std::to_string(differing) +
-                                                " of them had other field values, averaged"
-                                          : std::string()));
+                               (differing
+                                    ? "; " + std::to_string(differing) + " of them had other field values, averaged"
+                                    : std::string()));
       }
     }
   }
@@ -583,8 +593,10 @@ Result finishMesh(const std::string& label, TetMesh& mesh, CellSoup& soup, std::
       continue;
     }
     if (!remap.empty() && remap[v] != v) continue;  // merged away: already said
-    if (v < referenced.size() && referenced[v]) ++higherOrder;
-    else ++noCell;
+    if (v < referenced.size() && referenced[v])
+      ++higherOrder;
+    else
+      ++noCell;
   }
   if (kept < nv) {
     for (uint32_t& id : tets) id = newId[id];

@@ -29,8 +29,10 @@ TetMesh makeGridMesh(uint32_t n) {
           uint32_t v1 = base + stride[kPerm[p][0]];
           uint32_t v2 = v1 + stride[kPerm[p][1]];
           uint32_t v3 = base + stride[0] + stride[1] + stride[2];
-          if (p < 3) m.tets.insert(m.tets.end(), {base, v1, v2, v3});
-          else m.tets.insert(m.tets.end(), {base, v2, v1, v3});
+          if (p < 3)
+            m.tets.insert(m.tets.end(), {base, v1, v2, v3});
+          else
+            m.tets.insert(m.tets.end(), {base, v2, v1, v3});
         }
       }
   return m;

@@ -67,7 +67,7 @@ const GmshType* gmshType(int64_t type) {
 bool volumeShape(const GmshType& t, CellShape& shape) {
   if (t.dim != 3) return false;
   std::string_view n = t.name;
-  shape = n.ends_with("tetrahedron") ? CellShape::Tet
+  shape = n.ends_with("tetrahedron")  ? CellShape::Tet
           : n.ends_with("hexahedron") ? CellShape::Hex
           : n.ends_with("prism")      ? CellShape::Wedge
                                       : CellShape::Pyramid;
@@ -88,7 +88,6 @@ int vtkTypeOf(const GmshType& t) {
     default: return 0;
   }
 }
-
 
 // Tag -> index for node or element tags (positive integers, maybe sparse).
 class TagMap {
@@ -271,8 +270,9 @@ struct Gmsh {
       while (i < l.size() && !isSpace(l[i])) ++i;
       if (i > b) a.push_back(l.substr(b, i - b));
     }
-    if (a.size() < 3) return error(pos >= s.size() ? Status::Truncated : Status::Corrupt, p, sec,
-                                   "expected 'version file-type data-size', found '" + printable(l) + "'");
+    if (a.size() < 3)
+      return error(pos >= s.size() ? Status::Truncated : Status::Corrupt, p, sec,
+                   "expected 'version file-type data-size', found '" + printable(l) + "'");
     version = std::string(a[0]);
     if (version == "2" || version == "2.0" || version == "2.1" || version == "2.2")
       major = 2;
@@ -280,8 +280,9 @@ struct Gmsh {
       major = 4;
     else if (version.starts_with("4") || version.starts_with("3"))
       return error(Status::UnsupportedVersion, p, sec,
-                   "MSH " + printable(version) + " is not supported; tetstream reads 2.2 and 4.1 (re-save with "
-                   "Gmsh: -format msh41 or msh22)");
+                   "MSH " + printable(version) +
+                       " is not supported; tetstream reads 2.2 and 4.1 (re-save with "
+                       "Gmsh: -format msh41 or msh22)");
     else
       return error(Status::UnsupportedVersion, p, sec, "unknown MSH version '" + printable(version) + "'");
     if (a[1] == "1")
@@ -302,13 +303,12 @@ struct Gmsh {
       else if (one == 0x01000000u)
         swap = true;
       else
-        return error(Status::Corrupt, pos, sec,
-                     "the endianness check should be the int 1 in either byte order, found 0x" +
-                         [&] {
-                           char b[16];
-                           std::snprintf(b, sizeof b, "%08x", one);
-                           return std::string(b);
-                         }());
+        return error(
+            Status::Corrupt, pos, sec, "the endianness check should be the int 1 in either byte order, found 0x" + [&] {
+              char b[16];
+              std::snprintf(b, sizeof b, "%08x", one);
+              return std::string(b);
+            }());
       pos += 4;
     }
     return expectEnd(sec);
@@ -336,12 +336,14 @@ struct Gmsh {
         for (uint64_t i = 0; i < n; ++i) {
           int32_t tag = binInt();
           double xyz[3] = {binDouble(), binDouble(), binDouble()};
-          if (tag < 1) return error(Status::Corrupt, pos - 28, sec, "node tag " + std::to_string(tag) + " is not positive");
+          if (tag < 1)
+            return error(Status::Corrupt, pos - 28, sec, "node tag " + std::to_string(tag) + " is not positive");
           if (Result r = addNode(sec, uint64_t(tag), xyz); !r) return r;
         }
       } else {
-        if (n > left() / 8) return error(Status::Truncated, pos, sec, std::to_string(n) + " nodes cannot fit in the " +
-                                                                          std::to_string(left()) + " bytes left");
+        if (n > left() / 8)
+          return error(Status::Truncated, pos, sec,
+                       std::to_string(n) + " nodes cannot fit in the " + std::to_string(left()) + " bytes left");
         positions.reserve(3 * n);
         for (uint64_t i = 0; i < n; ++i) {
           uint64_t tag;
@@ -355,8 +357,8 @@ struct Gmsh {
       return finishTags(nodeTags, sec, "node");
     }
     uint64_t blocks, n, minTag, maxTag;
-    for (auto [v, what] : {std::pair{&blocks, "numEntityBlocks"}, {&n, "numNodes"}, {&minTag, "minNodeTag"},
-                           {&maxTag, "maxNodeTag"}})
+    for (auto [v, what] :
+         {std::pair{&blocks, "numEntityBlocks"}, {&n, "numNodes"}, {&minTag, "minNodeTag"}, {&maxTag, "maxNodeTag"}})
       if (Result r = count41(sec, what, *v); !r) return r;
     // Each node takes at least 3 doubles (binary) or 6 characters (text): a bound on n.
     if (n > left() / (binary ? 24 : 6) || blocks > left() / (binary ? 12 + uint64_t(sizeT) : 8) + 1)
@@ -385,8 +387,7 @@ struct Gmsh {
       const int coords = 3 + (parametric ? int(dim) : 0);
       tags.resize(inBlock);
       if (binary) {
-        if (Result r = need(inBlock, uint64_t(sizeT) + 8 * uint64_t(coords), sec,
-                            "node block " + std::to_string(b));
+        if (Result r = need(inBlock, uint64_t(sizeT) + 8 * uint64_t(coords), sec, "node block " + std::to_string(b));
             !r)
           return r;
         for (uint64_t& t : tags) t = binSize();
@@ -478,8 +479,8 @@ struct Gmsh {
           if (Result r = textInt(sec, "element tag count", ntags); !r) return r;
           if (tag < 1 || ntags < 0 || ntags > 64)
             return error(Status::Corrupt, p, sec,
-                         "element " + std::to_string(i) + ": tag " + std::to_string(tag) + ", " + std::to_string(ntags) +
-                             " tags (expected a positive tag and 0..64 tags)");
+                         "element " + std::to_string(i) + ": tag " + std::to_string(tag) + ", " +
+                             std::to_string(ntags) + " tags (expected a positive tag and 0..64 tags)");
           sawTags |= ntags > 0;
           for (int64_t k = 0; k < ntags; ++k) {
             int64_t x;
@@ -506,7 +507,8 @@ struct Gmsh {
           const GmshType* t = gmshType(type);
           if (!t)
             return error(Status::Unsupported, p, sec,
-                         "element type " + std::to_string(type) + " is not one tetstream knows (cannot skip it in a binary file)");
+                         "element type " + std::to_string(type) +
+                             " is not one tetstream knows (cannot skip it in a binary file)");
           if (count < 1 || uint64_t(count) > n - done || ntags < 0 || ntags > 64)
             return error(Status::Corrupt, p, sec,
                          "element block of " + std::to_string(count) + " elements with " + std::to_string(ntags) +
@@ -519,7 +521,8 @@ struct Gmsh {
             int32_t tag = binInt();
             pos += 4 * size_t(ntags);
             for (int k = 0; k < t->nodes; ++k) nodes[k] = uint64_t(int64_t(binInt()));
-            if (tag < 1) return error(Status::Corrupt, ep, sec, "element tag " + std::to_string(tag) + " is not positive");
+            if (tag < 1)
+              return error(Status::Corrupt, ep, sec, "element tag " + std::to_string(tag) + " is not positive");
             if (Result r = addElement(sec, ep, type, uint64_t(tag), nodes, t->nodes); !r) return r;
           }
           done += uint64_t(count);
@@ -528,7 +531,9 @@ struct Gmsh {
       return finishTags(elementTags, sec, "element");
     }
     uint64_t blocks, n, minTag, maxTag;
-    for (auto [v, what] : {std::pair{&blocks, "numEntityBlocks"}, {&n, "numElements"}, {&minTag, "minElementTag"},
+    for (auto [v, what] : {std::pair{&blocks, "numEntityBlocks"},
+                           {&n, "numElements"},
+                           {&minTag, "minElementTag"},
                            {&maxTag, "maxElementTag"}})
       if (Result r = count41(sec, what, *v); !r) return r;
     if (n > left() / (binary ? 2 * uint64_t(sizeT) : 4))
@@ -552,8 +557,9 @@ struct Gmsh {
       seen += inBlock;
       const GmshType* t = gmshType(type);
       if (!t && binary)
-        return error(Status::Unsupported, p, sec,
-                     "element type " + std::to_string(type) + " is not one tetstream knows (cannot skip it in a binary file)");
+        return error(
+            Status::Unsupported, p, sec,
+            "element type " + std::to_string(type) + " is not one tetstream knows (cannot skip it in a binary file)");
       if (binary) {
         const uint64_t per = uint64_t(sizeT) * uint64_t(1 + t->nodes);
         if (Result r = need(inBlock, per, sec, "element block " + std::to_string(b)); !r) return r;
@@ -720,8 +726,9 @@ struct Gmsh {
       if (pos >= s.size()) break;
       const size_t p = pos;
       if (s[pos] != '$')
-        return error(Status::Corrupt, p, "",
-                     "expected a section ('$Name'), found '" + printable(s.substr(pos, std::min<size_t>(20, left()))) + "'");
+        return error(
+            Status::Corrupt, p, "",
+            "expected a section ('$Name'), found '" + printable(s.substr(pos, std::min<size_t>(20, left()))) + "'");
       std::string name(line().substr(1));
       while (!name.empty() && isSpace(name.back())) name.pop_back();
       if (name.starts_with("End"))

@@ -22,9 +22,9 @@ using namespace vtkio;
 
 struct Keyword {
   const char* name;
-  int numbers;      // per entry, reference included; -1: the dimension (+ nothing); -2: dimension + 1
-  int cell;         // -1: not a volume cell; else a CellShape
-  int nodes;        // nodes per cell (volume cells)
+  int numbers;  // per entry, reference included; -1: the dimension (+ nothing); -2: dimension + 1
+  int cell;     // -1: not a volume cell; else a CellShape
+  int nodes;    // nodes per cell (volume cells)
 };
 // clang-format off
 constexpr Keyword kKeywords[] = {
@@ -91,7 +91,8 @@ Result readSol(std::string_view sol, const std::string& label, uint32_t vertices
     }
     if (iequals(w, "Dimension")) {
       if (Result r = t.integer("the dimension", dim); !r) return r;
-      if (dim != 3) return fail(Status::Unsupported, t.at(p) + ": dimension " + std::to_string(dim) + "; tetstream reads 3D");
+      if (dim != 3)
+        return fail(Status::Unsupported, t.at(p) + ": dimension " + std::to_string(dim) + "; tetstream reads 3D");
       continue;
     }
     if (!iequals(w, "SolAtVertices")) {
@@ -106,14 +107,20 @@ Result readSol(std::string_view sol, const std::string& label, uint32_t vertices
                                        std::to_string(vertices) + " vertices");
     int64_t k;
     if (Result r = t.integer("the number of solutions", k); !r) return r;
-    if (k < 1 || k > 64) return fail(Status::Corrupt, t.at(p) + ": " + std::to_string(k) + " solutions per vertex (expected 1..64)");
+    if (k < 1 || k > 64)
+      return fail(Status::Corrupt, t.at(p) + ": " + std::to_string(k) + " solutions per vertex (expected 1..64)");
     std::vector<int> comps;
     uint64_t total = 0;
     for (int64_t i = 0; i < k; ++i) {
       int64_t type;
       if (Result r = t.integer("solution type", type); !r) return r;
-      int c = type == 1 ? 1 : type == 2 ? int(dim) : type == 3 ? int(dim * (dim + 1) / 2) : type == 4 ? int(dim * dim) : 0;
-      if (!c) return fail(Status::Corrupt, t.at(t.pos) + ": solution type " + std::to_string(type) + " (expected 1..4)");
+      int c = type == 1   ? 1
+              : type == 2 ? int(dim)
+              : type == 3 ? int(dim * (dim + 1) / 2)
+              : type == 4 ? int(dim * dim)
+                          : 0;
+      if (!c)
+        return fail(Status::Corrupt, t.at(t.pos) + ": solution type " + std::to_string(type) + " (expected 1..4)");
       comps.push_back(c);
       total += uint64_t(c);
     }
@@ -138,8 +145,10 @@ Result readSol(std::string_view sol, const std::string& label, uint32_t vertices
     for (ScalarField& f : fs) addField(mesh, std::move(f), report);
     any = true;
   }
-  if (!any) report.notes.push_back(label + " has no SolAtVertices: no fields from it");
-  else report.notes.push_back("read the fields of " + label + " (SolAtVertices)");
+  if (!any)
+    report.notes.push_back(label + " has no SolAtVertices: no fields from it");
+  else
+    report.notes.push_back("read the fields of " + label + " (SolAtVertices)");
   return Result::success();
 }
 
@@ -181,7 +190,8 @@ Result readMedit(std::string_view bytes, const std::string& label, std::string_v
     if (iequals(w, "Dimension")) {
       if (Result r = t.integer("the dimension", dim); !r) return r;
       if (dim != 3)
-        return fail(Status::Unsupported, t.at(p) + ": dimension " + std::to_string(dim) + "; tetstream reads 3D meshes");
+        return fail(Status::Unsupported,
+                    t.at(p) + ": dimension " + std::to_string(dim) + "; tetstream reads 3D meshes");
       continue;
     }
     const Keyword* k = keyword(w);
@@ -197,7 +207,8 @@ Result readMedit(std::string_view bytes, const std::string& label, std::string_v
     if (kw == "Vertices") {
       if (haveVertices) return fail(Status::Corrupt, t.at(p) + ": a second Vertices section");
       if (n > kMaxVertices)
-        return fail(Status::TooLarge, t.at(p) + ": " + std::to_string(n) + " vertices; tetstream indexes vertices with 32 bits");
+        return fail(Status::TooLarge,
+                    t.at(p) + ": " + std::to_string(n) + " vertices; tetstream indexes vertices with 32 bits");
       haveVertices = true;
       nv = n;
       mesh.positions.resize(3 * n);

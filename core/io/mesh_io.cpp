@@ -1,12 +1,12 @@
 #include "io/mesh_io.h"
 
+#include <algorithm>
 #include <bit>
 #include <cctype>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
-#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <limits>
@@ -202,8 +202,8 @@ Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const
     if (Result r = readHead(path, head); !r) return r;
     fmt = sniff(head, ext);
     if (fmt == Format::Unknown)
-      return fail(Status::Unsupported, path + ": unsupported mesh format '" + ext + "' (content not recognized); " +
-                                           kSupported);
+      return fail(Status::Unsupported,
+                  path + ": unsupported mesh format '" + ext + "' (content not recognized); " + kSupported);
   }
   if (!options.solution.empty() && fmt != Format::Plot3d && fmt != Format::Medit)
     return fail(Status::BadArgument, path + ": a solution file (--q " + options.solution +
@@ -267,19 +267,15 @@ namespace vtkio {
 size_t scalarSize(ScalarType t) {
   switch (t) {
     case ScalarType::Int8:
-    case ScalarType::UInt8:
-      return 1;
+    case ScalarType::UInt8: return 1;
     case ScalarType::Int16:
-    case ScalarType::UInt16:
-      return 2;
+    case ScalarType::UInt16: return 2;
     case ScalarType::Int32:
     case ScalarType::UInt32:
-    case ScalarType::Float32:
-      return 4;
+    case ScalarType::Float32: return 4;
     case ScalarType::Int64:
     case ScalarType::UInt64:
-    case ScalarType::Float64:
-      return 8;
+    case ScalarType::Float64: return 8;
   }
   return 1;
 }
@@ -320,26 +316,16 @@ template <class T>
 T loadAs(const uint8_t* src, size_t i, ScalarType t, bool be) {
   const uint8_t* p = src + i * scalarSize(t);
   switch (t) {
-    case ScalarType::Int8:
-      return T(int8_t(*p));
-    case ScalarType::UInt8:
-      return T(*p);
-    case ScalarType::Int16:
-      return T(int16_t(loadRaw<uint16_t>(p, be)));
-    case ScalarType::UInt16:
-      return T(loadRaw<uint16_t>(p, be));
-    case ScalarType::Int32:
-      return T(int32_t(loadRaw<uint32_t>(p, be)));
-    case ScalarType::UInt32:
-      return T(loadRaw<uint32_t>(p, be));
-    case ScalarType::Int64:
-      return T(int64_t(loadRaw<uint64_t>(p, be)));
-    case ScalarType::UInt64:
-      return T(loadRaw<uint64_t>(p, be));
-    case ScalarType::Float32:
-      return T(std::bit_cast<float>(loadRaw<uint32_t>(p, be)));
-    case ScalarType::Float64:
-      return T(std::bit_cast<double>(loadRaw<uint64_t>(p, be)));
+    case ScalarType::Int8: return T(int8_t(*p));
+    case ScalarType::UInt8: return T(*p);
+    case ScalarType::Int16: return T(int16_t(loadRaw<uint16_t>(p, be)));
+    case ScalarType::UInt16: return T(loadRaw<uint16_t>(p, be));
+    case ScalarType::Int32: return T(int32_t(loadRaw<uint32_t>(p, be)));
+    case ScalarType::UInt32: return T(loadRaw<uint32_t>(p, be));
+    case ScalarType::Int64: return T(int64_t(loadRaw<uint64_t>(p, be)));
+    case ScalarType::UInt64: return T(loadRaw<uint64_t>(p, be));
+    case ScalarType::Float32: return T(std::bit_cast<float>(loadRaw<uint32_t>(p, be)));
+    case ScalarType::Float64: return T(std::bit_cast<double>(loadRaw<uint64_t>(p, be)));
   }
   return T(0);
 }
@@ -405,7 +391,8 @@ int parseNextInt(std::string_view text, size_t& pos, int64_t& out) {
   size_t at = pos + (pos < text.size() && (text[pos] == '-' || text[pos] == '+'));
   const size_t digits = at;
   uint64_t value = 0;
-  for (; at < text.size() && at - digits < 18 && uint8_t(text[at] - '0') < 10; ++at) value = 10 * value + uint8_t(text[at] - '0');
+  for (; at < text.size() && at - digits < 18 && uint8_t(text[at] - '0') < 10; ++at)
+    value = 10 * value + uint8_t(text[at] - '0');
   if (at > digits && (at == text.size() || isSpace(text[at]))) {
     out = text[pos] == '-' ? -int64_t(value) : int64_t(value);
     pos = at;

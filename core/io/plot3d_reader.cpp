@@ -222,13 +222,15 @@ Result readPlot3d(std::string_view grid, const std::string& gridLabel, std::stri
       size_t e;
       double h[4];
       if (walkQ(grid, cand, b, e, h) && (e == grid.size() || zeroTail(grid, e)))
-        return fail(Status::Corrupt, gridLabel + ": not a 3D PLOT3D grid, but it reads as a PLOT3D Q (solution) file: "
-                                                 "give the grid file and name this one with --q");
+        return fail(Status::Corrupt, gridLabel +
+                                         ": not a 3D PLOT3D grid, but it reads as a PLOT3D Q (solution) file: "
+                                         "give the grid file and name this one with --q");
     }
     return fail(Status::Corrupt,
-                gridLabel + ": not a 3D PLOT3D grid: no layout (C binary or Fortran records, either byte order, "
-                            "float or double, single- or multi-grid, with or without IBLANK) has a header whose sizes "
-                            "add up to the file's " +
+                gridLabel +
+                    ": not a 3D PLOT3D grid: no layout (C binary or Fortran records, either byte order, "
+                    "float or double, single- or multi-grid, with or without IBLANK) has a header whose sizes "
+                    "add up to the file's " +
                     std::to_string(grid.size()) + " bytes (truncated or another format?)");
   }
   if (exact > 1 || (!exact && padded > 1))
@@ -313,8 +315,9 @@ Result readPlot3d(std::string_view grid, const std::string& gridLabel, std::stri
       report.notes.push_back("ignored " + std::to_string(q.size() - qend) + " zero bytes at the end of " + qLabel);
     Reader qr{q, QL};
     const size_t qreal = QL.doubles ? 8 : 4;
-    ScalarField density{"density", std::vector<float>(total)}, momentum{"momentum_magnitude", std::vector<float>(total)},
-        energy{"energy", std::vector<float>(total)}, pressure{"pressure", std::vector<float>(total)};
+    ScalarField density{"density", std::vector<float>(total)},
+        momentum{"momentum_magnitude", std::vector<float>(total)}, energy{"energy", std::vector<float>(total)},
+        pressure{"pressure", std::vector<float>(total)};
     constexpr double kGamma = 1.4;
     base = 0;
     for (const Block& b : qb) {
@@ -332,8 +335,8 @@ Result readPlot3d(std::string_view grid, const std::string& gridLabel, std::stri
     }
     for (ScalarField* f : {&density, &momentum, &energy, &pressure}) mesh.fields.push_back(std::move(*f));
     char buf[160];
-    std::snprintf(buf, sizeof buf, " (free-stream Mach %g, alpha %g, Re %g, time %g)", header[0], header[1],
-                  header[2], header[3]);
+    std::snprintf(buf, sizeof buf, " (free-stream Mach %g, alpha %g, Re %g, time %g)", header[0], header[1], header[2],
+                  header[3]);
     report.format += " + Q solution (" + QL.str(false) + ")";
     report.notes.push_back(std::string("PLOT3D Q") + buf +
                            ": fields density, momentum_magnitude (|rho u|), energy, and pressure derived as "

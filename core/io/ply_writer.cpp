@@ -2,13 +2,13 @@
 // buffer and faces in another, so the whole file is three fwrites.
 #include "io/ply_writer.h"
 
-#include "io/file_writer.h"
-
 #include <bit>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <vector>
+
+#include "io/file_writer.h"
 
 namespace tetstream {
 

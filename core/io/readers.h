@@ -9,8 +9,8 @@
 #include <string_view>
 #include <vector>
 
-#include "mesh.h"
 #include "io/mesh_io.h"
+#include "mesh.h"
 #include "status.h"
 
 namespace tetstream {
@@ -36,8 +36,8 @@ Result readGmsh(std::string_view bytes, const std::string& label, TetMesh& out, 
 
 // TetGen .node + .ele (either file's bytes may come first; `nodeLabel`/`eleLabel` name them).
 // Point attributes become fields attr0, attr1, ...; 0- or 1-based numbering; 4- or 10-node tets.
-Result readTetgen(std::string_view node, const std::string& nodeLabel, std::string_view ele, const std::string& eleLabel,
-                  TetMesh& out, ReadReport& report);
+Result readTetgen(std::string_view node, const std::string& nodeLabel, std::string_view ele,
+                  const std::string& eleLabel, TetMesh& out, ReadReport& report);
 
 // Medit .mesh (ASCII): Vertices, Tetrahedra, Hexahedra, Prisms, Pyramids, TetrahedraP2,
 // HexahedraQ2; `sol` (may be empty) is a sibling .sol file whose SolAtVertices become fields.
@@ -138,7 +138,7 @@ struct CellSoup {
   // Vertices some input cell lists (any node, also mid-edge nodes and nodes of skipped cells).
   // Readers that cannot leave a vertex out (structured grids) may leave it empty.
   std::vector<uint8_t> referenced;
-  uint64_t structuredCells = 0;   // hexahedra made from a structured grid (noted apart)
+  uint64_t structuredCells = 0;  // hexahedra made from a structured grid (noted apart)
 
   void add(CellShape shape, const uint32_t* ids, uint64_t sourceIndex) {
     shapes.push_back(uint8_t(shape));
@@ -160,10 +160,10 @@ struct CellArray {
 // What a VTK cell type is to the readers: its linear shape, the node count it must have (0: at
 // least the corners, for Lagrange/Bezier cells of any order), the corners it keeps.
 struct VtkCellInfo {
-  bool volume = false;   // a 3D cell tetstream reads
+  bool volume = false;  // a 3D cell tetstream reads
   CellShape shape = CellShape::Tet;
-  int nodes = 0;         // exact node count, or 0 for "at least kShapeCorners"
-  bool voxel = false;    // VTK_VOXEL: corners in (i, j, k) order, not around the faces
+  int nodes = 0;       // exact node count, or 0 for "at least kShapeCorners"
+  bool voxel = false;  // VTK_VOXEL: corners in (i, j, k) order, not around the faces
 };
 VtkCellInfo vtkCellInfo(int64_t type);
 
@@ -176,8 +176,8 @@ Result appendVtkCells(const std::string& where, std::span<const int64_t> connect
 
 // Adds `count` hexahedra of an ni x nj x nk structured grid (points numbered i fastest, starting
 // at vertexBase) to the soup; cell (i, j, k) has source index sourceBase + i + (ni-1)(j + (nj-1)k).
-// keepPoint, when given, has one flag per point (indexed like the mesh, vertexBase included): a cell with a point whose flag is 0 is left
-// out (PLOT3D IBLANK = 0). Returns the number of cells added.
+// keepPoint, when given, has one flag per point (indexed like the mesh, vertexBase included): a cell with a point whose
+// flag is 0 is left out (PLOT3D IBLANK = 0). Returns the number of cells added.
 uint64_t appendStructuredCells(uint64_t ni, uint64_t nj, uint64_t nk, uint64_t vertexBase, uint64_t sourceBase,
                                CellSoup& soup, const std::vector<uint8_t>* keepPoint = nullptr);
 
@@ -258,7 +258,6 @@ struct TextReader {
     return Result::success();
   }
 };
-
 
 // Caps on what a file may declare before we believe it.
 inline constexpr uint64_t kMaxComponents = 1024;  // per array tuple

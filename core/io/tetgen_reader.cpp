@@ -14,8 +14,8 @@ namespace tetstream {
 
 using namespace vtkio;
 
-Result readTetgen(std::string_view node, const std::string& nodeLabel, std::string_view ele, const std::string& eleLabel,
-                  TetMesh& out, ReadReport& report) {
+Result readTetgen(std::string_view node, const std::string& nodeLabel, std::string_view ele,
+                  const std::string& eleLabel, TetMesh& out, ReadReport& report) {
   out = TetMesh{};
   TextReader n{nodeLabel, node};
   int64_t count, dim, nattr, nmark;
@@ -42,11 +42,13 @@ Result readTetgen(std::string_view node, const std::string& nodeLabel, std::stri
     return fail(Status::Truncated, n.at(0) + ": declares " + std::to_string(count) + " points, more than a file of " +
                                        std::to_string(node.size()) + " bytes can hold");
   if (uint64_t(count) > kMaxVertices)
-    return fail(Status::TooLarge, n.at(0) + ": " + std::to_string(count) + " points; tetstream indexes vertices with 32 bits");
+    return fail(Status::TooLarge,
+                n.at(0) + ": " + std::to_string(count) + " points; tetstream indexes vertices with 32 bits");
   TetMesh mesh;
   mesh.positions.resize(3 * size_t(count));
   std::vector<ScalarField> attrs(static_cast<size_t>(nattr));
-  for (int64_t a = 0; a < nattr; ++a) attrs[size_t(a)] = {"attr" + std::to_string(a), std::vector<float>(size_t(count))};
+  for (int64_t a = 0; a < nattr; ++a)
+    attrs[size_t(a)] = {"attr" + std::to_string(a), std::vector<float>(size_t(count))};
   int64_t base = 0;
   for (int64_t i = 0; i < count; ++i) {
     n.skip();
@@ -55,7 +57,8 @@ Result readTetgen(std::string_view node, const std::string& nodeLabel, std::stri
     if (Result r = n.integer("point " + std::to_string(i) + "'s number", id); !r) return r;
     if (i == 0) {
       if (id != 0 && id != 1)
-        return fail(Status::Corrupt, n.at(p) + ": the first point is numbered " + std::to_string(id) + ", expected 0 or 1");
+        return fail(Status::Corrupt,
+                    n.at(p) + ": the first point is numbered " + std::to_string(id) + ", expected 0 or 1");
       base = id;
     }
     if (id != base + i)
@@ -126,8 +129,8 @@ Result readTetgen(std::string_view node, const std::string& nodeLabel, std::stri
   soup.inputCells = uint64_t(ntets);
   if (per == 10) soup.reduced["TetGen 10-node tetrahedron"] = {4, uint64_t(ntets)};
   if (nregion) report.notes.push_back("ignored the tetrahedra's region attributes");
-  report.format = std::string("TetGen .node/.ele (") + (base ? "1" : "0") + "-based, " + std::to_string(per) +
-                  "-node tetrahedra)";
+  report.format =
+      std::string("TetGen .node/.ele (") + (base ? "1" : "0") + "-based, " + std::to_string(per) + "-node tetrahedra)";
   if (Result r = finishMesh(nodeLabel, mesh, soup, {}, report); !r) return r;
   out = std::move(mesh);
   return Result::success();

@@ -23,7 +23,6 @@ namespace {
 
 using namespace vtkio;
 
-
 // VTK writes names with %XX escapes for spaces and other special characters.
 std::string decodeName(std::string_view s) {
   auto hex = [](char c) -> int {
@@ -145,8 +144,8 @@ struct Legacy {
   }
 
   void skipSpace() { vtkio::skipSpace(s, pos); }
-  std::string_view token() { return nextToken(s, pos); }         // empty at the end of the file
-  std::string_view restOfLine() { return nextLine(s, pos); }     // binary data starts after it
+  std::string_view token() { return nextToken(s, pos); }      // empty at the end of the file
+  std::string_view restOfLine() { return nextLine(s, pos); }  // binary data starts after it
 
   bool peekKeyword(const char* kw) {
     size_t save = pos;
@@ -335,8 +334,9 @@ struct Legacy {
     if (Result r = parseCount(a[0], p, std::string(kw).c_str(), n); !r) return r;
     if (Result r = parseType(a[1], p, t); !r) return r;
     if (haveDims && n != dims[k])
-      return error(Status::Corrupt, p,
-                   std::string(kw) + " has " + std::to_string(n) + " values, DIMENSIONS says " + std::to_string(dims[k]));
+      return error(
+          Status::Corrupt, p,
+          std::string(kw) + " has " + std::to_string(n) + " values, DIMENSIONS says " + std::to_string(dims[k]));
     if (n == 0) return error(Status::Corrupt, p, std::string(kw) + " is empty");
     return readValues<double>(t, n, std::string(kw), &axis[k]);
   }
@@ -430,8 +430,8 @@ struct Legacy {
     if (__builtin_mul_overflow(tuples, comps, &count))
       return error(Status::TooLarge, pos, what + ": value count overflows");
     const bool cellSection = section == Section::CellData;
-    bool keep = convertible && ((section == Section::PointData && tuples == pointCount) ||
-                                (cellSection && tuples == sectionCount));
+    bool keep = convertible &&
+                ((section == Section::PointData && tuples == pointCount) || (cellSection && tuples == sectionCount));
     if (!keep) {
       skippedArrays.push_back(what);
       return readValues<double>(t, count, what, nullptr);
@@ -440,7 +440,8 @@ struct Legacy {
     if (Result r = readValues<double>(t, count, what, &v); !r) return r;
     if (cellSection) {
       std::vector<float> scalars = tuplesToScalars(v, uint32_t(comps));
-      cellArrays.push_back({fieldNameFor(name, uint32_t(comps), report, "cell"), std::vector<double>(scalars.begin(), scalars.end())});
+      cellArrays.push_back(
+          {fieldNameFor(name, uint32_t(comps), report, "cell"), std::vector<double>(scalars.begin(), scalars.end())});
       return Result::success();
     }
     ScalarField f{fieldNameFor(name, uint32_t(comps), report), tuplesToScalars(v, uint32_t(comps))};
@@ -576,8 +577,9 @@ struct Legacy {
             "POINT_DATA " + std::to_string(sectionCount) + " but there are " + std::to_string(pointCount) + " points");
       const uint64_t cells = structured ? structuredCellCount() : cellCount;
       if (!pd && (haveCells || haveDims) && sectionCount != cells)
-        return error(Status::Corrupt, kp,
-                     "CELL_DATA " + std::to_string(sectionCount) + " but there are " + std::to_string(cells) + " cells");
+        return error(
+            Status::Corrupt, kp,
+            "CELL_DATA " + std::to_string(sectionCount) + " but there are " + std::to_string(cells) + " cells");
       section = pd ? Section::PointData : Section::CellData;
       return Result::success();
     }
@@ -646,7 +648,8 @@ struct Legacy {
     if (!haveDataset) return fail(Status::Truncated, label + ": file ends before DATASET");
     if (kind != Kind::Unstructured) {
       if (!haveDims) return fail(Status::Truncated, label + ": file ends before DIMENSIONS");
-      if (kind == Kind::StructuredGrid && !havePoints) return fail(Status::Truncated, label + ": file ends before POINTS");
+      if (kind == Kind::StructuredGrid && !havePoints)
+        return fail(Status::Truncated, label + ": file ends before POINTS");
       if (kind == Kind::Rectilinear)
         for (int k = 0; k < 3; ++k)
           if (axis[k].empty())
@@ -702,8 +705,8 @@ Result readLegacyVtk(std::string_view bytes, const std::string& label, TetMesh& 
           for (uint64_t i = 0; i < nx; ++i, ++v) {
             const uint64_t ijk[3] = {i, j, k};
             for (int c = 0; c < 3; ++c)
-              mesh.positions[3 * v + c] = float(lg.kind == Kind::Rectilinear ? lg.axis[c][ijk[c]]
-                                                                            : lg.origin[c] + lg.spacing[c] * double(ijk[c]));
+              mesh.positions[3 * v + c] = float(
+                  lg.kind == Kind::Rectilinear ? lg.axis[c][ijk[c]] : lg.origin[c] + lg.spacing[c] * double(ijk[c]));
           }
     }
     appendStructuredCells(nx, ny, nz, 0, 0, soup);

@@ -115,7 +115,8 @@ class ByteSource {
     const auto* text = reinterpret_cast<const unsigned char*>(data_.data());
     size_t done = 0;
     for (; n - done >= 3 && data_.size() - pos_ >= 4; done += 3, pos_ += 4) {
-      const uint32_t a = table[text[pos_]], b = table[text[pos_ + 1]], c = table[text[pos_ + 2]], d = table[text[pos_ + 3]];
+      const uint32_t a = table[text[pos_]], b = table[text[pos_ + 1]], c = table[text[pos_ + 2]],
+                     d = table[text[pos_ + 3]];
       if ((a | b | c | d) >= kPad) break;  // (each is below 64 or at least kPad)
       const uint32_t bits = a << 18 | b << 12 | c << 6 | d;
       dst[done] = uint8_t(bits >> 16);
@@ -178,7 +179,7 @@ struct Vtu {
   bool zlib = false;
   bool hasAppended = false;
   bool appendedBase64 = false;
-  std::string_view appended;        // after '_' up to </AppendedData>
+  std::string_view appended;  // after '_' up to </AppendedData>
   size_t fileBytes = 0;
   std::set<std::string> encodings;  // seen, for ReadReport::format
 };
@@ -546,8 +547,7 @@ Result readPiece(Vtu& vtu, GridKind kind, const Grid& whole, pugi::xml_node piec
   } else if (np > 0) {
     pugi::xml_node da = piece.child("Points").child("DataArray");
     ArrayRef ref{where, da ? da.attribute("Name").as_string("Points") : "Points"};
-    if (!da)
-      return fail(Status::Corrupt, where + ": " + std::to_string(np) + " points but no <Points> DataArray");
+    if (!da) return fail(Status::Corrupt, where + ": " + std::to_string(np) + " points but no <Points> DataArray");
     uint64_t comps;
     if (Result r = readComponents(da, ref, comps); !r) return r;
     if (comps != 3)
@@ -719,7 +719,8 @@ Result readVtu(std::string_view bytes, const std::string& label, TetMesh& out, R
                                          "' is not three finite numbers");
       if (grid.attribute("Direction") && !parseNumbers(grid.attribute("Direction").value(), 9, whole.direction))
         return fail(Status::Corrupt, label + ": ImageData Direction='" +
-                                         printable(grid.attribute("Direction").value()) + "' is not nine finite numbers");
+                                         printable(grid.attribute("Direction").value()) +
+                                         "' is not nine finite numbers");
     }
   }
   if (kind != GridKind::Unstructured && (whole.n(0) < 2 || whole.n(1) < 2 || whole.n(2) < 2))
@@ -782,8 +783,8 @@ Result readVtu(std::string_view bytes, const std::string& label, TetMesh& out, R
   std::string enc;
   for (const std::string& e : vtu.encodings) enc += (enc.empty() ? "" : ", ") + e;
   std::string dims = kind == GridKind::Unstructured ? std::string()
-                                                     : ", " + std::to_string(whole.n(0)) + "x" +
-                                                           std::to_string(whole.n(1)) + "x" + std::to_string(whole.n(2));
+                                                    : ", " + std::to_string(whole.n(0)) + "x" +
+                                                          std::to_string(whole.n(1)) + "x" + std::to_string(whole.n(2));
   report.format = "VTK XML " + type + " (" + (enc.empty() ? std::string("no arrays") : enc) +
                   (vtu.zlib ? ", zlib" : "") + (vtu.header64 ? ", UInt64 header" : ", UInt32 header") +
                   (vtu.bigEndian ? ", BigEndian" : "") + dims + ")";

@@ -1,8 +1,8 @@
 #include "chunk_encode.h"
 
-#include <cstring>
-
 #include <zstd.h>
+
+#include <cstring>
 
 #include "chunk.h"
 #include "hash.h"
@@ -10,8 +10,13 @@
 namespace tetstream {
 namespace {
 
-void putU16(std::vector<uint8_t>& b, uint16_t x) { b.push_back(uint8_t(x)); b.push_back(uint8_t(x >> 8)); }
-void putU32(std::vector<uint8_t>& b, uint32_t x) { for (int i = 0; i < 4; ++i) b.push_back(uint8_t(x >> (8 * i))); }
+void putU16(std::vector<uint8_t>& b, uint16_t x) {
+  b.push_back(uint8_t(x));
+  b.push_back(uint8_t(x >> 8));
+}
+void putU32(std::vector<uint8_t>& b, uint32_t x) {
+  for (int i = 0; i < 4; ++i) b.push_back(uint8_t(x >> (8 * i)));
+}
 template <typename T>
 void putArray(std::vector<uint8_t>& b, const std::vector<T>& a) {  // little-endian host (chunk.h)
   size_t at = b.size();

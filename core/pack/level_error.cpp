@@ -169,7 +169,8 @@ uint32_t LevelErrorMeter::acrossByStarsUncached(uint32_t t, int k) const {
   for (uint32_t corner : stars_->corners(a)) {
     const uint32_t u = corner >> 2;
     const uint32_t* w = &mesh_->tets[4 * size_t(u)];
-    if (u != t && (w[0] == b || w[1] == b || w[2] == b || w[3] == b) && (w[0] == c || w[1] == c || w[2] == c || w[3] == c))
+    if (u != t && (w[0] == b || w[1] == b || w[2] == b || w[3] == b) &&
+        (w[0] == c || w[1] == c || w[2] == c || w[3] == c))
       return u;
   }
   return kNone;
@@ -182,9 +183,7 @@ uint32_t LevelErrorMeter::acrossByStarsUncached(uint32_t t, int k) const {
 // v is outside the mesh after all, it takes the tet it is least outside of among those, the
 // walk's, and the tets around the corners of the best of these: often much nearer than the
 // walk's own where a coarse level cuts across a curved boundary (around holes).
-LevelErrorMeter::Found LevelErrorMeter::locateAgain(Scratch& s, uint32_t v) const {
-  return nearby(s, v, walk(s, v));
-}
+LevelErrorMeter::Found LevelErrorMeter::locateAgain(Scratch& s, uint32_t v) const { return nearby(s, v, walk(s, v)); }
 
 LevelErrorMeter::Found LevelErrorMeter::nearby(Scratch& s, uint32_t v, Found found) const {
   if (!found.outside || found.tet == kNone) return found;
@@ -315,8 +314,10 @@ LevelError LevelErrorMeter::current(const TetMesh& level, const StarPool& stars,
   for (uint32_t input : restored_) {
     levelOf_[input] = uint32_t(inputOf_.size());
     inputOf_.push_back(input);
-    if (std::isfinite(samples_[input].value)) becomeVertex(input, uint32_t(inputOf_.size() - 1));
-    else samples_[input].tet = kNone;
+    if (std::isfinite(samples_[input].value))
+      becomeVertex(input, uint32_t(inputOf_.size() - 1));
+    else
+      samples_[input].tet = kNone;
   }
   restored_.clear();
   for (uint32_t j : revalued_)

@@ -48,7 +48,8 @@ class LevelErrorMeter {
   // After applySplit() restored input vertex `input` next to level vertex j, moving the listed
   // tets from j to the new vertex (`stars`: the level's). When the split gave p_j a value back,
   // every tet around j interpolates anew. Only notes what changed.
-  void afterSplit(uint32_t input, uint32_t j, std::span<const uint32_t> moved, const StarPool& stars, bool jValueChanged);
+  void afterSplit(uint32_t input, uint32_t j, std::span<const uint32_t> moved, const StarPool& stars,
+                  bool jValueChanged);
 
   // The error of the level now: `level` is the mesh the splits were applied to (begin()'s, or a
   // copy of it that went on), `stars` its vertices' tets. On two threads when `threads` > 1 and
@@ -57,7 +58,8 @@ class LevelErrorMeter {
 
  private:
   static constexpr uint32_t kNone = ~uint32_t(0);
-  static constexpr uint32_t kVertex = kNone - 1;  // Sample::tet of an input vertex that is a level vertex (kNone: unplaced)
+  static constexpr uint32_t kVertex =
+      kNone - 1;  // Sample::tet of an input vertex that is a level vertex (kNone: unplaced)
   // A point counts as inside a tet when its smallest coordinate is at least this: points on a
   // face (every input vertex on the boundary of a box) are not outside by round-off.
   static constexpr double kInside = -1e-9;
@@ -123,14 +125,14 @@ class LevelErrorMeter {
     uint32_t tet;       // its tet in the level mesh, kVertex, or kNone (not measured)
   };
   std::vector<Sample> samples_;
-  std::vector<uint8_t> outside_;       // per input vertex: outside the level mesh (clamped)
-  const TetMesh* mesh_ = nullptr;      // the level mesh
-  const StarPool* stars_ = nullptr;    // its vertices' tets
+  std::vector<uint8_t> outside_;     // per input vertex: outside the level mesh (clamped)
+  const TetMesh* mesh_ = nullptr;    // the level mesh
+  const StarPool* stars_ = nullptr;  // its vertices' tets
   size_t field_ = 0;
   const std::vector<float>& levelValues() const { return mesh_->fields[field_].values; }
-  std::vector<uint32_t> inputOf_;      // per level vertex: the input vertex it is
-  std::vector<uint32_t> levelOf_;      // per input vertex: the level vertex it is, or kNone
-  std::span<const uint32_t> intoOf_;   // per input vertex: the one it was collapsed into (begin())
+  std::vector<uint32_t> inputOf_;     // per level vertex: the input vertex it is
+  std::vector<uint32_t> levelOf_;     // per input vertex: the level vertex it is, or kNone
+  std::span<const uint32_t> intoOf_;  // per input vertex: the one it was collapsed into (begin())
   // What the splits since the last measurement changed (afterSplit(), which may run while begin()
   // does): the input vertices they restored, in level vertex order; the level vertices given a
   // new value; per level tet, whether its input vertices are to be tested again.

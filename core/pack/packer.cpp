@@ -1,7 +1,6 @@
 #include "packer.h"
 
 #include <unistd.h>
-#include <cstdio>
 
 #include <algorithm>
 #include <chrono>
@@ -45,8 +44,7 @@ double msSince(std::chrono::steady_clock::time_point t0) {
 uint64_t snapPositions(const TetMesh& mesh, const Manifest& m, std::vector<float>& snapped) {
   const Quantizer q = makeQuantizer(m);
   snapped.resize(mesh.positions.size());
-  for (size_t k = 0; k < snapped.size(); ++k)
-    snapped[k] = q.position[k % 3].snap(mesh.positions[k]);
+  for (size_t k = 0; k < snapped.size(); ++k) snapped[k] = q.position[k % 3].snap(mesh.positions[k]);
   uint64_t broken = 0;
   for (uint32_t t = 0; t < mesh.tetCount(); ++t) {
     const uint32_t* v = &mesh.tets[4 * size_t(t)];
@@ -115,8 +113,10 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   if (report.fatal()) {
     std::string why;
     for (const std::string& f : report.findings) why += (why.empty() ? "" : "; ") + f;
-    Status s = report.noTets ? Status::NoTets : report.outOfRangeIndices ? Status::OutOfRange
-             : report.nonFinitePositions ? Status::NonFinite : Status::Corrupt;
+    Status s = report.noTets               ? Status::NoTets
+               : report.outOfRangeIndices  ? Status::OutOfRange
+               : report.nonFinitePositions ? Status::NonFinite
+                                           : Status::Corrupt;
     return fail(s, "cannot pack this mesh: " + why);
   }
   if (mesh.fields.empty()) return fail(Status::MissingField, "the mesh has no point scalar field to show");
@@ -147,8 +147,10 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
     summary.notes.push_back("re-oriented " + std::to_string(summary.flippedTets) + " negatively oriented tetrahedra");
   if (renumber) {
     char note[160];
-    std::snprintf(note, sizeof note, "renumbered vertices and tetrahedra for speed: the file's numbering scatters "
-                  "neighbours (a tetrahedron's vertex ids span %.0f%% of them, median)", 100 * spread);
+    std::snprintf(note, sizeof note,
+                  "renumbered vertices and tetrahedra for speed: the file's numbering scatters "
+                  "neighbours (a tetrahedron's vertex ids span %.0f%% of them, median)",
+                  100 * spread);
     summary.notes.push_back(note);
   }
 
@@ -198,8 +200,9 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   so.recordReadSets = opt.orderSplits;
   so.maxError = opt.maxError;
   so.targetTets = opt.baseTets;
-  so.targetVertices = opt.baseVertices ? opt.baseVertices
-                                       : uint32_t(std::llround(std::clamp(opt.baseFraction, 0.0, 1.0) * mesh.vertexCount()));
+  so.targetVertices = opt.baseVertices
+                          ? opt.baseVertices
+                          : uint32_t(std::llround(std::clamp(opt.baseFraction, 0.0, 1.0) * mesh.vertexCount()));
   // A fraction of a small mesh would leave a base too coarse to show anything: keep a floor.
   if (!opt.baseVertices && opt.baseFraction > 0)
     so.targetVertices = std::max(so.targetVertices, std::min(opt.minBaseVertices, mesh.vertexCount()));
@@ -249,7 +252,8 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   if (std::isfinite(opt.maxError) && base.fieldMax >= 0 && range.max > range.min &&
       base.fieldMax > opt.maxError * (range.max - range.min)) {
     char buf[256];
-    std::snprintf(buf, sizeof buf, "the base's largest field error measured at the input's vertices, %.3g of the range, "
+    std::snprintf(buf, sizeof buf,
+                  "the base's largest field error measured at the input's vertices, %.3g of the range, "
                   "is above --max-error %.3g (the simplifier's estimate per collapse stayed within it)",
                   base.fieldMax / (range.max - range.min), opt.maxError);
     summary.notes.push_back(buf);

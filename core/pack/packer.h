@@ -15,24 +15,24 @@
 namespace tetstream {
 
 struct PackOptions {
-  std::string field;     // field that steers simplification and is shown first; "" = first field
-  std::string name;      // dataset name; "" = mesh.name
-  int zstdLevel = 18;  // higher levels take much longer for hardly fewer bytes
+  std::string field;                        // field that steers simplification and is shown first; "" = first field
+  std::string name;                         // dataset name; "" = mesh.name
+  int zstdLevel = 18;                       // higher levels take much longer for hardly fewer bytes
   double weights[3] = {100.0, 1.0, 0.005};  // geometry, field, shape (simplify.h)
-  double baseFraction = 0.01;             // base mesh size as a fraction of the vertices...
-  uint32_t baseVertices = 0;              // ...or as a vertex count (wins when non-zero)
-  uint32_t minBaseVertices = 256;         // floor for the fraction rule on small meshes
-  uint32_t baseTets = 0;                  // stop earlier once the base has this many tets
+  double baseFraction = 0.01;               // base mesh size as a fraction of the vertices...
+  uint32_t baseVertices = 0;                // ...or as a vertex count (wins when non-zero)
+  uint32_t minBaseVertices = 256;           // floor for the fraction rule on small meshes
+  uint32_t baseTets = 0;                    // stop earlier once the base has this many tets
   double maxError = std::numeric_limits<double>::infinity();  // stop at this field error (SimplifyOptions)
-  bool lossless = false;                  // keep float32 values in split records
-  bool fitValues = true;                  // coarse levels get fitted values (SimplifyOptions::fitValues)
-  uint32_t chunkKb = 256;                 // largest split chunk, compressed
-  bool ringWalk = true;                   // rings as walks in p_j's link (StreamOptions::ringWalk)
-  bool orderSplits = false;               // splits by kept vertex inside each chunk (pack --compact)
-  double maxMemoryBytes = 0;              // refuse meshes that need more (0: 90% of physical memory)
-  int threads = 2;                        // threads that evaluate collapse costs and measure levels (1 or 2; same output)
+  bool lossless = false;                                      // keep float32 values in split records
+  bool fitValues = true;             // coarse levels get fitted values (SimplifyOptions::fitValues)
+  uint32_t chunkKb = 256;            // largest split chunk, compressed
+  bool ringWalk = true;              // rings as walks in p_j's link (StreamOptions::ringWalk)
+  bool orderSplits = false;          // splits by kept vertex inside each chunk (pack --compact)
+  double maxMemoryBytes = 0;         // refuse meshes that need more (0: 90% of physical memory)
+  int threads = 2;                   // threads that evaluate collapse costs and measure levels (1 or 2; same output)
   uint32_t slabMinVertices = 10000;  // simplify in slabs at once from this size (SimplifyOptions)
-  uint32_t renumberMinTets = 50000;       // renumber scattered meshes from this size (pack/renumber.h)
+  uint32_t renumberMinTets = 50000;  // renumber scattered meshes from this size (pack/renumber.h)
   // Progress for displays: phase ("validate", "simplify", "encode", "write"), items done and
   // planned in that phase (collapses, splits; 0 planned when not countable).
   std::function<void(const char* phase, uint64_t done, uint64_t planned)> progress;
@@ -40,15 +40,15 @@ struct PackOptions {
 
 struct PackSummary {
   Manifest manifest;
-  uint64_t flippedTets = 0;          // negatively oriented tets re-oriented (FORMAT.md §3)
+  uint64_t flippedTets = 0;  // negatively oriented tets re-oriented (FORMAT.md §3)
   uint32_t baseVertices = 0, baseTets = 0, splits = 0;
   uint32_t flatTetsRemoved = 0, flatTetsLeft = 0;
-  uint32_t movedMasks = 0;           // splits that carry a mask of T_moved (it does not follow from T_new)
+  uint32_t movedMasks = 0;  // splits that carry a mask of T_moved (it does not follow from T_new)
   uint64_t queuePops = 0, requeued = 0, costEvaluations = 0;  // simplifier work, for benchmarks
-  uint32_t slabCollapses = 0;      // of the collapses, those made in slabs at once (the parallel phase)
-  std::string stopReason;            // why simplification stopped
+  uint32_t slabCollapses = 0;  // of the collapses, those made in slabs at once (the parallel phase)
+  std::string stopReason;      // why simplification stopped
   double prepareMs = 0, simplifyMs = 0, encodeMs = 0, writeMs = 0;  // prepare: checks, orientation, grid
-  std::vector<std::string> notes;    // what the packer changed or found, in plain words
+  std::vector<std::string> notes;                                   // what the packer changed or found, in plain words
 };
 
 // Validates and packs `mesh` into `outDir` (created if missing). The manifest is written last

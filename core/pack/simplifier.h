@@ -21,9 +21,9 @@
 
 #include "adjacency.h"
 #include "pack/quadric.h"
+#include "simplify.h"
 #include "tet_quality.h"
 #include "tet_tables.h"
-#include "simplify.h"
 
 namespace tetstream {
 
@@ -51,7 +51,7 @@ Result simplifyMeshTuned(const TetMesh& mesh, const SimplifyOptions& options, Si
 namespace tetstream::simplify_detail {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr uint32_t kOmega = 0xfffffffeu;   // the virtual vertex the boundary is coned to
+constexpr uint32_t kOmega = 0xfffffffeu;  // the virtual vertex the boundary is coned to
 constexpr double kFlat = 1e-7;            // |6V| <= kFlat * (longest edge)^3 counts as flat
 constexpr float kKappaCap = 1e4f;         // κ of flat tets, capped so averages stay finite
 
@@ -75,9 +75,15 @@ template <typename T>
 size_t intersectionSize(const std::vector<T>& a, const std::vector<T>& b) {
   size_t n = 0;
   for (size_t x = 0, y = 0; x < a.size() && y < b.size();) {
-    if (a[x] < b[y]) ++x;
-    else if (b[y] < a[x]) ++y;
-    else { ++n; ++x; ++y; }
+    if (a[x] < b[y])
+      ++x;
+    else if (b[y] < a[x])
+      ++y;
+    else {
+      ++n;
+      ++x;
+      ++y;
+    }
   }
   return n;
 }
@@ -163,24 +169,24 @@ class Simplifier {
   // the determinant is g·(P − x0) (newDet), and κ's edge and face terms without P are fixed.
   struct StarTet {
     uint32_t t;
-    uint32_t other[3];        // the vertices besides i, in slot order
-    uint64_t mask;            // bitOf() their places in Scratch::nbr (see removes())
-    double g[3];              // det of the new tet with P in the slot of i: g·(P − x[0]) (newDet)
-    double detOld;            // det with p_i (numerator for the slot of i)
+    uint32_t other[3];             // the vertices besides i, in slot order
+    uint64_t mask;                 // bitOf() their places in Scratch::nbr (see removes())
+    double g[3];                   // det of the new tet with P in the slot of i: g·(P − x[0]) (newDet)
+    double detOld;                 // det with p_i (numerator for the slot of i)
     double fixedEdges, fixedFace;  // κ's terms of the edges and the face without p_i
-    double x[3][3];           // positions of the other vertices
-    double sign;              // orientation sign of the slot of i
-    float f[3];               // field at the other vertices
-    float kappa;              // κ of the tet now
-    double quality;           // 3/κ now
+    double x[3][3];                // positions of the other vertices
+    double sign;                   // orientation sign of the slot of i
+    float f[3];                    // field at the other vertices
+    float kappa;                   // κ of the tet now
+    double quality;                // 3/κ now
   };
 
   // A candidate's cost is refined in stages while it could still be the cheapest
   // (cheapestCandidate): each stage's cost is a lower bound of the next one's.
   struct Candidate {
     enum Stage : uint8_t { Bound, Local, Exact };
-    double cost;     // exact, or a lower bound until stage Exact
-    double base;     // the cost without the shape term
+    double cost;                                // exact, or a lower bound until stage Exact
+    double base;                                // the cost without the shape term
     double sj, region, eg, weight, shapeBound;  // parts of the cost (boundTerms)
     double perTets;  // the factor for the tets it removes (SimplifyTuning::removedTetsExponent)
     uint32_t j;
@@ -192,14 +198,14 @@ class Simplifier {
   // Scratch for evaluating one vertex's out-edges; one per thread.
   struct Scratch {
     std::vector<StarTet> star;
-    uint32_t center = 0;  // the vertex of star
-    double flatBound = 0;  // see prepareStar
-    double qualityFloor = 0;  // the least 3/κ a changed tet may have (see prepareStar)
+    uint32_t center = 0;         // the vertex of star
+    double flatBound = 0;        // see prepareStar
+    double qualityFloor = 0;     // the least 3/κ a changed tet may have (see prepareStar)
     uint64_t boundaryEdges = 0;  // bitOf() the neighbours joined to the vertex by a boundary edge
-    double removedQuality = 0;  // of the last legal() candidate: Σ 3/κ of the tets it removes
-    int removed = 0;            // ... and their count
+    double removedQuality = 0;   // of the last legal() candidate: Σ 3/κ of the tets it removes
+    int removed = 0;             // ... and their count
     std::vector<uint32_t> nbr;
-    struct Passed {  // an out-edge that passed legal(), with what legal() found of it
+    struct Passed {    // an out-edge that passed legal(), with what legal() found of it
       uint32_t place;  // in nbr
       int removed;
       double removedQuality;
@@ -226,7 +232,11 @@ class Simplifier {
     std::vector<uint8_t> values;
     uint32_t stamp = 0, count = 0;
     void beginSet(uint32_t s) {
-      if (keys.empty()) { keys.resize(512); stamps.assign(512, 0); values.resize(512); }
+      if (keys.empty()) {
+        keys.resize(512);
+        stamps.assign(512, 0);
+        values.resize(512);
+      }
       stamp = s;
       count = 0;
     }
@@ -243,7 +253,11 @@ class Simplifier {
     void mark(uint64_t key, uint8_t value) {
       if (2 * (count + 1) > keys.size()) grow();
       size_t k = slot(key);
-      if (stamps[k] != stamp) { stamps[k] = stamp; keys[k] = key; ++count; }
+      if (stamps[k] != stamp) {
+        stamps[k] = stamp;
+        keys[k] = key;
+        ++count;
+      }
       values[k] = value;
     }
     void grow() {
@@ -269,18 +283,18 @@ class Simplifier {
   // What the collapse loop works with (a queue and its log, not a thread): the queue of the whole
   // mesh, or of one slab in the parallel phase (runSlabs), with its own log and scratch.
   struct Queue {
-    int slab = -1;          // -1: the whole mesh; else the slab
+    int slab = -1;  // -1: the whole mesh; else the slab
     Heap heap;
-    CollapseLog ownLog;     // a slab's collapses in this round (merged into out_.log after it)
+    CollapseLog ownLog;  // a slab's collapses in this round (merged into out_.log after it)
     CollapseLog* log = &ownLog;
-    std::vector<float> keys;  // a slab's collapses: the queue key each was taken at
-    Scratch* scratch = nullptr;  // link condition and collapse (and a slab's evaluations): its thread's
+    std::vector<float> keys;             // a slab's collapses: the queue key each was taken at
+    Scratch* scratch = nullptr;          // link condition and collapse (and a slab's evaluations): its thread's
     std::atomic<uint32_t> collapsed{0};  // (read by the progress report on the other thread)
     uint32_t tetsRemoved = 0;
     uint64_t pops = 0, requeued = 0, rejectedByLink = 0, flatTetsRemoved = 0, linkMismatches = 0;
     bool errorBound = false;
     std::vector<uint32_t> touched, around;
-    CollapseTets record;    // the tets of the collapse being made
+    CollapseTets record;  // the tets of the collapse being made
     std::vector<uint64_t> linkEdges, edgeLink;
     EdgeTable edgeTable;
     uint32_t edgeTableStamp = 0;
@@ -444,7 +458,7 @@ class Simplifier {
   const SimplifyOptions& opt_;
   SimplifyTuning& tune_;
   SimplifyResult& out_;
-  FaceAdjacency* adjacency_;  // the caller's, taken over by init() (or none)
+  FaceAdjacency* adjacency_;         // the caller's, taken over by init() (or none)
   std::vector<uint32_t>* takeTets_;  // mesh_.tets, taken over by init() (or none: copied)
   uint32_t V_ = 0, T_ = 0, alive_ = 0, tetsAlive_ = 0, flatInput_ = 0;
   const float* field_ = nullptr;
@@ -472,9 +486,9 @@ class Simplifier {
   }
   std::vector<float> kappa_, lastCost_;
   std::vector<FieldQuadric> fieldQuadric_;  // (its weight: the input volume a vertex stands for, a quarter of each tet)
-  double meanVertexVolume_ = 1;              // the unit of the volume measure (init(), boundTerms())
-  std::vector<double> qualitySum_;  // per vertex: Σ 3/κ over its star
-  std::vector<uint8_t> queued_;  // per vertex: has an entry in the queue (or in the current round)
+  double meanVertexVolume_ = 1;             // the unit of the volume measure (init(), boundTerms())
+  std::vector<double> qualitySum_;          // per vertex: Σ 3/κ over its star
+  std::vector<uint8_t> queued_;             // per vertex: has an entry in the queue (or in the current round)
   Scratch mainScratch_;
   std::vector<Scratch> scratches_;  // one per entry of a round (and per thread in init() and runSlabs())
   // The one queue's scratches (all but the two of the first costs and the slabs) get their
@@ -489,9 +503,9 @@ class Simplifier {
   std::vector<uint32_t> changed_;  // per vertex: roundStamp_ of the last round that touched it
   bool trackChanges_ = false;      // collapses keep changed_ (the one queue's rounds of several)
   uint32_t roundStamp_ = 0;
-  Queue main_;     // the one queue of the whole mesh (its log is out_.log)
-  Queue slabs_[kMaxSlabs];  // the slabs of the parallel phase
-  float slack_ = 1.0f;  // see tryCollapse
+  Queue main_;                  // the one queue of the whole mesh (its log is out_.log)
+  Queue slabs_[kMaxSlabs];      // the slabs of the parallel phase
+  float slack_ = 1.0f;          // see tryCollapse
   std::vector<uint8_t> inner_;  // per vertex: every neighbour is in its slab (runSlabs)
 };
 

@@ -64,7 +64,9 @@ Result Simplifier::run() {
   if (trackChanges_) changed_.assign(V_, 0);
   WorkPool pool(parallel ? 1 : 0);
   auto evaluateTask = [this](uint32_t k) { evaluateVertex(scratches_[k], round_[k].vertex); };
-  auto goOn = [&] { return alive_ - Q.collapsed > target && tetsAlive_ - Q.tetsRemoved > opt_.targetTets && !Q.errorBound; };
+  auto goOn = [&] {
+    return alive_ - Q.collapsed > target && tetsAlive_ - Q.tetsRemoved > opt_.targetTets && !Q.errorBound;
+  };
   while (goOn()) {
     round_.clear();
     Entry e;

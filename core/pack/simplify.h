@@ -75,9 +75,9 @@ struct SimplifyOptions {
   // Stop when the collapse next in line would leave a field error E_f (relative to the field's
   // range) above this.
   double maxError = std::numeric_limits<double>::infinity();
-  int field = 0;                // index of the field that steers the field error
-  double minQuality = 0.02;     // 3/κ of every tet a collapse changes must stay at or above this
-                                // (or at the worst 3/κ of the star before it, when that is lower)
+  int field = 0;             // index of the field that steers the field error
+  double minQuality = 0.02;  // 3/κ of every tet a collapse changes must stay at or above this
+                             // (or at the worst 3/κ of the star before it, when that is lower)
   // After each collapse the kept vertex takes the value of the steering field that fits the
   // original field over everything it stands for (field quadric minimum at p_j); the log keeps
   // the values before, so splits restore them exactly. Off: every vertex keeps its sample.
@@ -103,18 +103,18 @@ struct SimplifyOptions {
 
 struct SimplifyResult {
   CollapseLog log;
-  std::vector<uint32_t> tets;      // 4 per original tet, current vertices (valid where tetAlive)
-  std::vector<uint8_t> tetAlive;   // 1 per original tet
+  std::vector<uint32_t> tets;     // 4 per original tet, current vertices (valid where tetAlive)
+  std::vector<uint8_t> tetAlive;  // 1 per original tet
   std::vector<uint8_t> vertexAlive;
-  std::vector<float> values;       // the steering field per vertex at the end (fitted values)
-  int valuesField = -1;            // the index of that field in the mesh
+  std::vector<float> values;            // the steering field per vertex at the end (fitted values)
+  int valuesField = -1;                 // the index of that field in the mesh
   uint32_t vertices = 0, tetCount = 0;  // counts of the base mesh
-  uint32_t flatTetsRemoved = 0;    // input tets with zero volume that the collapses removed
+  uint32_t flatTetsRemoved = 0;         // input tets with zero volume that the collapses removed
   uint32_t flatTetsLeft = 0;
   uint64_t costEvaluations = 0, rejectedByLink = 0;
   uint64_t queuePops = 0, requeued = 0;  // pops of current entries, and those pushed back costlier
-  uint32_t slabCollapses = 0;          // collapses made in the slabs at once (slabMinVertices)
-  std::string stopReason;          // "target reached", "no legal collapse left", "error bound"
+  uint32_t slabCollapses = 0;            // collapses made in the slabs at once (slabMinVertices)
+  std::string stopReason;                // "target reached", "no legal collapse left", "error bound"
 };
 
 // Why a single collapse is or is not allowed (for tests and diagnostics).

@@ -40,7 +40,10 @@ void Simplifier::prepareStar(Scratch& sc, uint32_t i) {
     worstKappa = std::max(worstKappa, st.kappa);
     int si = 0, m = 0;
     for (int k = 0; k < 4; ++k) {
-      if (v[k] == i) { si = k; continue; }
+      if (v[k] == i) {
+        si = k;
+        continue;
+      }
       const Point q = p(v[k]);
       st.other[m] = v[k];
       st.mask |= bitOf(sc.place[v[k]]);
@@ -71,7 +74,8 @@ void Simplifier::prepareStar(Scratch& sc, uint32_t i) {
       hi[a] = std::max(hi[a], q[a]);
     }
   }
-  const double diam2 = (hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]);
+  const double diam2 =
+      (hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]);
   sc.flatBound = kFlat * diam2 * std::sqrt(diam2);
   // A changed tet must reach the minimum quality, or else be no worse than the worst tet of
   // the star now: real meshes (boundary layers of CFD grids) start with tets far below any
@@ -110,7 +114,8 @@ bool Simplifier::legal(Scratch& sc, uint32_t i, uint32_t j, uint64_t bit, Collap
 // Everything of the cost but the local field error and the exact shape term: the geometric
 // error, the region term of the field error and a lower bound of the shape term.
 // (removed, removedQuality: what legal() found of the tets the collapse removes.)
-Simplifier::Candidate Simplifier::boundTerms(Scratch& sc, uint32_t i, uint32_t j, uint64_t bit, int removed, double removedQuality) {
+Simplifier::Candidate Simplifier::boundTerms(Scratch& sc, uint32_t i, uint32_t j, uint64_t bit, int removed,
+                                             double removedQuality) {
   const Point P = p(j);
   Candidate c;
   c.j = j;
@@ -152,7 +157,7 @@ Simplifier::Candidate Simplifier::boundTerms(Scratch& sc, uint32_t i, uint32_t j
   c.shapeBound = after > 0 ? std::max(0.0, 1.0 - (qualitySum_[j] - removedQuality + moved) / after) : 0.0;
   // Per tet removed (simplify.h); legal() counted them (at least the one tet of the edge).
   c.perTets = tune_.removedTetsExponent == 0.5 ? 1.0 / std::sqrt(double(std::max(removed, 1)))
-                                              : std::pow(double(std::max(removed, 1)), -tune_.removedTetsExponent);
+                                               : std::pow(double(std::max(removed, 1)), -tune_.removedTetsExponent);
   setCost(c, 0.0);  // a lower bound: the local error is at least 0 (rounding is monotone)
   c.stage = Candidate::Bound;
   return c;
@@ -274,8 +279,10 @@ int Simplifier::cheapestCandidate(Scratch& sc, uint32_t i) {
     Candidate& b = sc.candidates[size_t(best)];
     if (b.stage == Candidate::Exact) return best;
     CollapseVerdict v;
-    if (b.stage == Candidate::Bound) localTerm(sc, i, b);
-    else if (!finishCost(sc, b, &v)) sc.candidates.erase(sc.candidates.begin() + best);
+    if (b.stage == Candidate::Bound)
+      localTerm(sc, i, b);
+    else if (!finishCost(sc, b, &v))
+      sc.candidates.erase(sc.candidates.begin() + best);
   }
 }
 

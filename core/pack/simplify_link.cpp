@@ -15,10 +15,14 @@ bool hasTriangle(const std::vector<uint64_t>& edges) {
       ends(edges[y], c, d);
       // Sharing one end, the other two ends must be joined too.
       uint32_t p = ~0u, q = ~0u;
-      if (a == c) p = b, q = d;
-      else if (a == d) p = b, q = c;
-      else if (b == c) p = a, q = d;
-      else if (b == d) p = a, q = c;
+      if (a == c)
+        p = b, q = d;
+      else if (a == d)
+        p = b, q = c;
+      else if (b == c)
+        p = a, q = d;
+      else if (b == d)
+        p = a, q = c;
       if (p == ~0u || p == q) continue;
       const uint64_t third = edgeKey(p, q);
       for (size_t z = 0; z < edges.size(); ++z)
@@ -31,7 +35,8 @@ bool hasTriangle(const std::vector<uint64_t>& edges) {
 
 // Lk(i) ∩ Lk(j) = Lk(ij) with the boundary coned to kOmega: vertices and edges of the two
 // links meet exactly in the link of the edge, and no triangle is in both.
-void Simplifier::gatherLink(uint32_t v, std::vector<uint32_t>& verts, std::vector<uint64_t>& edges, std::vector<Tri>& tris) {
+void Simplifier::gatherLink(uint32_t v, std::vector<uint32_t>& verts, std::vector<uint64_t>& edges,
+                            std::vector<Tri>& tris) {
   verts.clear();
   edges.clear();
   tris.clear();
@@ -40,8 +45,10 @@ void Simplifier::gatherLink(uint32_t v, std::vector<uint32_t>& verts, std::vecto
     uint32_t o[3];
     int n = 0, sv = 0;
     for (int k = 0; k < 4; ++k) {
-      if (x[k] == v) sv = k;
-      else o[n++] = x[k];
+      if (x[k] == v)
+        sv = k;
+      else
+        o[n++] = x[k];
     }
     verts.insert(verts.end(), o, o + 3);
     edges.push_back(edgeKey(o[0], o[1]));
@@ -72,12 +79,12 @@ void Simplifier::gatherLink(uint32_t v, std::vector<uint32_t>& verts, std::vecto
 bool Simplifier::linkCondition(Queue& Q, uint32_t i, uint32_t j) {
   const bool verify = tune_.verifyLinkCondition;
   const bool reference = verify && linkConditionBySorting(i, j);
-#define TS_LINK_RESULT(x)                                              \
-do {                                                                 \
-  const bool result_ = (x);                                          \
-  if (verify && result_ != reference) ++Q.linkMismatches;            \
-  return result_;                                                    \
-} while (0)
+#define TS_LINK_RESULT(x)                                   \
+  do {                                                      \
+    const bool result_ = (x);                               \
+    if (verify && result_ != reference) ++Q.linkMismatches; \
+    return result_;                                         \
+  } while (0)
   Scratch& sc = *Q.scratch;
   auto hasBoundaryFace = [&](uint32_t v) {
     bool any = false;
@@ -104,16 +111,22 @@ do {                                                                 \
   bool boundaryEdge = false;
   uint32_t stampE = ++sc.stamp;
   Q.edgeLink.clear();
-  forEdgeLink(i, j, [&](const uint32_t o[2]) {
-    for (int k = 0; k < 2; ++k)
-      if (sc.seen[o[k]] != stampE) { sc.seen[o[k]] = stampE; ++edgeVerts; }
-    ++edgeEdges;  // each tet around the edge has its own opposite edge
-    Q.edgeLink.push_back(edgeKey(o[0], o[1]));
-  }, [&](uint32_t k) {
-    boundaryEdge = true;
-    ++edgeEdges;  // (k, ω) for the boundary face (i, j, k): one per face
-    Q.edgeLink.push_back(edgeKey(k, kOmega));
-  });
+  forEdgeLink(
+      i, j,
+      [&](const uint32_t o[2]) {
+        for (int k = 0; k < 2; ++k)
+          if (sc.seen[o[k]] != stampE) {
+            sc.seen[o[k]] = stampE;
+            ++edgeVerts;
+          }
+        ++edgeEdges;  // each tet around the edge has its own opposite edge
+        Q.edgeLink.push_back(edgeKey(o[0], o[1]));
+      },
+      [&](uint32_t k) {
+        boundaryEdge = true;
+        ++edgeEdges;  // (k, ω) for the boundary face (i, j, k): one per face
+        Q.edgeLink.push_back(edgeKey(k, kOmega));
+      });
   if (common != edgeVerts + (boundaryEdge ? 1 : 0)) TS_LINK_RESULT(false);
   // Edges: those of Lk(j) in a table, then the distinct ones of Lk(i) found there. With the
   // vertices equal, an edge in both links has both ends in Lk(ij) (stamped stampE; ω when the
@@ -183,13 +196,16 @@ bool Simplifier::linkConditionBySorting(uint32_t i, uint32_t j) {
   gatherLink(j, lvJ, leJ, ltJ);
   if (intersectionSize(ltI, ltJ) != 0) return false;
   // Link of the edge: the opposite edges of the tets around it, and the boundary faces at it.
-  forEdgeLink(i, j, [&](const uint32_t o[2]) {
-    lvE.insert(lvE.end(), o, o + 2);
-    leE.push_back(edgeKey(o[0], o[1]));
-  }, [&](uint32_t k) {
-    lvE.push_back(kOmega);
-    leE.push_back(edgeKey(k, kOmega));
-  });
+  forEdgeLink(
+      i, j,
+      [&](const uint32_t o[2]) {
+        lvE.insert(lvE.end(), o, o + 2);
+        leE.push_back(edgeKey(o[0], o[1]));
+      },
+      [&](uint32_t k) {
+        lvE.push_back(kOmega);
+        leE.push_back(edgeKey(k, kOmega));
+      });
   sortUnique(lvE);
   sortUnique(leE);
   return intersectionSize(lvI, lvJ) == lvE.size() && intersectionSize(leI, leJ) == leE.size();

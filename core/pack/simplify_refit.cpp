@@ -78,8 +78,10 @@ void Simplifier::refitValues() {
         rhs[r] += l.w[x] * f;
         for (int y = 0; y < 4; ++y) {
           if (l.w[y] == 0) continue;
-          if (col[l.t4[y]] == none) rhs[r] -= l.w[x] * l.w[y] * vert_[l.t4[y]].fit;  // a fixed value
-          else at(r, col[l.t4[y]]) += l.w[x] * l.w[y];
+          if (col[l.t4[y]] == none)
+            rhs[r] -= l.w[x] * l.w[y] * vert_[l.t4[y]].fit;  // a fixed value
+          else
+            at(r, col[l.t4[y]]) += l.w[x] * l.w[y];
         }
       }
     }

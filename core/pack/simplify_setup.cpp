@@ -21,8 +21,10 @@ void Simplifier::init() {
   if (!(diag_ > 0)) diag_ = 1;
 
   assert(!takeTets_ || takeTets_ == &mesh_.tets);
-  if (takeTets_) out_.tets = std::move(*takeTets_);  // (mesh_.tets is not read again: T_ counts them)
-  else out_.tets = mesh_.tets;
+  if (takeTets_)
+    out_.tets = std::move(*takeTets_);  // (mesh_.tets is not read again: T_ counts them)
+  else
+    out_.tets = mesh_.tets;
   out_.tetAlive.assign(T_, 1);
   out_.vertexAlive.assign(V_, 0);
   star_.assign(V_, {});
@@ -35,7 +37,10 @@ void Simplifier::init() {
     for (int k = 0; k < 4; ++k) star_[out_.tets[4 * size_t(t) + k]].push_back(t);
   alive_ = 0;
   for (uint32_t v = 0; v < V_; ++v)
-    if (!star_[v].empty()) { out_.vertexAlive[v] = 1; ++alive_; }
+    if (!star_[v].empty()) {
+      out_.vertexAlive[v] = 1;
+      ++alive_;
+    }
 
   if (adjacency_ && adjacency_->opposite.size() == out_.tets.size()) {
     opp_ = std::move(adjacency_->opposite);
@@ -151,7 +156,8 @@ bool Simplifier::fieldHyperplane(const uint32_t* v, double (&hyperplane)[5], dou
     for (int r = 0; r < 3; ++r)
       for (int k = 0; k < 3; ++k) m[r][k] = k == col ? ds[r] : e[r][k];
     g[col] = (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
-              m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])) / det;
+              m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])) /
+             det;
   }
   const double c = field_[v[0]] - (g[0] * p0[0] + g[1] * p0[1] + g[2] * p0[2]);
   w = std::abs(det) / 24.0;

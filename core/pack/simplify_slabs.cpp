@@ -97,7 +97,8 @@ void Simplifier::runSlabs(uint32_t planned) {
   for (uint32_t s = 0; s < kMaxSlabs; ++s) slabs_[s].slab = int(s);
   // The log sized up front (a log grown by doubling holds up to twice its size): a collapse
   // removes about (T − target tets) / planned tets and moves the rest of a star of 4T/V tets.
-  const double removedEach = double(tetsAlive_ - std::min<uint32_t>(tetsAlive_, opt_.targetTets)) / std::max(1u, planned);
+  const double removedEach =
+      double(tetsAlive_ - std::min<uint32_t>(tetsAlive_, opt_.targetTets)) / std::max(1u, planned);
   const double movedEach = std::max(0.0, 4.0 * tetsAlive_ / std::max<uint32_t>(alive_, 1) - removedEach);
   const double expected = planned + 1.0;
   forEachArray([&](auto& v) { v.reserve(size_t(expected)); }, out_.log);

@@ -1,8 +1,8 @@
 #include "pack/split_encode.h"
 
 #include <algorithm>
-#include <cmath>
 #include <cassert>
+#include <cmath>
 #include <deque>
 #include <future>
 
@@ -19,7 +19,9 @@ namespace {
 
 constexpr uint32_t kNone = ~uint32_t(0);
 
-void putU32(std::vector<uint8_t>& b, uint32_t x) { for (int i = 0; i < 4; ++i) b.push_back(uint8_t(x >> (8 * i))); }
+void putU32(std::vector<uint8_t>& b, uint32_t x) {
+  for (int i = 0; i < 4; ++i) b.push_back(uint8_t(x >> (8 * i)));
+}
 
 class Encoder {
  public:
@@ -223,8 +225,10 @@ class Encoder {
   }
 
   void putValue(std::vector<uint8_t>& out, float value, float predictor, const QuantAxis& axis) {
-    if (q_.lossless) putF32(out, value);
-    else putVarint(out, zigzag(int32_t(axis.quantize(value)) - int32_t(axis.quantize(predictor))));
+    if (q_.lossless)
+      putF32(out, value);
+    else
+      putVarint(out, zigzag(int32_t(axis.quantize(value)) - int32_t(axis.quantize(predictor))));
   }
 
   // Whether the split that undoes collapse c meets the mesh its log describes: p_j there and p_i
@@ -251,7 +255,9 @@ class Encoder {
     tetsRead_ = c;
     return tets_;
   }
-  static Result misfit() { return fail(Status::Corrupt, "encoder: a split does not fit the mesh it undoes (internal error)"); }
+  static Result misfit() {
+    return fail(Status::Corrupt, "encoder: a split does not fit the mesh it undoes (internal error)");
+  }
 
   void encodeSplit(uint32_t c) {
     const CollapseLog& log = s_.log;
@@ -321,7 +327,8 @@ class Encoder {
       jValueChanged = jValue != pm_.mesh.fields[f].values[js];
     }
     changed_.clear();
-    applySplit(pm_, SplitOp{js, moved_, newTets_, pi, fields_.data(), s_.valuesField >= 0 ? &jValue : nullptr}, changed_);
+    applySplit(pm_, SplitOp{js, moved_, newTets_, pi, fields_.data(), s_.valuesField >= 0 ? &jValue : nullptr},
+               changed_);
     if (metered_) meter_.afterSplit(i, js, moved_, pm_.stars, jValueChanged);
   }
 
@@ -423,9 +430,8 @@ class Encoder {
     const uint32_t C = s_.log.size();
     job.info.fieldError = splitsApplied < C ? prefixMax_[C - splitsApplied - 1] : 0.0;
     measure(job.info);
-    job.done = std::async(std::launch::async, [&job, level = opt_.zstdLevel] {
-      return finishChunk(job.raw, level, job.file, job.info);
-    });
+    job.done = std::async(std::launch::async,
+                          [&job, level = opt_.zstdLevel] { return finishChunk(job.raw, level, job.file, job.info); });
     if (jobs_.size() >= 2) {
       Job& older = jobs_[jobs_.size() - 2];
       if (Result r = wait(older); !r) return r;
@@ -473,8 +479,8 @@ class Encoder {
   ProgressiveMesh pm_;
   LevelErrorMeter meter_;
   bool metered_ = false;
-  std::vector<uint32_t> baseOf_;          // per input vertex: the base vertex it went into
-  std::vector<uint32_t> intoOf_;          // ... the vertex it went into directly (itself if none)
+  std::vector<uint32_t> baseOf_;  // per input vertex: the base vertex it went into
+  std::vector<uint32_t> intoOf_;  // ... the vertex it went into directly (itself if none)
   // The base's error, measured on another thread: declared after all that task reads, so it is
   // destroyed, and waited for, first.
   std::future<LevelError> baseError_;
@@ -482,7 +488,7 @@ class Encoder {
   std::vector<float> prefixMax_, fields_;
   std::vector<uint8_t> columns_[kSplitColumns];  // the current chunk's records, column by column
   std::vector<Pair> pairs_, chain_;
-  CollapseTets tets_;                     // collapse tetsRead_'s (tetsOf)
+  CollapseTets tets_;  // collapse tetsRead_'s (tetsOf)
   uint32_t tetsRead_ = kNone;
   std::deque<Job> jobs_;  // chunks being compressed, in order (stable addresses)
   std::vector<uint32_t> star_, moved_, candidates_, newTets_, changed_, implied_;

@@ -29,15 +29,15 @@ struct StreamOptions {
 };
 
 struct EncodedStream {
-  TetMesh base;                              // vertices and tets in stream order
-  std::vector<uint8_t> baseFile;             // the base chunk (index 0), compressed
-  ChunkInfo baseInfo;                        // its manifest entry (file name left empty)
-  std::vector<std::vector<uint8_t>> files;   // split chunk files, chunk 1 onwards
-  std::vector<ChunkInfo> chunks;             // their manifest entries (file names left empty)
-  std::vector<uint32_t> streamVertexOf;      // original vertex id -> id in the stream
-  std::vector<uint32_t> streamTetOf;         // original tet id -> id in the stream
-  double baseFieldError = 0;                 // estimated field error of the base mesh
-  uint32_t movedMasks = 0;                   // splits whose T_moved does not follow from T_new (vertex_link.h)
+  TetMesh base;                             // vertices and tets in stream order
+  std::vector<uint8_t> baseFile;            // the base chunk (index 0), compressed
+  ChunkInfo baseInfo;                       // its manifest entry (file name left empty)
+  std::vector<std::vector<uint8_t>> files;  // split chunk files, chunk 1 onwards
+  std::vector<ChunkInfo> chunks;            // their manifest entries (file names left empty)
+  std::vector<uint32_t> streamVertexOf;     // original vertex id -> id in the stream
+  std::vector<uint32_t> streamTetOf;        // original tet id -> id in the stream
+  double baseFieldError = 0;                // estimated field error of the base mesh
+  uint32_t movedMasks = 0;                  // splits whose T_moved does not follow from T_new (vertex_link.h)
 };
 
 // `mesh` is the simplifier's input (values on the quantization grid of `m` unless lossless; its

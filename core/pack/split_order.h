@@ -47,12 +47,12 @@ class SplitOrder {
 
  private:
   struct TetState {
-    uint32_t stamp = 0;      // plan() call that last touched this tet (0: never)
-    uint32_t written = 0;    // the wave of its last writer in that chunk (0: none)
-    uint32_t read = 0;       // the latest wave that read it
+    uint32_t stamp = 0;    // plan() call that last touched this tet (0: never)
+    uint32_t written = 0;  // the wave of its last writer in that chunk (0: none)
+    uint32_t read = 0;     // the latest wave that read it
   };
   std::vector<TetState> state_;
-  CollapseTets tets_;  // of the collapse being planned
+  CollapseTets tets_;                                         // of the collapse being planned
   std::vector<uint32_t> waveOf_, waveStart_, byWave_, next_;  // per split; splits grouped by wave
   std::vector<uint64_t> wave_;
   uint32_t first_ = 0, stamp_ = 0;

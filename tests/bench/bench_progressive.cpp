@@ -20,8 +20,8 @@
 #include <string>
 #include <vector>
 
-#include "isosurface.h"
 #include "io/mesh_io.h"
+#include "isosurface.h"
 #include "tet_quality.h"
 
 using namespace tetstream;
@@ -106,12 +106,21 @@ struct Locator {
 int cmdError(int argc, char** argv) {
   TetMesh orig, approx;
   ReadReport rep;
-  if (Result r = readMesh(argv[2], orig, rep); !r) { std::fprintf(stderr, "%s\n", r.message.c_str()); return 1; }
-  if (Result r = readMesh(argv[3], approx, rep); !r) { std::fprintf(stderr, "%s\n", r.message.c_str()); return 1; }
+  if (Result r = readMesh(argv[2], orig, rep); !r) {
+    std::fprintf(stderr, "%s\n", r.message.c_str());
+    return 1;
+  }
+  if (Result r = readMesh(argv[3], approx, rep); !r) {
+    std::fprintf(stderr, "%s\n", r.message.c_str());
+    return 1;
+  }
   const std::string field = arg(argc, argv, "--field", orig.fields[0].name.c_str());
   int fo = orig.findField(field), fa = approx.findField(arg(argc, argv, "--approx-field", field.c_str()));
   if (fa < 0 && approx.fields.size() == 1) fa = 0;  // VTK's decimation renames it "scalars"
-  if (fo < 0 || fa < 0) { std::fprintf(stderr, "field %s missing\n", field.c_str()); return 1; }
+  if (fo < 0 || fa < 0) {
+    std::fprintf(stderr, "field %s missing\n", field.c_str());
+    return 1;
+  }
   Locator loc(approx);
   Range range = computeRange(orig.fields[size_t(fo)].values);
   double sum2 = 0, maxErr = 0;
@@ -135,10 +144,11 @@ int cmdError(int argc, char** argv) {
     qMin = std::min(qMin, q);
   }
   double rms = std::sqrt(sum2 / orig.vertexCount()), span = double(range.max) - range.min;
-  std::printf("{\"tets\": %u, \"vertices\": %u, \"rms\": %.6g, \"max\": %.6g, \"rmsRelative\": %.6g, \"maxRelative\": %.6g, "
-              "\"volumeRatio\": %.6f, \"meanQuality\": %.4f, \"minQuality\": %.3g}\n",
-              approx.tetCount(), approx.vertexCount(), rms, maxErr, rms / span, maxErr / span, volA / volO,
-              qSum / std::max(1u, approx.tetCount()), qMin);
+  std::printf(
+      "{\"tets\": %u, \"vertices\": %u, \"rms\": %.6g, \"max\": %.6g, \"rmsRelative\": %.6g, \"maxRelative\": %.6g, "
+      "\"volumeRatio\": %.6f, \"meanQuality\": %.4f, \"minQuality\": %.3g}\n",
+      approx.tetCount(), approx.vertexCount(), rms, maxErr, rms / span, maxErr / span, volA / volO,
+      qSum / std::max(1u, approx.tetCount()), qMin);
   return 0;
 }
 
@@ -189,7 +199,11 @@ struct TriangleGrid {
     }
     auto dot = [](const double* u, const double* v) { return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]; };
     double ab[3], ac[3], ap[3], q[3];
-    for (int k = 0; k < 3; ++k) { ab[k] = bb[k] - a[k]; ac[k] = c[k] - a[k]; ap[k] = p[k] - a[k]; }
+    for (int k = 0; k < 3; ++k) {
+      ab[k] = bb[k] - a[k];
+      ac[k] = c[k] - a[k];
+      ap[k] = p[k] - a[k];
+    }
     double d1 = dot(ab, ap), d2 = dot(ac, ap);
     auto at = [&](double u, double v) {  // a + u ab + v ac
       for (int k = 0; k < 3; ++k) q[k] = a[k] + u * ab[k] + v * ac[k];
@@ -243,7 +257,10 @@ void oneWay(const IsoSurface& from, const TriangleGrid& to, double& sum, double&
     const float* v[3];
     for (int k = 0; k < 3; ++k) v[k] = &from.positions[3 * size_t(from.indices[3 * size_t(t) + k])];
     double u[3], w[3];
-    for (int k = 0; k < 3; ++k) { u[k] = v[1][k] - v[0][k]; w[k] = v[2][k] - v[0][k]; }
+    for (int k = 0; k < 3; ++k) {
+      u[k] = v[1][k] - v[0][k];
+      w[k] = v[2][k] - v[0][k];
+    }
     double area = 0.5 * std::sqrt(std::pow(u[1] * w[2] - u[2] * w[1], 2) + std::pow(u[2] * w[0] - u[0] * w[2], 2) +
                                   std::pow(u[0] * w[1] - u[1] * w[0], 2));
     double centroid[3];
@@ -262,13 +279,22 @@ void oneWay(const IsoSurface& from, const TriangleGrid& to, double& sum, double&
 int cmdIsoDistance(int argc, char** argv) {
   TetMesh orig, approx;
   ReadReport rep;
-  if (Result r = readMesh(argv[2], orig, rep); !r) { std::fprintf(stderr, "%s\n", r.message.c_str()); return 1; }
-  if (Result r = readMesh(argv[3], approx, rep); !r) { std::fprintf(stderr, "%s\n", r.message.c_str()); return 1; }
+  if (Result r = readMesh(argv[2], orig, rep); !r) {
+    std::fprintf(stderr, "%s\n", r.message.c_str());
+    return 1;
+  }
+  if (Result r = readMesh(argv[3], approx, rep); !r) {
+    std::fprintf(stderr, "%s\n", r.message.c_str());
+    return 1;
+  }
   const std::string field = arg(argc, argv, "--field", orig.fields[0].name.c_str());
   const float value = float(std::atof(arg(argc, argv, "--value", "0")));
   int fo = orig.findField(field), fa = approx.findField(field);
   if (fa < 0 && approx.fields.size() == 1) fa = 0;  // VTK's decimation renames it "scalars"
-  if (fo < 0 || fa < 0) { std::fprintf(stderr, "field %s missing\n", field.c_str()); return 1; }
+  if (fo < 0 || fa < 0) {
+    std::fprintf(stderr, "field %s missing\n", field.c_str());
+    return 1;
+  }
   IsoExtractor scratch;
   IsoSurface a, b;
   extractIsosurface(orig, orig.fields[size_t(fo)].values, value, scratch, a);
@@ -290,7 +316,10 @@ int cmdIsoDistance(int argc, char** argv) {
 int cmdRaw(char** argv) {
   TetMesh m;
   ReadReport rep;
-  if (Result r = readMesh(argv[2], m, rep); !r) { std::fprintf(stderr, "%s\n", r.message.c_str()); return 1; }
+  if (Result r = readMesh(argv[2], m, rep); !r) {
+    std::fprintf(stderr, "%s\n", r.message.c_str());
+    return 1;
+  }
   std::FILE* f = std::fopen(argv[3], "wb");
   if (!f) return 1;
   std::fwrite(m.positions.data(), 4, m.positions.size(), f);
@@ -305,8 +334,14 @@ int cmdRaw(char** argv) {
 int cmdVtu(char** argv) {
   TetMesh m;
   ReadReport rep;
-  if (Result r = readMesh(argv[2], m, rep); !r) { std::fprintf(stderr, "%s\n", r.message.c_str()); return 1; }
-  if (Result r = writeMesh(argv[3], m); !r) { std::fprintf(stderr, "%s\n", r.message.c_str()); return 1; }
+  if (Result r = readMesh(argv[2], m, rep); !r) {
+    std::fprintf(stderr, "%s\n", r.message.c_str());
+    return 1;
+  }
+  if (Result r = writeMesh(argv[3], m); !r) {
+    std::fprintf(stderr, "%s\n", r.message.c_str());
+    return 1;
+  }
   return 0;
 }
 
@@ -317,7 +352,9 @@ int main(int argc, char** argv) {
   if (argc >= 4 && !std::strcmp(argv[1], "isodist")) return cmdIsoDistance(argc, argv);
   if (argc >= 4 && !std::strcmp(argv[1], "raw")) return cmdRaw(argv);
   if (argc >= 4 && !std::strcmp(argv[1], "vtu")) return cmdVtu(argv);
-  std::fprintf(stderr, "usage: tetstream_bench error ORIG.vtu APPROX.vtu [--field F] | raw MESH.vtu OUT.bin | vtu MESH OUT.vtu | "
-                       "isodist ORIG.vtu APPROX.vtu [--field F] [--value V]\n");
+  std::fprintf(
+      stderr,
+      "usage: tetstream_bench error ORIG.vtu APPROX.vtu [--field F] | raw MESH.vtu OUT.bin | vtu MESH OUT.vtu | "
+      "isodist ORIG.vtu APPROX.vtu [--field F] [--value V]\n");
   return 2;
 }

@@ -1,5 +1,8 @@
 #include "harness.h"
 
+#include <unistd.h>
+#include <zstd.h>
+
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -8,19 +11,16 @@
 #include <iterator>
 #include <memory>
 #include <string_view>
-#include <unistd.h>
-
-#include <zstd.h>
 
 #include "chunk.h"
 #include "dataset.h"
 #include "hash.h"
-#include "manifest.h"
-#include "pack/chunk_encode.h"
 #include "io/generators.h"
 #include "io/mesh_io.h"
-#include "pack/packer.h"
 #include "io/readers.h"
+#include "manifest.h"
+#include "pack/chunk_encode.h"
+#include "pack/packer.h"
 #include "validate.h"
 
 namespace tetstream::fuzz {
@@ -213,8 +213,10 @@ void baseChunk(const uint8_t* data, size_t size) {
   if (!receiveChunk(ds, 1, ctx.files[1])) return;
   std::vector<uint32_t> changed;
   bool reached = false;
-  if (stepTowards(ds, ds.splitsReceived(), ~0u, changed, &reached)) checkStructure(ds.pm.mesh);
-  else FUZZ_CHECK(ds.splitsApplied() == 0);
+  if (stepTowards(ds, ds.splitsReceived(), ~0u, changed, &reached))
+    checkStructure(ds.pm.mesh);
+  else
+    FUZZ_CHECK(ds.splitsApplied() == 0);
 }
 
 void meshFile(const char* extension, const uint8_t* data, size_t size) {
@@ -226,26 +228,32 @@ void meshFile(const char* extension, const uint8_t* data, size_t size) {
 
 void twoFiles(const char* format, const uint8_t* data, size_t size) {
   if (size < 4) return;
-  const size_t first = std::min<size_t>(size - 4, size_t(data[0]) | size_t(data[1]) << 8 | size_t(data[2]) << 16 |
-                                                      size_t(data[3]) << 24);
+  const size_t first = std::min<size_t>(
+      size - 4, size_t(data[0]) | size_t(data[1]) << 8 | size_t(data[2]) << 16 | size_t(data[3]) << 24);
   const std::string_view a(reinterpret_cast<const char*>(data + 4), first);
   const std::string_view b(reinterpret_cast<const char*>(data + 4 + first), size - 4 - first);
   TetMesh m;
   ReadReport report;
   const std::string f = format;
-  Result r = f == "tetgen" ? readTetgen(a, "fuzz.node", b, "fuzz.ele", m, report)
+  Result r = f == "tetgen"  ? readTetgen(a, "fuzz.node", b, "fuzz.ele", m, report)
              : f == "medit" ? readMedit(a, "fuzz.mesh", b, "fuzz.sol", m, report)
                             : readPlot3d(a, "fuzz.xyz", b, "fuzz.q", m, report);
   if (r) checkReaderPromise(m);
 }
 
 bool runTarget(const std::string& name, const uint8_t* data, size_t size) {
-  if (name == "manifest") manifest(data, size);
-  else if (name == "split-chunk") splitChunk(data, size);
-  else if (name == "base-chunk") baseChunk(data, size);
-  else if (name.starts_with("mesh-") && name.size() > 5) meshFile(std::string(".").append(name, 5).c_str(), data, size);
-  else if (name == "pair-tetgen" || name == "pair-medit" || name == "pair-plot3d") twoFiles(name.c_str() + 5, data, size);
-  else return false;
+  if (name == "manifest")
+    manifest(data, size);
+  else if (name == "split-chunk")
+    splitChunk(data, size);
+  else if (name == "base-chunk")
+    baseChunk(data, size);
+  else if (name.starts_with("mesh-") && name.size() > 5)
+    meshFile(std::string(".").append(name, 5).c_str(), data, size);
+  else if (name == "pair-tetgen" || name == "pair-medit" || name == "pair-plot3d")
+    twoFiles(name.c_str() + 5, data, size);
+  else
+    return false;
   return true;
 }
 

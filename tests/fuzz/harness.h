@@ -47,7 +47,7 @@ std::vector<std::pair<std::string, std::vector<uint8_t>>> seeds(const std::strin
 
 }  // namespace tetstream::fuzz
 
-#define FUZZ_CHECK(x) \
-  do {                \
+#define FUZZ_CHECK(x)                                                     \
+  do {                                                                    \
     if (!(x)) ::tetstream::fuzz::fuzzCheckFailed(#x, __FILE__, __LINE__); \
   } while (0)

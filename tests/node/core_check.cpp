@@ -140,10 +140,11 @@ int streamBench(const std::string& dir, float iso) {
     inc.clearChanges();
   }
   const double undoMs = msSince(t0);
-  std::printf("{\"splits\": %u, \"finalTriangles\": %u, \"streamMs\": %.1f, \"splitsPerSecond\": %.0f, "
-              "\"viewerSplitsPerSecond\": %.0f, \"undoMs\": %.1f, \"undoSplitsPerSecond\": %.0f, \"levels\": [",
-              splits, finalTriangles, streamMs, splits / streamMs * 1000, splits / viewerMs * 1000, undoMs,
-              splits / undoMs * 1000);
+  std::printf(
+      "{\"splits\": %u, \"finalTriangles\": %u, \"streamMs\": %.1f, \"splitsPerSecond\": %.0f, "
+      "\"viewerSplitsPerSecond\": %.0f, \"undoMs\": %.1f, \"undoSplitsPerSecond\": %.0f, \"levels\": [",
+      splits, finalTriangles, streamMs, splits / streamMs * 1000, splits / viewerMs * 1000, undoMs,
+      splits / undoMs * 1000);
   // Isovalue changes at several levels: interval tree (rebuild) against a scan of every tet.
   bool first = true;
   for (double fraction : {0.05, 0.10, 0.15, 0.30, 1.0}) {

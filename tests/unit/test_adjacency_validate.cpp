@@ -8,8 +8,8 @@
 
 #include "adjacency.h"
 #include "io/generators.h"
-#include "tet_tables.h"
 #include "test_helpers.h"
+#include "tet_tables.h"
 #include "validate.h"
 
 using namespace tetstream;
@@ -48,7 +48,11 @@ TEST(Adjacency, GridBoundaryIsClosedAndOutward) {
     const float* p1 = &m.positions[3 * b[i + 1]];
     const float* p2 = &m.positions[3 * b[i + 2]];
     float u[3], v[3], c[3];
-    for (int k = 0; k < 3; ++k) { u[k] = p1[k] - p0[k]; v[k] = p2[k] - p0[k]; c[k] = (p0[k] + p1[k] + p2[k]) / 3; }
+    for (int k = 0; k < 3; ++k) {
+      u[k] = p1[k] - p0[k];
+      v[k] = p2[k] - p0[k];
+      c[k] = (p0[k] + p1[k] + p2[k]) / 3;
+    }
     float nx = u[1] * v[2] - u[2] * v[1], ny = u[2] * v[0] - u[0] * v[2], nz = u[0] * v[1] - u[1] * v[0];
     EXPECT_GT(nx * c[0] + ny * c[1] + nz * c[2], 0);
   }
@@ -70,7 +74,10 @@ TEST(Adjacency, LargeMeshPairsEveryFaceOnce) {
   };
   for (uint32_t h = 0; h < adj.opposite.size(); ++h) {
     const uint32_t o = adj.opposite[h];
-    if (o == kNoNeighbor) { ++boundary; continue; }
+    if (o == kNoNeighbor) {
+      ++boundary;
+      continue;
+    }
     ASSERT_EQ(adj.opposite[o], h);
     ASSERT_EQ(faceOf(o), faceOf(h));
   }

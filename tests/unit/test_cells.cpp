@@ -40,9 +40,8 @@ std::string blockMesh(int n, int pattern, uint32_t seed, uint64_t& cells) {
   for (int k = 0; k < n; ++k)
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i) {
-        std::vector<int> c = {vid(i, j, k),         vid(i + 1, j, k),         vid(i + 1, j + 1, k),
-                              vid(i, j + 1, k),     vid(i, j, k + 1),         vid(i + 1, j, k + 1),
-                              vid(i + 1, j + 1, k + 1), vid(i, j + 1, k + 1)};
+        std::vector<int> c = {vid(i, j, k),     vid(i + 1, j, k),     vid(i + 1, j + 1, k),     vid(i, j + 1, k),
+                              vid(i, j, k + 1), vid(i + 1, j, k + 1), vid(i + 1, j + 1, k + 1), vid(i, j + 1, k + 1)};
         // Mixed: a random kind per cube, except that wedges come in whole z columns (their
         // triangle faces only meet other wedges' triangles, as in a real prism layer).
         int kind = pattern;
@@ -64,8 +63,8 @@ std::string blockMesh(int n, int pattern, uint32_t seed, uint64_t& cells) {
         } else {
           int centre = int(pts.size());
           pts.push_back({i + 0.5, j + 0.5, k + 0.5});
-          for (auto f : std::vector<std::array<int, 4>>{{0, 1, 2, 3}, {4, 7, 6, 5}, {0, 4, 5, 1}, {1, 5, 6, 2},
-                                                         {2, 6, 7, 3}, {3, 7, 4, 0}})
+          for (auto f : std::vector<std::array<int, 4>>{
+                   {0, 1, 2, 3}, {4, 7, 6, 5}, {0, 4, 5, 1}, {1, 5, 6, 2}, {2, 6, 7, 3}, {3, 7, 4, 0}})
             out.push_back({14, {c[f[0]], c[f[1]], c[f[2]], c[f[3]], centre}});
         }
       }
@@ -146,9 +145,9 @@ TEST(SplitConformity, StructuredGridIsKuhnAndMatchesTheGenerator) {
 // ------------------------------------------------------------------ degenerate input
 std::string legacy(const std::string& points, int npts, const std::string& cells, int ncells, int ints,
                    const std::string& types, const std::string& tail = "") {
-  return "# vtk DataFile Version 4.2\nd\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS " + std::to_string(npts) + " float\n" +
-         points + "\nCELLS " + std::to_string(ncells) + " " + std::to_string(ints) + "\n" + cells + "\nCELL_TYPES " +
-         std::to_string(ncells) + "\n" + types + "\n" + tail;
+  return "# vtk DataFile Version 4.2\nd\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS " + std::to_string(npts) +
+         " float\n" + points + "\nCELLS " + std::to_string(ncells) + " " + std::to_string(ints) + "\n" + cells +
+         "\nCELL_TYPES " + std::to_string(ncells) + "\n" + types + "\n" + tail;
 }
 
 TEST(Degenerate, CollapsedHexahedronKeepsItsVolume) {
@@ -183,8 +182,10 @@ TEST(Degenerate, DuplicateVerticesMergedOrKeptApart) {
   const std::string pts2 = "0 0 0 1 0 0 0 1 0 0 0 1 0 0 0 1 0 0 0 -1 0 0 0 -1";
   ASSERT_TRUE(readMeshBytes(legacy(pts2, 8, "4 0 1 2 3\n4 4 5 6 7", 2, 10, "10 10"), "e.vtk", m, r));
   EXPECT_EQ(m.vertexCount(), 8u);
-  EXPECT_TRUE(hasNote(r, "found 2 vertices at the same coordinates as another; not merged, since merging would make "
-                         "1 more face or boundary edge non-manifold")) << allNotes(r);
+  EXPECT_TRUE(hasNote(r,
+                      "found 2 vertices at the same coordinates as another; not merged, since merging would make "
+                      "1 more face or boundary edge non-manifold"))
+      << allNotes(r);
   EXPECT_EQ(validateMesh(m).nonManifoldBoundaryEdges, 0u);
 
   // The same, with more tets elsewhere, two of them already sharing only an edge. With few cells
@@ -197,12 +198,14 @@ TEST(Degenerate, DuplicateVerticesMergedOrKeptApart) {
     const std::string x = std::to_string(20 + 2 * k), x1 = std::to_string(21 + 2 * k);
     pts3 += " " + x + " 0 0 " + x1 + " 0 0 " + x + " 1 0 " + x + " 0 1";
     const int b = 14 + 4 * k;
-    cells3 += "\n4 " + std::to_string(b) + " " + std::to_string(b + 1) + " " + std::to_string(b + 2) + " " + std::to_string(b + 3);
+    cells3 += "\n4 " + std::to_string(b) + " " + std::to_string(b + 1) + " " + std::to_string(b + 2) + " " +
+              std::to_string(b + 3);
   }
-  ASSERT_TRUE(readMeshBytes(legacy(pts3, 14 + 4 * apartTets, cells3, 4 + apartTets, 5 * (4 + apartTets),
-                                   "10 10 10 10 10 10 10 10 10 10"),
-                            "f.vtk", m, r));
-  EXPECT_TRUE(hasNote(r, "not merged, since merging would make 1 more face or boundary edge non-manifold")) << allNotes(r);
+  ASSERT_TRUE(readMeshBytes(
+      legacy(pts3, 14 + 4 * apartTets, cells3, 4 + apartTets, 5 * (4 + apartTets), "10 10 10 10 10 10 10 10 10 10"),
+      "f.vtk", m, r));
+  EXPECT_TRUE(hasNote(r, "not merged, since merging would make 1 more face or boundary edge non-manifold"))
+      << allNotes(r);
   EXPECT_EQ(m.tetCount(), 10u);
   EXPECT_EQ(validateMesh(m).nonManifoldBoundaryEdges, 1u);
 }
@@ -228,8 +231,10 @@ TEST(Degenerate, StructuredGridWithACollapsedEdge) {
   std::string p;
   for (int k = 0; k < 2; ++k)
     for (int j = 0; j < 2; ++j)
-      for (int i = 0; i < 3; ++i) p += std::to_string(i) + " " + (i == 2 ? "0.5" : std::to_string(j)) + " " + std::to_string(k) + "\n";
-  std::string text = "# vtk DataFile Version 3.0\ns\nASCII\nDATASET STRUCTURED_GRID\nDIMENSIONS 3 2 2\nPOINTS 12 float\n" + p;
+      for (int i = 0; i < 3; ++i)
+        p += std::to_string(i) + " " + (i == 2 ? "0.5" : std::to_string(j)) + " " + std::to_string(k) + "\n";
+  std::string text =
+      "# vtk DataFile Version 3.0\ns\nASCII\nDATASET STRUCTURED_GRID\nDIMENSIONS 3 2 2\nPOINTS 12 float\n" + p;
   TetMesh m;
   ReadReport r;
   Result res = readMeshBytes(text, "s.vtk", m, r);

@@ -5,22 +5,21 @@
 // local updates through splits and undos equal to one extracted from scratch.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
+#include <random>
 #include <string>
 #include <vector>
 
-#include <algorithm>
-#include <map>
-#include <random>
-
 #include "colourmap.h"
-#include "isosurface.h"
-#include "slice.h"
 #include "dataset.h"
-#include "isosurface_incremental.h"
 #include "io/generators.h"
+#include "isosurface.h"
+#include "isosurface_incremental.h"
 #include "pack/packer.h"
+#include "slice.h"
 #include "test_helpers.h"
 
 using namespace tetstream;
@@ -157,9 +156,11 @@ TEST(ColourField, InterpolatedAtSurfaceVerticesThroughSplits) {
   // Another colour field for the same surface: the isovalue's own field.
   inc.recolour(g.field("harmonic"));
   EXPECT_TRUE(inc.fullUploadNeeded());
-  expectColours(inc, [&](const float*) { return iso; }, 1e-5f, "recoloured by the iso field");
+  expectColours(
+      inc, [&](const float*) { return iso; }, 1e-5f, "recoloured by the iso field");
   inc.recolour({});
-  expectColours(inc, [](const float*) { return 0.f; }, 0.f, "no colour field");
+  expectColours(
+      inc, [](const float*) { return 0.f; }, 0.f, "no colour field");
   inc.recolour(g.field("x"));
   expectColours(inc, isX, 1e-5f, "recoloured by x");
   inc.compact();
@@ -201,7 +202,8 @@ double distanceToOutline(const float* p, const std::vector<std::array<double, 3>
     const auto& a = poly[i];
     const auto& b = poly[(i + 1) % poly.size()];
     double ab[3], ap[3], t = 0, len2 = 0;
-    for (int k = 0; k < 3; ++k) ab[k] = b[size_t(k)] - a[size_t(k)], ap[k] = p[k] - a[size_t(k)], t += ab[k] * ap[k], len2 += ab[k] * ab[k];
+    for (int k = 0; k < 3; ++k)
+      ab[k] = b[size_t(k)] - a[size_t(k)], ap[k] = p[k] - a[size_t(k)], t += ab[k] * ap[k], len2 += ab[k] * ab[k];
     t = std::clamp(t / len2, 0.0, 1.0);
     double d2 = 0;
     for (int k = 0; k < 3; ++k) d2 += (ap[k] - t * ab[k]) * (ap[k] - t * ab[k]);
@@ -254,7 +256,8 @@ TEST(Slice, AxisPlaneThroughCubeIsTheSquare) {
 // (1, -1, 0), side sqrt(2), area 3 sqrt(3). On the n = 3 and n = 5 grids the plane passes
 // through mesh vertices and along mesh edges (the exact-λ rules); on n = 6 through none.
 TEST(Slice, ObliquePlaneThroughCubeIsTheRegularHexagon) {
-  const std::vector<std::array<double, 3>> hex = {{1, -1, 0}, {1, 0, -1}, {0, 1, -1}, {-1, 1, 0}, {-1, 0, 1}, {0, -1, 1}};
+  const std::vector<std::array<double, 3>> hex = {{1, -1, 0}, {1, 0, -1}, {0, 1, -1},
+                                                  {-1, 1, 0}, {-1, 0, 1}, {0, -1, 1}};
   for (uint32_t n : {3u, 5u, 6u}) {
     SCOPED_TRACE("grid " + std::to_string(n));
     expectSlice(makeGridMesh(n), {1, 1, 1}, 0.f, 3 * std::sqrt(3.0), hex);
@@ -296,7 +299,8 @@ TEST(Slice, FollowsSplitsLocallyLikeFromScratch) {
         for (size_t t = 0; t < s.indices.size(); t += 3) {
           std::array<std::array<float, 3>, 3> c;
           for (int k = 0; k < 3; ++k)
-            for (int j = 0; j < 3; ++j) c[size_t(k)][size_t(j)] = s.positions[3 * size_t(s.indices[t + size_t(k)]) + size_t(j)];
+            for (int j = 0; j < 3; ++j)
+              c[size_t(k)][size_t(j)] = s.positions[3 * size_t(s.indices[t + size_t(k)]) + size_t(j)];
           std::rotate(c.begin(), std::min_element(c.begin(), c.end()), c.end());
           tris.push_back({c[0][0], c[0][1], c[0][2], c[1][0], c[1][1], c[1][2], c[2][0], c[2][1], c[2][2]});
         }

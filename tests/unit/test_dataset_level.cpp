@@ -41,7 +41,11 @@ TEST(Level, UndoAndRedoReachTheSameMeshes) {
 // A chunk whose hash matches a lying manifest: the bad record is found while applying, the
 // chunk's splits are undone, it is dropped, and the level stays where the last good chunk ended.
 TEST(Level, BadRecordInAHashedChunkUndoesItsChunk) {
-  std::string dir = pack("bad-record", harmonic(9), [] { PackOptions o; o.chunkKb = 1; return o; }());
+  std::string dir = pack("bad-record", harmonic(9), [] {
+    PackOptions o;
+    o.chunkKb = 1;
+    return o;
+  }());
   Dataset ds;
   ASSERT_TRUE(loadPackedDir(dir, ds, 2));
   const uint32_t goodVertices = ds.pm.vertexCount(), goodTets = ds.pm.tetCount();

@@ -1,6 +1,5 @@
 // Packed format: round trip through files, determinism, and hostile manifests and chunks.
 #include <gtest/gtest.h>
-
 #include <zstd.h>
 
 #include <filesystem>
@@ -9,8 +8,8 @@
 #include "chunk.h"
 #include "dataset.h"
 #include "hash.h"
-#include "pack/chunk_encode.h"
 #include "io/generators.h"
+#include "pack/chunk_encode.h"
 #include "pack/packer.h"
 #include "test_helpers.h"
 

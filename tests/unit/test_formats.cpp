@@ -89,8 +89,8 @@ TEST_P(FormatFixture, CountsVolumeConformityAndFields) {
     for (const auto& row : e[name]) {
       int64_t v = findVertex(m, row[0], row[1], row[2]);
       ASSERT_GE(v, 0) << file << " vertex at " << row;
-      EXPECT_NEAR(m.fields[size_t(f)].values[size_t(v)], row[3].get<double>(), 1e-5) << file << " " << name << " at "
-                                                                                      << row;
+      EXPECT_NEAR(m.fields[size_t(f)].values[size_t(v)], row[3].get<double>(), 1e-5)
+          << file << " " << name << " at " << row;
     }
     EXPECT_TRUE(hasNote(r, std::string("converted cell data '") + name)) << file << allNotes(r);
   }
@@ -159,8 +159,12 @@ TEST(FormatNotes, EachConversionIsSaid) {
        {"TetGen .node/.ele (0-based, 4-node tetrahedra)"},
        {"point attributes became fields attr0..attr1", "ignored the points' boundary markers"}},
       {"tetgen_cube.node", {"TetGen .node/.ele (1-based, 4-node tetrahedra)"}, {}},
-      {"tetgen_cube_p2.node", {"(1-based, 10-node tetrahedra)"}, {"TetGen 10-node tetrahedron cells to their 4 corner"}},
-      {"grid43.vti", {"VTK XML ImageData (ascii, UInt32 header, 4x3x3)"}, {"split 12 hexahedra into 72 tetrahedra (grid cells"}},
+      {"tetgen_cube_p2.node",
+       {"(1-based, 10-node tetrahedra)"},
+       {"TetGen 10-node tetrahedron cells to their 4 corner"}},
+      {"grid43.vti",
+       {"VTK XML ImageData (ascii, UInt32 header, 4x3x3)"},
+       {"split 12 hexahedra into 72 tetrahedra (grid cells"}},
       {"grid43.vts", {"VTK XML StructuredGrid (appended base64, zlib"}, {"converted cell data 'cid'"}},
       {"grid43_points.vtk", {"legacy VTK 5.1 (BINARY, STRUCTURED_POINTS 4x3x3)"}, {"converted cell data 'cid'"}},
       {"grid43_sgrid.vtk", {"(ASCII, STRUCTURED_GRID 4x3x3)"}, {}},
@@ -172,9 +176,7 @@ TEST(FormatNotes, EachConversionIsSaid) {
       {"p3d_fortran_iblank.x",
        {"Fortran records, little-endian, double, multi-grid header, IBLANK"},
        {"IBLANK: 1 points are blanked (0); 1 cells touching them are left out"}},
-      {"p3d_two_blocks.g",
-       {"2 blocks 4x3x3, 3x3x3"},
-       {"read 2 grid blocks", "merged 9 duplicate vertices"}},
+      {"p3d_two_blocks.g", {"2 blocks 4x3x3, 3x3x3"}, {"read 2 grid blocks", "merged 9 duplicate vertices"}},
   };
   for (const Said& c : cases) {
     TetMesh m;
@@ -280,8 +282,9 @@ TEST(FormatBadInput, Gmsh) {
   b[el] = 99;  // the first block's element type
   EXPECT_FAILS(readBytes(b, "b.msh"), Status::Unsupported, "element type 99");
   // Data for a node that does not exist.
-  EXPECT_FAILS(readBytes(head + nodes + "$Elements\n1\n1 4 0 1 2 3 4\n$EndElements\n$NodeData\n1\n\"f\"\n0\n3\n0\n1\n1\n"
-                                        "7 1.5\n$EndNodeData\n",
+  EXPECT_FAILS(readBytes(head + nodes +
+                             "$Elements\n1\n1 4 0 1 2 3 4\n$EndElements\n$NodeData\n1\n\"f\"\n0\n3\n0\n1\n1\n"
+                             "7 1.5\n$EndNodeData\n",
                          "a.msh"),
                Status::OutOfRange, "'f' gives a value for node 7");
 }
@@ -314,14 +317,16 @@ TEST(FormatBadInput, TetgenAndMedit) {
   TetMesh mm;
   ReadReport mr;
   EXPECT_TRUE(readBytes(mh + "Tetrahedra\n1\n1 2 3 4 0\nFancyKeyword 2\n1 2\nEnd\n", "a.mesh"));
-  EXPECT_FAILS(readMedit(mh + "Tetrahedra\n1\n1 2 3 4 0\nEnd\n", "a.mesh", "SolAtVertices\n3\n1 1\n1 2 3\n", "a.sol", mm, mr),
-               Status::Corrupt, "SolAtVertices has 3 entries, the mesh has 4 vertices");
+  EXPECT_FAILS(
+      readMedit(mh + "Tetrahedra\n1\n1 2 3 4 0\nEnd\n", "a.mesh", "SolAtVertices\n3\n1 1\n1 2 3\n", "a.sol", mm, mr),
+      Status::Corrupt, "SolAtVertices has 3 entries, the mesh has 4 vertices");
 }
 
 TEST(FormatBadInput, StructuredAndPlot3d) {
-  EXPECT_FAILS(readBytes("# vtk DataFile Version 3.0\nx\nBINARY\nDATASET STRUCTURED_POINTS\nDIMENSIONS 1000 1000 1000\n",
-                         "a.vtk"),
-               Status::Truncated, "DIMENSIONS declares 1000000000 points");
+  EXPECT_FAILS(
+      readBytes("# vtk DataFile Version 3.0\nx\nBINARY\nDATASET STRUCTURED_POINTS\nDIMENSIONS 1000 1000 1000\n",
+                "a.vtk"),
+      Status::Truncated, "DIMENSIONS declares 1000000000 points");
   EXPECT_FAILS(readBytes("# vtk DataFile Version 3.0\nx\nASCII\nDATASET STRUCTURED_GRID\nDIMENSIONS 2 2 2\nPOINTS 7 "
                          "float\n0 0 0 1 0 0 0 1 0 1 1 0 0 0 1 1 0 1 0 1 1\n",
                          "a.vtk"),
@@ -343,11 +348,13 @@ TEST(FormatBadInput, StructuredAndPlot3d) {
   EXPECT_FAILS(readBytes(std::string(100, 'x'), "a.xyz"), Status::Corrupt, "no layout");
   EXPECT_FAILS(readBytes("abc", "a.xyz"), Status::Truncated, "too short for a PLOT3D grid header");
   // A Q file given as the grid.
-  EXPECT_FAILS(readBytes(loadFile(formatsPath("p3d_be.q")), "p3d_be.xyz"), Status::Corrupt, "reads as a PLOT3D Q (solution) file");
+  EXPECT_FAILS(readBytes(loadFile(formatsPath("p3d_be.q")), "p3d_be.xyz"), Status::Corrupt,
+               "reads as a PLOT3D Q (solution) file");
   TetMesh m;
   ReadReport r;
   const std::string grid = loadFile(formatsPath("p3d_be.xyz")), q = loadFile(formatsPath("p3d_be.q"));
-  EXPECT_FAILS(readPlot3d(grid, "g.xyz", q.substr(0, q.size() - 200), "g.q", m, r), Status::Corrupt, "g.q: not a PLOT3D Q");
+  EXPECT_FAILS(readPlot3d(grid, "g.xyz", q.substr(0, q.size() - 200), "g.q", m, r), Status::Corrupt,
+               "g.q: not a PLOT3D Q");
 }
 
 // Cuts every fixture (the main file, and the companion of two-file formats) at many lengths:

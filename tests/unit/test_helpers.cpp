@@ -1,9 +1,9 @@
 #include "test_helpers.h"
 
 #include <gtest/gtest.h>
-
 #include <sys/wait.h>
 #include <unistd.h>
+#include <zstd.h>
 
 #include <algorithm>
 #include <array>
@@ -18,13 +18,11 @@
 #include <map>
 #include <memory>
 
-#include <zstd.h>
-
 #include "adjacency.h"
 #include "chunk.h"
 #include "dataset.h"
-#include "pack/chunk_encode.h"
 #include "io/generators.h"
+#include "pack/chunk_encode.h"
 #include "split_stream.h"
 #include "validate.h"
 
@@ -290,7 +288,8 @@ void expectSameMesh(const TetMesh& in, const TetMesh& out, const Quantizer& q, b
   ASSERT_EQ(in.tetCount(), out.tetCount());
   // Key vertices by grid cell: unique for these meshes, identical for both sides.
   auto key = [&](const float* p) {
-    return std::array<uint32_t, 3>{q.position[0].quantize(p[0]), q.position[1].quantize(p[1]), q.position[2].quantize(p[2])};
+    return std::array<uint32_t, 3>{q.position[0].quantize(p[0]), q.position[1].quantize(p[1]),
+                                   q.position[2].quantize(p[2])};
   };
   std::map<std::array<uint32_t, 3>, uint32_t> original;
   for (uint32_t v = 0; v < in.vertexCount(); ++v) original[key(&in.positions[3 * v])] = v;
@@ -302,13 +301,18 @@ void expectSameMesh(const TetMesh& in, const TetMesh& out, const Quantizer& q, b
     toIn[v] = it->second;
     for (int k = 0; k < 3; ++k) {
       float a = in.positions[3 * it->second + k], b = out.positions[3 * v + k];
-      if (exact) EXPECT_EQ(std::memcmp(&a, &b, 4), 0);
-      else EXPECT_LE(std::abs(a - b), 0.5f * q.position[k].step * 1.0001f);
+      if (exact)
+        EXPECT_EQ(std::memcmp(&a, &b, 4), 0);
+      else
+        EXPECT_LE(std::abs(a - b), 0.5f * q.position[k].step * 1.0001f);
     }
     for (size_t f = 0; f < in.fields.size(); ++f) {
       float a = in.fields[f].values[it->second], b = out.fields[f].values[v];
-      if (exact) EXPECT_EQ(std::memcmp(&a, &b, 4), 0);
-      else EXPECT_LE(std::abs(a - b), 0.5f * q.field[f].step * 1.0001f + FLT_EPSILON * (std::abs(q.field[f].min) + 2 * std::abs(b)));  // (+ float decode)
+      if (exact)
+        EXPECT_EQ(std::memcmp(&a, &b, 4), 0);
+      else
+        EXPECT_LE(std::abs(a - b), 0.5f * q.field[f].step * 1.0001f +
+                                       FLT_EPSILON * (std::abs(q.field[f].min) + 2 * std::abs(b)));  // (+ float decode)
     }
   }
   // Tets: the same vertex sets, and each an even permutation of the input's (same orientation).
@@ -329,7 +333,8 @@ void expectSameMesh(const TetMesh& in, const TetMesh& out, const Quantizer& q, b
     ASSERT_NE(it, inTets.end()) << "tet " << t << " is not in the input";
     int inversions = 0;  // parity of the permutation from the input's order to ours
     std::array<int, 4> pos;
-    for (int k = 0; k < 4; ++k) pos[k] = int(std::find(it->second.begin(), it->second.end(), v[k]) - it->second.begin());
+    for (int k = 0; k < 4; ++k)
+      pos[k] = int(std::find(it->second.begin(), it->second.end(), v[k]) - it->second.begin());
     for (int a = 0; a < 4; ++a)
       for (int b = a + 1; b < 4; ++b) inversions += pos[a] > pos[b];
     EXPECT_EQ(inversions % 2, 0) << "tet " << t << " changed orientation";
@@ -344,7 +349,7 @@ void expectSamePack(const std::string& a, const std::string& b) {
 }
 
 void roundTrip(const std::string& name, const TetMesh& m, PackOptions o) {
-  o.chunkKb = 2;  // many small chunks: many prefixes to check
+  o.chunkKb = 2;          // many small chunks: many prefixes to check
   o.minBaseVertices = 0;  // these meshes are small: simplify all the way to 1%
   PackSummary s;
   std::string dir = pack(name, m, o, &s);

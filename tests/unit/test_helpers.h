@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
+#include "io/mesh_io.h"
 #include "manifest.h"
 #include "mesh.h"
-#include "io/mesh_io.h"
 #include "pack/packer.h"
 #include "pack/simplify.h"
 #include "quantize.h"

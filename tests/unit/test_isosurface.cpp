@@ -5,8 +5,8 @@
 #include <map>
 #include <numbers>
 
-#include "isosurface.h"
 #include "io/generators.h"
+#include "isosurface.h"
 #include "test_helpers.h"
 
 using namespace tetstream;

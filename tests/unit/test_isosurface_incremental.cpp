@@ -12,10 +12,10 @@
 #include <random>
 #include <string>
 
-#include "isosurface.h"
-#include "isosurface_incremental.h"
 #include "dataset.h"
 #include "io/generators.h"
+#include "isosurface.h"
+#include "isosurface_incremental.h"
 #include "pack/packer.h"
 #include "test_helpers.h"
 

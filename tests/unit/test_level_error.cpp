@@ -43,7 +43,8 @@ void expectMeasuredLikeBruteForce(const std::string& name, const TetMesh& in, ui
     }
     const double rms = std::sqrt(sum / in.vertexCount());
     const ChunkInfo& c = m.chunks[k - 1];
-    EXPECT_NEAR(c.fieldRms, rms, 3 * step) << name << ", chunk " << k;  // (the level loaded has its positions on the grid too)
+    EXPECT_NEAR(c.fieldRms, rms, 3 * step)
+        << name << ", chunk " << k;  // (the level loaded has its positions on the grid too)
     EXPECT_NEAR(c.fieldMax, max, 3 * step) << name << ", chunk " << k;
     if (k == 1) {
       EXPECT_GT(c.fieldMax, 20 * step) << "the base is coarse";

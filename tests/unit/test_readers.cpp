@@ -473,14 +473,9 @@ TEST(ReaderBadInput, RandomByteDamageNeverCrashes) {
       for (int k = 0; k < flips; ++k) {
         size_t at = rng() % b.size();
         switch (rng() % 3) {
-          case 0:
-            b[at] = char(rng());
-            break;
-          case 1:
-            b[at] ^= char(1 << (rng() % 8));
-            break;
-          default:
-            b[at] = "0123456789-e. <>\"_\n"[rng() % 19];
+          case 0: b[at] = char(rng()); break;
+          case 1: b[at] ^= char(1 << (rng() % 8)); break;
+          default: b[at] = "0123456789-e. <>\"_\n"[rng() % 19];
         }
       }
       TetMesh m;
@@ -504,14 +499,22 @@ TEST(ReaderText, ParseNextInt) {
     size_t pos;  // after the call
   };
   const Case cases[] = {
-      {"  42 7", 1, 42, 4},          {"\t\n-12\n", 1, -12, 5},   {"+7", 1, 7, 2},
-      {"007 ", 1, 7, 3},             {"-0", 1, 0, 2},               {"4.0 1", 1, 4, 3},
-      {"4e0", 1, 4, 3},              {"4.5", -1, 0, 0},             {"12abc", -1, 0, 0},
-      {" -", -1, 0, 1},              {"   ", 0, 0, 3},              {"", 0, 0, 0},
+      {"  42 7", 1, 42, 4},
+      {"\t\n-12\n", 1, -12, 5},
+      {"+7", 1, 7, 2},
+      {"007 ", 1, 7, 3},
+      {"-0", 1, 0, 2},
+      {"4.0 1", 1, 4, 3},
+      {"4e0", 1, 4, 3},
+      {"4.5", -1, 0, 0},
+      {"12abc", -1, 0, 0},
+      {" -", -1, 0, 1},
+      {"   ", 0, 0, 3},
+      {"", 0, 0, 0},
       {"123456789012345678", 1, 123456789012345678, 18},
-      {"1234567890123456789", 1, 1234567890123456789, 19},     // 19 digits: past the quick path
+      {"1234567890123456789", 1, 1234567890123456789, 19},  // 19 digits: past the quick path
       {"-9223372036854775808", 1, INT64_MIN, 20},
-      {"99999999999999999999", -1, 0, 0},                      // beyond int64
+      {"99999999999999999999", -1, 0, 0},  // beyond int64
   };
   for (const Case& c : cases) {
     size_t pos = 0;
@@ -664,7 +667,8 @@ TEST(ReaderBadInput, MultiplePiecesAreConcatenated) {
   auto piece = [](const std::string& points, const std::string& f) {
     return "<Piece NumberOfPoints=\"4\" NumberOfCells=\"1\"><PointData><DataArray type=\"Float32\" Name=\"f\" "
            "format=\"ascii\">" +
-           f + "</DataArray></PointData><Points><DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"ascii\">" +
+           f +
+           "</DataArray></PointData><Points><DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"ascii\">" +
            points +
            "</DataArray></Points><Cells><DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">0 1 2 3"
            "</DataArray><DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">4</DataArray>"
@@ -680,7 +684,8 @@ TEST(ReaderBadInput, MultiplePiecesAreConcatenated) {
   ASSERT_EQ(m.fields.size(), 1u);
   EXPECT_EQ(m.fields[0].values, (std::vector<float>{1, 2, 3, 4, 5}));
   EXPECT_TRUE(hasNote(r, "concatenated 2 pieces"));
-  EXPECT_TRUE(hasNote(r, "merged 3 duplicate vertices (exactly the same coordinates) into the first copy")) << allNotes(r);
+  EXPECT_TRUE(hasNote(r, "merged 3 duplicate vertices (exactly the same coordinates) into the first copy"))
+      << allNotes(r);
 
   // A field missing from the second piece is dropped, with a note.
   std::string b2 = b;

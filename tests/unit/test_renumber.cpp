@@ -69,16 +69,20 @@ TEST(Renumber, ScatteredNumberingIsFoundAndRenumbered) {
   ASSERT_EQ(m.tetCount(), before.tetCount());
   // The same tets in slot order, vertices matched by position (unique on a grid), and values.
   std::map<std::array<float, 3>, uint32_t> old;
-  for (uint32_t v = 0; v < before.vertexCount(); ++v) old[{before.positions[3 * v], before.positions[3 * v + 1], before.positions[3 * v + 2]}] = v;
+  for (uint32_t v = 0; v < before.vertexCount(); ++v)
+    old[{before.positions[3 * v], before.positions[3 * v + 1], before.positions[3 * v + 2]}] = v;
   std::vector<uint32_t> toOld(m.vertexCount());
   for (uint32_t v = 0; v < m.vertexCount(); ++v) {
     toOld[v] = old.at({m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]});
     EXPECT_EQ(m.fields[0].values[v], before.fields[0].values[toOld[v]]);
   }
   std::set<std::array<uint32_t, 4>> tets;
-  for (uint32_t t = 0; t < before.tetCount(); ++t) tets.insert({before.tets[4 * t], before.tets[4 * t + 1], before.tets[4 * t + 2], before.tets[4 * t + 3]});
+  for (uint32_t t = 0; t < before.tetCount(); ++t)
+    tets.insert({before.tets[4 * t], before.tets[4 * t + 1], before.tets[4 * t + 2], before.tets[4 * t + 3]});
   for (uint32_t t = 0; t < m.tetCount(); ++t)
-    EXPECT_TRUE(tets.count({toOld[m.tets[4 * t]], toOld[m.tets[4 * t + 1]], toOld[m.tets[4 * t + 2]], toOld[m.tets[4 * t + 3]]})) << "tet " << t;
+    EXPECT_TRUE(tets.count(
+        {toOld[m.tets[4 * t]], toOld[m.tets[4 * t + 1]], toOld[m.tets[4 * t + 2]], toOld[m.tets[4 * t + 3]]}))
+        << "tet " << t;
   for (uint32_t t = 0; t < m.tetCount(); ++t) EXPECT_GT(tetVolume(m, t), 0.0) << "tet " << t;
 }
 
@@ -105,14 +109,17 @@ TEST(Renumber, BrokenScatteredMeshIsRefusedNotRenumbered) {
   o.renumberMinTets = 0;
   for (int broken = 0; broken < 2; ++broken) {
     TetMesh m = good;
-    if (broken == 0) m.tets[17] = m.vertexCount() + 3;
-    else m.positions[10] = std::numeric_limits<float>::infinity();
+    if (broken == 0)
+      m.tets[17] = m.vertexCount() + 3;
+    else
+      m.positions[10] = std::numeric_limits<float>::infinity();
     PackSummary s;
     const std::string dir = tempDir("renumber-broken-" + std::to_string(broken));
     Result r = packMesh(m, dir, o, s);
     EXPECT_FALSE(r);
     EXPECT_EQ(r.status, broken == 0 ? Status::OutOfRange : Status::NonFinite) << r.message;
-    EXPECT_NE(r.message.find(broken == 0 ? "reference a vertex that does not exist" : "NaN or infinite"), std::string::npos)
+    EXPECT_NE(r.message.find(broken == 0 ? "reference a vertex that does not exist" : "NaN or infinite"),
+              std::string::npos)
         << r.message;
     EXPECT_FALSE(std::filesystem::exists(std::filesystem::path(dir) / "manifest.json"));
   }

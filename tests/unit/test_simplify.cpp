@@ -71,8 +71,8 @@ double volumeRms(const TetMesh& in, const TetMesh& coarse) {
     double w[4] = {}, value = 0;
     bestTet(coarse, c, tet, w);
     for (int k = 0; k < 4; ++k) value += w[k] * coarse.fields[0].values[coarse.tets[4 * tet + k]];
-    const double vol = std::abs(tetVolume(&in.positions[3 * v[0]], &in.positions[3 * v[1]], &in.positions[3 * v[2]],
-                                          &in.positions[3 * v[3]]));
+    const double vol = std::abs(
+        tetVolume(&in.positions[3 * v[0]], &in.positions[3 * v[1]], &in.positions[3 * v[2]], &in.positions[3 * v[3]]));
     sum += vol * (value - s) * (value - s);
     volume += vol;
   }
@@ -196,8 +196,8 @@ TEST(Simplify, GradedMeshKeepsTheFarFieldWhereIsosurfacesAre) {
   const TetMesh a = coarseMesh(m, volume), b = coarseMesh(m, count);
   const double va = volumeRms(m, a), vb = volumeRms(m, b), ra = fieldRms(m, a, 0), rb = fieldRms(m, b, 0);
   std::printf("volume RMS %.5f (vertices alone %.5f), RMS at the vertices %.5f (%.5f)\n", va, vb, ra, rb);
-  EXPECT_LT(va, 0.7 * vb);   // (measured: 0.54 against 1.43)
-  EXPECT_LT(ra, 1.1 * rb);   // (0.42 against 0.63)
+  EXPECT_LT(va, 0.7 * vb);  // (measured: 0.54 against 1.43)
+  EXPECT_LT(ra, 1.1 * rb);  // (0.42 against 0.63)
 }
 
 // Each cost is divided by the root of the tets the collapse removes (simplify.h): at the same
@@ -294,12 +294,12 @@ TEST(Simplify, MaxErrorBoundsEveryCollapse) {
   EXPECT_LE(s.manifest.chunks[0].fieldError, 0.02 * (r.max - r.min) * 1.0001);
   // The estimate is no bound on the measured error: the packer says so when it goes above.
   const bool above = s.manifest.chunks[0].fieldMax > 0.02 * (r.max - r.min);
-  const bool noted = std::any_of(s.notes.begin(), s.notes.end(), [](const std::string& n) { return n.find("--max-error") != std::string::npos; });
+  const bool noted = std::any_of(s.notes.begin(), s.notes.end(),
+                                 [](const std::string& n) { return n.find("--max-error") != std::string::npos; });
   EXPECT_EQ(noted, above) << "measured largest error " << s.manifest.chunks[0].fieldMax / (r.max - r.min);
 }
 
 // ------------------------------------------------------------------ legality on tiny meshes
-
 
 TEST(Legality, BoundaryVertexMayNotBePulledInward) {
   TetMesh m = harmonic(3);
@@ -328,9 +328,9 @@ TEST(Legality, LinkConditionProtectsTopology) {
   // Tets (i, j, a, b), (i, k, c, d), (j, k, e, f): i and j share the neighbour k, but (i, j, k)
   // is no triangle of the mesh; collapsing i into j would glue two parts of the boundary.
   TetMesh m;
-  m.positions = {0, 0, 0,  1, 0, 0,  0, 1, 0,  0, 0, 1,         // i j a b
-                 -1, -2, 0,  -1, -2, 1,  -1, -3, 0,             // k c d
-                 1.5f, -3, 0,  1.5f, -3, 1};                    // e f
+  m.positions = {0,    0,  0, 1,    0,  0, 0,  1,  0, 0, 0, 1,  // i j a b
+                 -1,   -2, 0, -1,   -2, 1, -1, -3, 0,           // k c d
+                 1.5f, -3, 0, 1.5f, -3, 1};                     // e f
   m.tets = {0, 1, 2, 3, 0, 4, 5, 6, 1, 4, 7, 8};
   for (uint32_t t = 0; t < m.tetCount(); ++t)
     if (tetVolume(m, t) < 0) std::swap(m.tets[4 * t + 2], m.tets[4 * t + 3]);

@@ -53,7 +53,8 @@ TEST(SimplifyRefit, FittedValuesLowerTheFieldErrorOfCoarseLevels) {
   // that did not steer; the fitted field has values of its own.
   const Quantizer& q = fit.quant;  // the same grid for both packs
   auto key = [&](const float* p) {
-    return std::array<uint32_t, 3>{q.position[0].quantize(p[0]), q.position[1].quantize(p[1]), q.position[2].quantize(p[2])};
+    return std::array<uint32_t, 3>{q.position[0].quantize(p[0]), q.position[1].quantize(p[1]),
+                                   q.position[2].quantize(p[2])};
   };
   std::map<std::array<uint32_t, 3>, uint32_t> at;
   for (uint32_t v = 0; v < m.vertexCount(); ++v) at[key(&m.positions[3 * v])] = v;
@@ -62,7 +63,8 @@ TEST(SimplifyRefit, FittedValuesLowerTheFieldErrorOfCoarseLevels) {
     for (uint32_t v = 0; v < level.vertexCount(); ++v) {
       const uint32_t w = at.at(key(&level.positions[3 * v]));
       // The input's value on the quantization grid: within half a step (and float rounding).
-      n += std::abs(level.fields[size_t(f)].values[v] - m.fields[size_t(f)].values[w]) <= 0.51f * q.field[size_t(f)].step;
+      n += std::abs(level.fields[size_t(f)].values[v] - m.fields[size_t(f)].values[w]) <=
+           0.51f * q.field[size_t(f)].step;
     }
     return n;
   };
@@ -138,9 +140,12 @@ TEST(SimplifyRefit, RefitValuesMinimiseTheErrorAtTheInputVertices) {
     }
     ++free;
     const double g = gradient[c], tolerance = 1e-5 * curvature[c] + 1e-9;
-    if (value[c] <= range.min) EXPECT_GT(g, -tolerance) << "vertex " << v << " held at the minimum";
-    else if (value[c] >= range.max) EXPECT_LT(g, tolerance) << "vertex " << v << " held at the maximum";
-    else EXPECT_NEAR(g, 0.0, tolerance) << "vertex " << v;
+    if (value[c] <= range.min)
+      EXPECT_GT(g, -tolerance) << "vertex " << v << " held at the minimum";
+    else if (value[c] >= range.max)
+      EXPECT_LT(g, tolerance) << "vertex " << v << " held at the maximum";
+    else
+      EXPECT_NEAR(g, 0.0, tolerance) << "vertex " << v;
   }
   EXPECT_GT(free, 10u);
 }

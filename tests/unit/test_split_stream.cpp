@@ -195,8 +195,8 @@ TEST(SplitStream, MovedTetsFollowFromNewTetsOnAlmostEverySplit) {
   TetMesh flat = harmonic(12);  // one vertex pushed onto the layer below: flat tets around it
   flat.positions[3 * gridVertex(12, 5, 5, 5) + 2] = flat.positions[3 * gridVertex(12, 5, 5, 4) + 2];
   PackOptions o;
-  for (const auto& [name, mesh] : {std::pair{"moved-cube", harmonic(12)}, std::pair{"moved-l", lShape(12)},
-                                   std::pair{"moved-flat", flat}}) {
+  for (const auto& [name, mesh] :
+       {std::pair{"moved-cube", harmonic(12)}, std::pair{"moved-l", lShape(12)}, std::pair{"moved-flat", flat}}) {
     PackSummary s;
     pack(name, mesh, o, &s);
     EXPECT_GT(s.splits, 500u) << name;

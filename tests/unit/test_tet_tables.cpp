@@ -7,18 +7,22 @@
 #include <set>
 
 #include "isosurface.h"
+#include "test_helpers.h"
 #include "tet_quality.h"
 #include "tet_tables.h"
-#include "test_helpers.h"
 
 using namespace tetstream;
 
 namespace {
 const float kRef[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};  // positive orientation
 
-void sub(const float* a, const float* b, float* out) { for (int k = 0; k < 3; ++k) out[k] = a[k] - b[k]; }
+void sub(const float* a, const float* b, float* out) {
+  for (int k = 0; k < 3; ++k) out[k] = a[k] - b[k];
+}
 void cross(const float* u, const float* v, float* out) {
-  out[0] = u[1] * v[2] - u[2] * v[1]; out[1] = u[2] * v[0] - u[0] * v[2]; out[2] = u[0] * v[1] - u[1] * v[0];
+  out[0] = u[1] * v[2] - u[2] * v[1];
+  out[1] = u[2] * v[0] - u[0] * v[2];
+  out[2] = u[0] * v[1] - u[1] * v[0];
 }
 float dot(const float* u, const float* v) { return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]; }
 }  // namespace
@@ -120,7 +124,10 @@ TEST(TetQuality, ConditionNumberMatchesTheMatrixDefinition) {
   double Winv[3][3];
   inverse(W, Winv);
   uint64_t seed = 12345;
-  auto rnd = [&] { seed = seed * 6364136223846793005ull + 1442695040888963407ull; return double(seed >> 11) / double(1ull << 53) - 0.5; };
+  auto rnd = [&] {
+    seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+    return double(seed >> 11) / double(1ull << 53) - 0.5;
+  };
   for (int trial = 0; trial < 200; ++trial) {
     double p[4][3];
     for (auto& v : p)
@@ -136,12 +143,14 @@ TEST(TetQuality, ConditionNumberMatchesTheMatrixDefinition) {
     EXPECT_NEAR(tetConditionNumber(p[0], p[1], p[2], p[3]), expected, 1e-9 * expected);
     TetShape shape = tetShape(p[0], p[1], p[2], p[3]);
     EXPECT_NEAR(shape.kappa(), expected, 1e-9 * expected);
-    EXPECT_NEAR(shape.det / 6, tetVolume(std::array<float, 3>{float(p[0][0]), float(p[0][1]), float(p[0][2])}.data(),
-                                         std::array<float, 3>{float(p[1][0]), float(p[1][1]), float(p[1][2])}.data(),
-                                         std::array<float, 3>{float(p[2][0]), float(p[2][1]), float(p[2][2])}.data(),
-                                         std::array<float, 3>{float(p[3][0]), float(p[3][1]), float(p[3][2])}.data()),
+    EXPECT_NEAR(shape.det / 6,
+                tetVolume(std::array<float, 3>{float(p[0][0]), float(p[0][1]), float(p[0][2])}.data(),
+                          std::array<float, 3>{float(p[1][0]), float(p[1][1]), float(p[1][2])}.data(),
+                          std::array<float, 3>{float(p[2][0]), float(p[2][1]), float(p[2][2])}.data(),
+                          std::array<float, 3>{float(p[3][0]), float(p[3][1]), float(p[3][2])}.data()),
                 1e-6);
   }
-  const double regular[4][3] = {{0, 0, 0}, {1, 0, 0}, {0.5, std::sqrt(3.0) / 2, 0}, {0.5, std::sqrt(3.0) / 6, std::sqrt(2.0 / 3.0)}};
+  const double regular[4][3] = {
+      {0, 0, 0}, {1, 0, 0}, {0.5, std::sqrt(3.0) / 2, 0}, {0.5, std::sqrt(3.0) / 6, std::sqrt(2.0 / 3.0)}};
   EXPECT_NEAR(tetConditionNumber(regular[0], regular[1], regular[2], regular[3]), 3.0, 1e-12) << "equilateral: κ = 3";
 }

@@ -3,24 +3,23 @@
 // kept up to date locally, the level of detail moving back and forth, the download rate, and
 // the camera framing the dataset.
 #include <gtest/gtest.h>
+#include <zstd.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <numbers>
 #include <numeric>
 #include <random>
 
-#include <nlohmann/json.hpp>
-#include <zstd.h>
-
 #include "adjacency.h"
 #include "camera.h"
 #include "frame_policy.h"
-#include "pack/chunk_encode.h"
 #include "io/generators.h"
+#include "pack/chunk_encode.h"
 #include "pack/packer.h"
 #include "test_helpers.h"
 #include "viewer_memory.h"
@@ -115,7 +114,6 @@ void buildBoundary(const TetMesh& mesh, BoundaryMesh& out) {
     i = j;
   }
 }
-
 
 struct Packed {
   std::string manifest;
@@ -569,7 +567,7 @@ TEST(ViewerState, ADatasetTooBigStopsAtTheLastLevelThatFits) {
 
 bool g_refuseHeap = false;
 uint64_t g_heapAsked = 0;  // the last request
-int g_refusals = 0;  // refuse this many more requests, then give
+int g_refusals = 0;        // refuse this many more requests, then give
 bool fakeReserveHeap(uint64_t bytes) {
   g_heapAsked = bytes;
   if (g_refusals > 0) return --g_refusals, false;
