@@ -9,13 +9,8 @@
 #include "tet_tables.h"
 
 namespace tetstream {
-namespace {
 
-// Boundary edges whose two triangles' normals differ by more than ~30 degrees are creases.
-constexpr float kCreaseCos = 0.866f;
-
-// Outward unit normal of triangle (a, b, c), 0 when degenerate.
-void faceNormal(const float* p, const uint32_t tri[3], float n[3]) {
+void triangleNormal(const float* p, const uint32_t tri[3], float n[3]) {
   const float* a = p + 3 * size_t(tri[0]);
   const float* b = p + 3 * size_t(tri[1]);
   const float* c = p + 3 * size_t(tri[2]);
@@ -27,8 +22,6 @@ void faceNormal(const float* p, const uint32_t tri[3], float n[3]) {
   float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
   for (int k = 0; k < 3; ++k) n[k] = len > 0 ? n[k] / len : 0.f;
 }
-
-}  // namespace
 
 // ------------------------------------------------------------------ the hull, kept up to date
 
@@ -199,7 +192,7 @@ void HullTracker::addFace(const float* p, const uint32_t tri[3]) {
   const uint32_t slot = triangleCount();
   faces_.insert(faces_.end(), tri, tri + 3);
   float n[3];
-  faceNormal(p, tri, n);
+  triangleNormal(p, tri, n);
   for (int k = 0; k < 3; ++k) {
     const float* q = p + 3 * size_t(tri[k]);
     positions_.insert(positions_.end(), q, q + 3);

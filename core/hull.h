@@ -10,6 +10,13 @@
 
 namespace tetstream {
 
+// Boundary edges whose two triangles' normals differ by more than ~30 degrees are creases.
+inline constexpr float kCreaseCos = 0.866f;
+
+// Outward unit normal n of triangle tri (vertex ids into positions p, 3 floats each), 0 when
+// degenerate.
+void triangleNormal(const float* p, const uint32_t tri[3], float n[3]);
+
 // The domain boundary (translucent hull and crease lines) of a ProgressiveMesh, kept up to date
 // across vertex splits and their undo without looking at the whole mesh: only faces and edges
 // at the split vertices can change (a split touches star(i) ∪ star(j) only, paper §4.3), so

@@ -19,7 +19,10 @@ std::string statsJson(const ViewerState& s) {
   uint32_t splitsTotal = 0;
   for (size_t c = 1; c < m.chunks.size(); ++c) splitsTotal += m.chunks[c].splits;
   const double fieldError = fieldErrorBound(s);
-  json j = {
+  // The view a link keeps (field, isovalue, colour, slice, showBoundary), then everything else;
+  // "level" here is the level shown, not the one asked for.
+  json j = viewObject(s);
+  j.update(json{
       {"state", loadStateName(s.state)},
       {"error", s.error},
       {"name", m.name},
@@ -27,18 +30,7 @@ std::string statsJson(const ViewerState& s) {
       {"tets", ds.pm.mesh.tetCount()},
       {"triangles", s.surface.triangleCount()},
       {"surfaceVertices", s.surface.vertexCount()},
-      {"isovalue", s.isovalue},
       {"surfaceArea", s.surface.area()},
-      {"field", s.field >= 0 ? json(m.fields[size_t(s.field)].name) : json(nullptr)},
-      {"colourField", s.colour.field >= 0 ? json(m.fields[size_t(s.colour.field)].name) : json(nullptr)},
-      {"colourMap", colourMapName(s.colour.map)},
-      {"colourRange", json::array({s.colour.min, s.colour.max})},
-      {"slice",
-       {{"on", s.sliceOn},
-        {"normal", json::array({s.slice.normal()[0], s.slice.normal()[1], s.slice.normal()[2]})},
-        {"offset", s.slice.offset()},
-        {"triangles", s.slice.surface().triangleCount()},
-        {"area", s.slice.surface().area()}}},
       {"fields", std::move(fields)},
       {"chunksReceived", ds.chunksReceived},
       {"chunksApplied", ds.chunksApplied()},
@@ -104,7 +96,9 @@ std::string statsJson(const ViewerState& s) {
       {"panelRect", rect(s.telemetry.screen.panel)},
       {"showHelp", s.view.showHelp},
       {"targetLevel", targetLevel(s)},
-  };
+  });
+  j["slice"]["triangles"] = s.slice.surface().triangleCount();
+  j["slice"]["area"] = s.slice.surface().area();
   // Messages may carry bytes from the network: never let invalid UTF-8 abort the dump.
   return j.dump(-1, ' ', false, json::error_handler_t::replace);
 }

@@ -495,10 +495,10 @@ const ChunkInfo* levelChunk(const ViewerState& s) {
   return c ? &s.dataset.manifest.chunks[c - 1] : nullptr;
 }
 
-std::string viewJson(const ViewerState& s) {
+nlohmann::json viewObject(const ViewerState& s) {
   using json = nlohmann::json;
   const Manifest& m = s.dataset.manifest;
-  const json j = {
+  return {
       {"field", s.field >= 0 ? json(m.fields[size_t(s.field)].name) : json(nullptr)},
       {"isovalue", s.isovalue},
       {"colourField", s.colour.field >= 0 ? json(m.fields[size_t(s.colour.field)].name) : json(nullptr)},
@@ -511,7 +511,10 @@ std::string viewJson(const ViewerState& s) {
       {"level", targetLevel(s)},
       {"showBoundary", s.view.showBoundary},
   };
-  return j.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+std::string viewJson(const ViewerState& s) {
+  return viewObject(s).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 }  // namespace tetstream::viewer

@@ -32,6 +32,7 @@
 #include <cstdlib>
 #include <map>
 #include <memory>
+#include <nlohmann/json_fwd.hpp>
 #include <span>
 #include <string>
 #include <string_view>
@@ -226,7 +227,9 @@ bool growTree(ViewerState& s, double deadlineMs, Clock now);
 
 // The view a link keeps, as JSON: {field, isovalue, colourField, colourMap, colourRange, slice:
 // {on, normal, offset}, level (the level asked for as a fraction of the full mesh's vertices; 1
-// while live), showBoundary} (docs/js-api.md).
+// while live), showBoundary} (docs/js-api.md). viewObject is the same object, which stats()
+// extends (telemetry.cpp).
+nlohmann::json viewObject(const ViewerState& s);
 std::string viewJson(const ViewerState& s);
 
 }  // namespace tetstream::viewer

@@ -40,25 +40,6 @@ struct BoundaryMesh {
   uint32_t lineCount() const { return uint32_t(featureLines.size() / 6); }
 };
 
-// Boundary edges whose two triangles' normals differ by more than ~30 degrees are creases.
-constexpr float kCreaseCos = 0.866f;
-
-uint64_t edgeKey(uint32_t a, uint32_t b) { return a < b ? uint64_t(a) << 32 | b : uint64_t(b) << 32 | a; }
-
-// Outward unit normal of triangle (a, b, c), 0 when degenerate.
-void faceNormal(const float* p, const uint32_t tri[3], float n[3]) {
-  const float* a = p + 3 * size_t(tri[0]);
-  const float* b = p + 3 * size_t(tri[1]);
-  const float* c = p + 3 * size_t(tri[2]);
-  float u[3], v[3];
-  for (int k = 0; k < 3; ++k) u[k] = b[k] - a[k], v[k] = c[k] - a[k];
-  n[0] = u[1] * v[2] - u[2] * v[1];
-  n[1] = u[2] * v[0] - u[0] * v[2];
-  n[2] = u[0] * v[1] - u[1] * v[0];
-  float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-  for (int k = 0; k < 3; ++k) n[k] = len > 0 ? n[k] / len : 0.f;
-}
-
 // Boundary triangles of a mesh and their crease edges (dihedral angle above ~30 degrees, or an
 // edge not shared by exactly two boundary triangles).
 void buildBoundary(const TetMesh& mesh, BoundaryMesh& out) {
@@ -76,7 +57,7 @@ void buildBoundary(const TetMesh& mesh, BoundaryMesh& out) {
   out.normals.reserve(9 * nt);
   for (size_t t = 0; t < nt; ++t) {
     float n[3];
-    faceNormal(p, &tris[3 * t], n);
+    triangleNormal(p, &tris[3 * t], n);
     for (int k = 0; k < 3; ++k) {
       const float* q = p + 3 * size_t(tris[3 * t + k]);
       out.positions.insert(out.positions.end(), q, q + 3);
