@@ -4,8 +4,6 @@
 import { canvas, page, viewerReady } from './page.js';
 import { peekChunks, openDataset, useLocalFiles } from './stream.js';
 import { showError } from './status.js';
-import { forgetPendingLevel } from './api.js';
-import { keepUpdating } from './main.js';
 
 // ------------------------------------------------------------------ touch
 // One finger orbits, two fingers pinch-zoom and pan (pointer events). Touches that start on the
@@ -105,6 +103,13 @@ export function packedFolder(list) {
   return files;
 }
 
+// What else opening a folder does, set by main.js: the old link's pending level is forgotten
+// and the page's updates run.
+const folderHooks = { forgetPendingLevel() {}, keepUpdating() {} };
+export function setFolderHooks(hooks) {
+  Object.assign(folderHooks, hooks);
+}
+
 // Opens a packed dataset from local files (a Map path -> File, relative to its folder).
 export async function openFolder(files) {
   if (!files || !files.get('manifest.json')) {
@@ -120,10 +125,10 @@ export async function openFolder(files) {
     return false;
   }
   useLocalFiles(files);
-  forgetPendingLevel();
+  folderHooks.forgetPendingLevel();
   document.getElementById('help').style.display = 'none';
   if (location.search) history.replaceState(history.state, '', location.pathname);
-  keepUpdating();
+  folderHooks.keepUpdating();
   await openDataset(new URL(URL.createObjectURL(files.get('manifest.json'))), 'while opening the folder');
   return true;
 }

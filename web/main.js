@@ -5,11 +5,13 @@
 //   stream.js   manifest, chunks and the network's figures
 //   api.js      window.tetstream and the view in the URL
 //   status.js   the status line     input.js    touch and folder drop
-import { applyPendingLevel, syncUrl } from './api.js';
-import './input.js';
+// Imports go one way (none back up): net.js, rate.js, loader.js, page.js; program.js, status.js;
+// stream.js; api.js, input.js; this file, which wires the hooks that point back up.
+import { applyLinkState, applyPendingLevel, copyLink, forgetPendingLevel, saveScreenshot, syncUrl } from './api.js';
+import { setFolderHooks } from './input.js';
 import { page, params } from './page.js';
 import { updateStatus, hideStatus } from './status.js';
-import { fail, network, openDataset } from './stream.js';
+import { fail, network, openDataset, setViewHooks } from './stream.js';
 
 // Four times a second while a dataset is open: the network snapshot to the panel, a link's
 // level as its parts arrive, the address bar, the status line.
@@ -18,11 +20,11 @@ function update() {
   network.report();
   applyPendingLevel();
   syncUrl();
-  updateStatus();
+  updateStatus(network);
 }
 
 let timer = 0;
-export function keepUpdating() {
+function keepUpdating() {
   if (!timer) timer = setInterval(update, 250);
 }
 
@@ -59,4 +61,6 @@ async function start() {
   }
 }
 
+setViewHooks({ applyLinkState, copyLink, saveScreenshot });
+setFolderHooks({ forgetPendingLevel, keepUpdating });
 start();

@@ -3,7 +3,6 @@
 // It reads the page's own figures and a few typed getters of the viewer, never stats().
 import { seconds } from './net.js';
 import { formatBytes, page, stallMs, viewerReady, wasmString } from './page.js';
-import { network } from './stream.js';
 
 const statusBox = document.getElementById('status');
 const statusText = document.getElementById('status-text');
@@ -64,7 +63,8 @@ function viewerStatus() {
 }
 
 // The line and its bar, from what the page and the viewer know now (four times a second).
-export function updateStatus() {
+// network: stream.js's (passed in, since streaming itself writes to this line).
+export function updateStatus(network) {
   if (page.state === 'idle' || page.aborted) return;
   const s = viewerStatus();
   if (s && s.state === 'error') {

@@ -5,7 +5,6 @@
 // hands the panel one snapshot (ts_set_network). Functions of the viewer: docs/js-api.md.
 import { ChunkLoader, damageText } from './loader.js';
 import { fetchBytes } from './net.js';
-import { applyLinkState, copyLink, saveScreenshot } from './api.js';
 import { boot, copyToWasm, LoadError, maxMemoryMB, page, stallMs, viewerReady, wasmString } from './page.js';
 import { loadProgram, prepareWebGl, withRetries } from './program.js';
 import { RateMeter } from './rate.js';
@@ -105,6 +104,14 @@ function programIn() {
   if (page.programLoaded) return;
   page.programLoaded = true;
   if (page.loader) page.loader.warm();
+}
+
+// What the page does with the viewer besides streaming into it, set by main.js (api.js's
+// functions, which read the network from here): the view a link asked for, once the manifest is
+// open, and the panel's "copy link" and screenshot buttons.
+const viewHooks = { applyLinkState() {}, copyLink() {}, saveScreenshot: async () => {} };
+export function setViewHooks(hooks) {
+  Object.assign(viewHooks, hooks);
 }
 
 let programLoad = null; // the program is loaded once, whatever number of datasets the page opens
@@ -236,8 +243,8 @@ async function stream(manifestUrl) {
 
   const viewer = page.viewer = await programPromise; // a failure here has no viewer to report into
   viewer.onPauseChange = (paused) => network.setPaused(paused);
-  viewer.onCopyLink = () => { copyLink(); };
-  viewer.onScreenshot = () => { saveScreenshot().catch((e) => console.warn(`tetstream: screenshot: ${e.message}`)); };
+  viewer.onCopyLink = () => { viewHooks.copyLink(); };
+  viewer.onScreenshot = () => { viewHooks.saveScreenshot().catch((e) => console.warn(`tetstream: screenshot: ${e.message}`)); };
   let manifestBytes;
   try {
     manifestBytes = await manifestPromise;
@@ -258,7 +265,7 @@ async function stream(manifestUrl) {
   }
   document.title = `tetstream — ${wasmString(viewer._ts_name()) || manifestUrl.pathname}`;
   if (page.state === 'error') return fail(page.error); // the base could not be had: say so in the panel too
-  applyLinkState();
+  viewHooks.applyLinkState();
 
   const { names, sizes } = chunksOfViewer();
   network.chunkSizes = sizes;
