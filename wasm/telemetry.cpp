@@ -77,7 +77,6 @@ std::string statsJson(const ViewerState& s) {
       {"fullUploads", s.telemetry.fullUploads},
       {"partialUploads", s.telemetry.partialUploads},
       {"grownUploads", s.telemetry.grownUploads},
-      {"showBoundary", s.view.showBoundary},
       {"notice", s.network.notice},
       {"chunksAllowed", s.memory.chunksAllowed},
       {"memoryLimited", s.memory.limited},

@@ -134,11 +134,16 @@ double totalVolume(const TetMesh& m) {
   return v;
 }
 
-double boundaryArea(const TetMesh& m) {
+std::vector<uint32_t> boundaryTriangles(const TetMesh& m) {
   FaceAdjacency adj;
   buildFaceAdjacency(m.tets, m.vertexCount(), adj);
   std::vector<uint32_t> tris;
   extractBoundary(m.tets, adj, tris);
+  return tris;
+}
+
+double boundaryArea(const TetMesh& m) {
+  const std::vector<uint32_t> tris = boundaryTriangles(m);
   double area = 0;
   for (size_t i = 0; i < tris.size(); i += 3) {
     const float* a = &m.positions[3 * size_t(tris[i])];
@@ -241,10 +246,7 @@ TetMesh coarseMesh(const TetMesh& in, const SimplifyResult& r) {
 
 // V − E + F of the boundary surface: 2 for a ball-shaped domain, 0 for one with a tunnel.
 long boundaryEuler(const TetMesh& m) {
-  FaceAdjacency adj;
-  buildFaceAdjacency(m.tets, m.vertexCount(), adj);
-  std::vector<uint32_t> b;
-  extractBoundary(m.tets, adj, b);
+  const std::vector<uint32_t> b = boundaryTriangles(m);
   std::vector<uint32_t> verts(b);
   std::sort(verts.begin(), verts.end());
   verts.erase(std::unique(verts.begin(), verts.end()), verts.end());

@@ -98,6 +98,8 @@ inline std::vector<uint8_t> loadBytes(const std::string& path) {
 // Sum of the tets' unsigned volumes.
 double totalVolume(const TetMesh& m);
 // Area of the boundary surface (a split that does not conform leaves inner faces on it).
+// The boundary faces as outward-wound vertex triples (adjacency.h's extractBoundary).
+std::vector<uint32_t> boundaryTriangles(const TetMesh& m);
 double boundaryArea(const TetMesh& m);
 // A conforming, valid mesh: every inner face shared by exactly two tets, a closed manifold
 // boundary, one orientation, no flat or duplicate tets, no unused vertices.

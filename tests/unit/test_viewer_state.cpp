@@ -45,10 +45,7 @@ struct BoundaryMesh {
 void buildBoundary(const TetMesh& mesh, BoundaryMesh& out) {
   out = {};
   if (mesh.tetCount() == 0) return;
-  FaceAdjacency adj;
-  buildFaceAdjacency(mesh.tets, mesh.vertexCount(), adj);
-  std::vector<uint32_t> tris;
-  extractBoundary(mesh.tets, adj, tris);
+  const std::vector<uint32_t> tris = test::boundaryTriangles(mesh);
 
   const float* p = mesh.positions.data();
   const size_t nt = tris.size() / 3;
@@ -159,10 +156,7 @@ void expectMatchesFromScratch(const ViewerState& s, const char* where) {
   EXPECT_TRUE(s.surface.validate());
 
   // Hull: the same outward-wound triangles (compared with the smallest id first) and creases.
-  FaceAdjacency adj;
-  buildFaceAdjacency(mesh.tets, mesh.vertexCount(), adj);
-  std::vector<uint32_t> tris;
-  extractBoundary(mesh.tets, adj, tris);
+  const std::vector<uint32_t> tris = test::boundaryTriangles(mesh);
   auto canonical = [](std::span<const uint32_t> t) {
     std::vector<std::array<uint32_t, 3>> out;
     for (size_t i = 0; i + 2 < t.size(); i += 3) {
