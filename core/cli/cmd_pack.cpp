@@ -196,7 +196,7 @@ Runner addPack(CLI::App& app) {
                  {"flatTetsRemoved", s.flatTetsRemoved},
                  {"flatTetsLeft", s.flatTetsLeft},
                  {"queuePops", s.queuePops},
-                 {"slabCollapses", s.slabCollapses},
+                 {"regionCollapses", s.regionCollapses},
                  {"requeued", s.requeued},
                  {"costEvaluations", s.costEvaluations},
                  {"readMs", readMs},
