@@ -213,7 +213,7 @@ Result parseNodes(Reader& r, const json& list, Manifest& m) {
     if (chunks[1] < 1) return bad("'" + path + "chunks' must hold at least one chunk");
     if (chunks[0] != nextChunk)
       return bad("'" + path + "chunks' must start at chunk " + std::to_string(nextChunk) +
-                 (k == 0 ? " (the first split chunk)" : ", where the previous node's end"));
+                 (k == 0 ? " (the first split chunk)" : ", where the previous node ends"));
     if (chunks[0] + chunks[1] > m.chunks.size()) return bad("'" + path + "chunks' runs past the last chunk");
     nextChunk = chunks[0] + chunks[1];
     node.firstChunk = uint32_t(chunks[0]);
