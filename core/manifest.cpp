@@ -118,7 +118,7 @@ struct Reader {
     }
     return true;
   }
-  // [a, b] with a <= b, both non-negative integers <= hi.
+  // [a, b]: two non-negative integers, each at most hi.
   bool integerPair(const json& obj, const char* key, const std::string& path, uint64_t hi, uint64_t out[2]) {
     const json* v = member(obj, key, path);
     if (!v) return false;
@@ -184,12 +184,12 @@ Result parseRanges(const json& n, const std::string& path, const Manifest& m, co
   return Result::success();
 }
 
-// FORMAT.md §1.1. Run after the chunks, whose counts the nodes' ranges must agree with.
+// FORMAT.md §1.1. Run after the chunks: the nodes' vertex and tet ids must agree with their counts.
 Result parseNodes(Reader& r, const json& list, Manifest& m) {
   const size_t splitChunks = m.chunks.size() - 1;
   if (!list.is_array() || list.size() > splitChunks)
     return bad("'nodes' must be an array of at most one node per split chunk (" + std::to_string(splitChunks) + ")");
-  uint64_t nextChunk = 1;  // the chunks before it belong to earlier nodes (or are the base)
+  uint64_t nextChunk = 1;  // the first chunk in no node yet (chunk 0 is the base)
   for (size_t k = 0; k < list.size(); ++k) {
     const json& n = list[k];
     const std::string name = "nodes[" + std::to_string(k) + "]", path = name + ".";

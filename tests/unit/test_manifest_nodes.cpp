@@ -156,7 +156,10 @@ TEST(ManifestNodes, HostileNodesAreRefusedWithTheKeyNamed) {
   };
   const Case cases[] = {
       {"'nodes'", [](json& d) { d.erase("nodes"); }},
-      {"'nodes'", [](json& d) { d["nodes"] = {{"parent", -1}}; }},
+      {"'nodes'",
+       [](json& d) {
+         d["nodes"] = {{"parent", -1}};
+       }},
       {"'nodes'", [](json& d) { d["nodes"].push_back(d["nodes"][3]); }},  // more nodes than split chunks
       {"'nodes[1]'", [](json& d) { d["nodes"][1] = 5; }},
       // Parents: -1 or an earlier node, so no cycle and parents first.
@@ -169,8 +172,14 @@ TEST(ManifestNodes, HostileNodesAreRefusedWithTheKeyNamed) {
       {"'nodes[1].parent'", [](json& d) { d["nodes"][1]["parent"] = "0"; }},
       {"'nodes[1].parent'", [](json& d) { d["nodes"][1].erase("parent"); }},
       // Chunks: consecutive, non-empty, covering every split chunk once.
-      {"'nodes[1].chunks'", [](json& d) { d["nodes"][1]["chunks"] = {2, 0}; }},
-      {"'nodes[1].chunks'", [](json& d) { d["nodes"][1]["chunks"] = {1, 1}; }},  // overlaps node 0
+      {"'nodes[1].chunks'",
+       [](json& d) {
+         d["nodes"][1]["chunks"] = {2, 0};
+       }},
+      {"'nodes[1].chunks'",
+       [](json& d) {
+         d["nodes"][1]["chunks"] = {1, 1};
+       }},                   // overlaps node 0
       {"'nodes[1].chunks'",  // node 0 takes chunk 2 too: node 1 overlaps it
        [](json& d) {
          json& n = d["nodes"][0];
@@ -178,42 +187,123 @@ TEST(ManifestNodes, HostileNodesAreRefusedWithTheKeyNamed) {
          n["vertices"] = {10, 20};
          n["tets"] = {20, 44};
        }},
-      {"'nodes[2].chunks'", [](json& d) { d["nodes"][2]["chunks"] = {4, 1}; }},  // leaves chunk 3 out
-      {"'nodes[0].chunks'", [](json& d) { d["nodes"][0]["chunks"] = {0, 1}; }},  // the base is no node's
-      {"'nodes[2].chunks'", [](json& d) { d["nodes"].erase(3); }},               // chunk 4 in no node
-      {"'nodes[3].chunks'", [](json& d) { d["nodes"][3]["chunks"] = {4, 2}; }},
-      {"'nodes[3].chunks'", [](json& d) { d["nodes"][3]["chunks"] = {4, 4294967295u}; }},
-      {"'nodes[3].chunks'", [](json& d) { d["nodes"][3]["chunks"] = {4294967295u, 1}; }},
-      {"'nodes[0].chunks'", [](json& d) { d["nodes"][0]["chunks"] = {-1, 1}; }},
+      {"'nodes[2].chunks'",
+       [](json& d) {
+         d["nodes"][2]["chunks"] = {4, 1};
+       }},  // leaves chunk 3 out
+      {"'nodes[0].chunks'",
+       [](json& d) {
+         d["nodes"][0]["chunks"] = {0, 1};
+       }},                                                          // the base is no node's
+      {"'nodes[2].chunks'", [](json& d) { d["nodes"].erase(3); }},  // chunk 4 in no node
+      {"'nodes[3].chunks'",
+       [](json& d) {
+         d["nodes"][3]["chunks"] = {4, 2};
+       }},
+      {"'nodes[3].chunks'",
+       [](json& d) {
+         d["nodes"][3]["chunks"] = {4, 4294967295u};
+       }},
+      {"'nodes[3].chunks'",
+       [](json& d) {
+         d["nodes"][3]["chunks"] = {4294967295u, 1};
+       }},
+      {"'nodes[0].chunks'",
+       [](json& d) {
+         d["nodes"][0]["chunks"] = {-1, 1};
+       }},
       {"'nodes[0].chunks'", [](json& d) { d["nodes"][0]["chunks"] = {1}; }},
-      {"'nodes[0].chunks'", [](json& d) { d["nodes"][0]["chunks"] = {1.0, 1}; }},
+      {"'nodes[0].chunks'",
+       [](json& d) {
+         d["nodes"][0]["chunks"] = {1.0, 1};
+       }},
       {"'nodes[0].chunks'", [](json& d) { d["nodes"][0]["chunks"] = "1"; }},
       // Stable ids must agree with the chunks' counts.
-      {"'nodes[1].vertices'", [](json& d) { d["nodes"][1]["vertices"] = {15, 21}; }},
-      {"'nodes[1].vertices'", [](json& d) { d["nodes"][1]["vertices"] = {14, 20}; }},
-      {"'nodes[1].vertices'", [](json& d) { d["nodes"][1]["vertices"] = {15, 99999999999}; }},
-      {"'nodes[1].vertices'", [](json& d) { d["nodes"][1]["vertices"] = {20, 15}; }},
-      {"'nodes[2].tets'", [](json& d) { d["nodes"][2]["tets"] = {44, 57}; }},
-      {"'nodes[2].tets'", [](json& d) { d["nodes"][2]["tets"] = {32, 56}; }},
+      {"'nodes[1].vertices'",
+       [](json& d) {
+         d["nodes"][1]["vertices"] = {15, 21};
+       }},
+      {"'nodes[1].vertices'",
+       [](json& d) {
+         d["nodes"][1]["vertices"] = {14, 20};
+       }},
+      {"'nodes[1].vertices'",
+       [](json& d) {
+         d["nodes"][1]["vertices"] = {15, 99999999999};
+       }},
+      {"'nodes[1].vertices'",
+       [](json& d) {
+         d["nodes"][1]["vertices"] = {20, 15};
+       }},
+      {"'nodes[2].tets'",
+       [](json& d) {
+         d["nodes"][2]["tets"] = {44, 57};
+       }},
+      {"'nodes[2].tets'",
+       [](json& d) {
+         d["nodes"][2]["tets"] = {32, 56};
+       }},
       {"'nodes[2].tets'", [](json& d) { d["nodes"][2].erase("tets"); }},
       // Ranges: one finite [min, max] per field, nested in the field's and the parent's.
       {"'nodes[1].ranges'", [](json& d) { d["nodes"][1]["ranges"].erase(1); }},
-      {"'nodes[1].ranges'", [](json& d) { d["nodes"][1]["ranges"].push_back({0, 1}); }},
-      {"'nodes[1].ranges'", [](json& d) { d["nodes"][1]["ranges"] = {{"f", {0, 1}}}; }},
+      {"'nodes[1].ranges'",
+       [](json& d) {
+         d["nodes"][1]["ranges"].push_back({0, 1});
+       }},
+      {"'nodes[1].ranges'",
+       [](json& d) {
+         d["nodes"][1]["ranges"] = {{"f", {0, 1}}};
+       }},
       {"'nodes[2].ranges'", [](json& d) { d["nodes"][2].erase("ranges"); }},
-      {"'nodes[1].ranges[0]'", [](json& d) { d["nodes"][1]["ranges"][0] = {-1, 0, 1}; }},
-      {"'nodes[1].ranges[1]'", [](json& d) { d["nodes"][1]["ranges"][1] = {5, 2}; }},
-      {"'nodes[1].ranges[0]'", [](json& d) { d["nodes"][1]["ranges"][0] = {-1, 0.75}; }},  // parent's ends at 0.5
-      {"'nodes[3].ranges[1]'", [](json& d) { d["nodes"][3]["ranges"][1] = {2, 11}; }},     // field's ends at 10
-      {"'nodes[3].ranges[0]'", [](json& d) { d["nodes"][3]["ranges"][0] = {0, 1e39}; }},
-      {"'nodes[3].ranges[0]'", [](json& d) { d["nodes"][3]["ranges"][0] = {nullptr, 1}; }},  // NaN is written so
-      {"'nodes[3].ranges[0]'", [](json& d) { d["nodes"][3]["ranges"][0] = {"0", 1}; }},
+      {"'nodes[1].ranges[0]'",
+       [](json& d) {
+         d["nodes"][1]["ranges"][0] = {-1, 0, 1};
+       }},
+      {"'nodes[1].ranges[1]'",
+       [](json& d) {
+         d["nodes"][1]["ranges"][1] = {5, 2};
+       }},
+      {"'nodes[1].ranges[0]'",
+       [](json& d) {
+         d["nodes"][1]["ranges"][0] = {-1, 0.75};
+       }},  // parent's ends at 0.5
+      {"'nodes[3].ranges[1]'",
+       [](json& d) {
+         d["nodes"][3]["ranges"][1] = {2, 11};
+       }},  // field's ends at 10
+      {"'nodes[3].ranges[0]'",
+       [](json& d) {
+         d["nodes"][3]["ranges"][0] = {0, 1e39};
+       }},
+      {"'nodes[3].ranges[0]'",
+       [](json& d) {
+         d["nodes"][3]["ranges"][0] = {nullptr, 1};
+       }},  // NaN is written so
+      {"'nodes[3].ranges[0]'",
+       [](json& d) {
+         d["nodes"][3]["ranges"][0] = {"0", 1};
+       }},
       // Bounds: finite boxes nested in the top-level box and the parent's.
-      {"'nodes[2].bounds'", [](json& d) { d["nodes"][2]["bounds"]["max"] = {2.5, 2, 2}; }},
-      {"'nodes[3].bounds'", [](json& d) { d["nodes"][3]["bounds"]["max"] = {5, 2, 2}; }},
-      {"'nodes[3].bounds.min'", [](json& d) { d["nodes"][3]["bounds"]["min"] = {3, 0, 3}; }},
-      {"'nodes[3].bounds.max'", [](json& d) { d["nodes"][3]["bounds"]["max"] = {1e39, 2, 2}; }},
-      {"'nodes[3].bounds.max'", [](json& d) { d["nodes"][3]["bounds"]["max"] = {4, 2}; }},
+      {"'nodes[2].bounds'",
+       [](json& d) {
+         d["nodes"][2]["bounds"]["max"] = {2.5, 2, 2};
+       }},
+      {"'nodes[3].bounds'",
+       [](json& d) {
+         d["nodes"][3]["bounds"]["max"] = {5, 2, 2};
+       }},
+      {"'nodes[3].bounds.min'",
+       [](json& d) {
+         d["nodes"][3]["bounds"]["min"] = {3, 0, 3};
+       }},
+      {"'nodes[3].bounds.max'",
+       [](json& d) {
+         d["nodes"][3]["bounds"]["max"] = {1e39, 2, 2};
+       }},
+      {"'nodes[3].bounds.max'",
+       [](json& d) {
+         d["nodes"][3]["bounds"]["max"] = {4, 2};
+       }},
       {"'nodes[0].bounds'", [](json& d) { d["nodes"][0].erase("bounds"); }},
       {"'nodes[0].bounds'", [](json& d) { d["nodes"][0]["bounds"] = "box"; }},
       // Errors: finite and not negative; the measured ones optional.
