@@ -143,7 +143,8 @@ const CHUNK_FILE = /^chunks\/[0-9a-z.-]+$/;
 export function peekChunks(bytes) {
   try {
     const m = JSON.parse(new TextDecoder().decode(bytes));
-    if (m.format !== 'tetstream' || m.formatVersion !== 1 || !Array.isArray(m.chunks)) return null;
+    // Versions 1 and 2 list their chunk files alike (FORMAT.md §1); nodes are the viewer's to read.
+    if (m.format !== 'tetstream' || ![1, 2].includes(m.formatVersion) || !Array.isArray(m.chunks)) return null;
     if (!m.chunks.length || m.chunks.length > 65536) return null;
     const names = [], sizes = [];
     for (const c of m.chunks) {

@@ -265,6 +265,27 @@ std::vector<std::pair<std::string, std::vector<uint8_t>>> seeds(const std::strin
   ChunkDecoder dec;
   if (target == "manifest") {
     out.push_back({"packed", std::vector<uint8_t>(ctx.manifestJson.begin(), ctx.manifestJson.end())});
+    // The same chunks as a chain of two nodes (the first split chunk, then the rest), so fuzzing
+    // starts inside the node rules whatever hierarchy the packer wrote.
+    Manifest chain = m;
+    chain.nodes.clear();
+    for (uint32_t first : {1u, 2u}) {
+      NodeInfo n;
+      n.parent = int32_t(first) - 2;
+      n.firstChunk = first;
+      n.chunkCount = first == 1 ? 1 : uint32_t(m.chunks.size()) - 2;
+      n.vertexBegin = m.chunks[first - 1].vertices;
+      n.vertexEnd = m.chunks[first + n.chunkCount - 1].vertices;
+      n.tetBegin = m.chunks[first - 1].tets;
+      n.tetEnd = m.chunks[first + n.chunkCount - 1].tets;
+      n.bounds = m.bounds;
+      for (const FieldInfo& f : m.fields) n.ranges.push_back(f.range);
+      n.fieldError = m.chunks[first - 1].fieldError;
+      chain.nodes.push_back(n);
+    }
+    const std::string text = writeManifest(chain);
+    FUZZ_CHECK(parseManifest(text, chain));
+    out.push_back({"nodes", std::vector<uint8_t>(text.begin(), text.end())});
   } else if (target == "base-chunk") {
     std::span<const uint8_t> p = payloadOf(dec, m.chunks[0], 0, ctx.files[0]);
     out.push_back({"base", std::vector<uint8_t>(p.begin(), p.end())});
