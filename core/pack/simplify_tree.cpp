@@ -132,9 +132,14 @@ void Simplifier::runTree(uint32_t target) {
     const double stages = tree.depth - level + 1;
     auto keepOf = [&](double now, double goal) { return goal > 0 && now > goal ? std::pow(goal / now, 1 / stages) : 1; };
     const double keep = std::max(keepOf(alive_, target), opt_.targetTets ? keepOf(tetsAlive_, opt_.targetTets) : 0.0);
-    const double planned = (1 - keep) * alive_;
+    double planned = (1 - keep) * alive_;
     if (keys.empty() || planned < 1) continue;
-    const size_t at = size_t(std::min(kQuantileCap * double(keys.size() - 1), kQuantileReach * planned));
+    size_t at = size_t(std::min(kQuantileCap * double(keys.size() - 1), kQuantileReach * planned));
+    if (getenv("TS_FINAL")) {
+      const double goal = std::max<double>(target, opt_.targetTets ? alive_ * double(opt_.targetTets) / tetsAlive_ : 0.0);
+      planned = (alive_ - goal) * atof(getenv("TS_FINAL"));
+      at = size_t(std::min<double>(double(keys.size() - 1), planned));
+    }
     std::nth_element(keys.begin(), keys.begin() + ptrdiff_t(at), keys.end());
     const float tau = keys[at];
     // Regions go to the threads largest first, to the one with less work so far.
