@@ -194,7 +194,7 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   so.weightField = opt.weights[1];
   so.weightShape = opt.weights[2];
   so.threads = opt.threads;
-  so.leafVertices = getenv("TS_LEAF") ? uint32_t(atoi(getenv("TS_LEAF"))) : opt.leafVertices;
+  so.leafVertices = opt.leafVertices;
   so.fitValues = opt.fitValues;
   so.field = iso;
   so.recordReadSets = opt.orderSplits;

@@ -17,7 +17,7 @@ Bounds unite(const Bounds& a, const Bounds& b) {
 
 }  // namespace
 
-RegionStats regionStats(const TetMesh& mesh, const SimplifyResult& s) {
+RegionStats regionStats(const TetMesh& mesh, const SimplifyResult& s, const Manifest& m) {
   const RegionTree& tree = s.tree;
   const uint32_t nodes = tree.nodes(), F = uint32_t(mesh.fields.size());
   RegionStats out;
@@ -62,7 +62,19 @@ RegionStats regionStats(const TetMesh& mesh, const SimplifyResult& s) {
   for (uint32_t n = 1; n < nodes; ++n)
     for (uint32_t f = 0; f < F; ++f)
       if (!(out.ranges[n][f].min <= out.ranges[n][f].max))
-        out.ranges[n][f] = n > 1 ? out.ranges[n / 2][f] : computeRange(mesh.fields[f].values);
+        out.ranges[n][f] = n > 1 ? out.ranges[n / 2][f] : m.fields[f].range;
+  for (uint32_t n = 1; n < nodes; ++n) {
+    for (uint32_t f = 0; f < F; ++f) {
+      Range& r = out.ranges[n][f];
+      r = {std::clamp(r.min, m.fields[f].range.min, m.fields[f].range.max),
+           std::clamp(r.max, m.fields[f].range.min, m.fields[f].range.max)};
+    }
+    for (int k = 0; k < 3; ++k) {
+      Bounds& b = out.bounds[n];
+      b.min[k] = std::clamp(b.min[k], m.bounds.min[k], m.bounds.max[k]);
+      b.max[k] = std::clamp(b.max[k], m.bounds.min[k], m.bounds.max[k]);
+    }
+  }
   return out;
 }
 

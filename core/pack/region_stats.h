@@ -4,6 +4,7 @@
 #pragma once
 #include <vector>
 
+#include "manifest.h"
 #include "mesh.h"
 #include "pack/simplify.h"
 
@@ -19,7 +20,8 @@ struct RegionStats {
 };
 
 // `mesh`: the simplifier's input (positions and fields; its tets are not read). Vertices of no
-// tet belong to no region.
-RegionStats regionStats(const TetMesh& mesh, const SimplifyResult& s);
+// tet belong to no region. Bounds and ranges are kept within the manifest's, which were taken
+// before the values were snapped to the grid (a snapped value may lie an ulp outside).
+RegionStats regionStats(const TetMesh& mesh, const SimplifyResult& s, const Manifest& m);
 
 }  // namespace tetstream

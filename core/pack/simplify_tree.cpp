@@ -14,14 +14,15 @@
 // The cut: at the median along the longest side of the region's bounding box, ties by vertex id,
 // so the tree is perfect (every leaf at the same depth) and each leaf holds at most leafVertices.
 //
-// How far a level goes: the stream's coarsening is shared out evenly between the levels and the
-// root, each keeping the same fraction of what it starts with (the depth-th root of base over
-// input). The level's regions then collapse every queued inner vertex up to one cost τ: the
-// cost by which one queue of the whole mesh would have taken that many, estimated as the
-// quantile of the queued vertices' costs (inner or not; costs rise as neighbours collapse, so
-// the quantile is taken further out by kQuantileReach). One τ for the whole level keeps the
-// order of the collapses close to one queue's, a region of smooth field coarsening further than
-// one of detail, and what a region must leave along its cuts waits for the level above.
+// How far a level goes: its regions collapse every queued inner vertex up to one cost τ, the
+// cost at which the one queue of the whole mesh would stop at the target (estimated from the
+// costs queued now, at most kLevelShareCap of the way). So the regions coarsen as far as the base will be coarse wherever their
+// cuts allow, and each level above mostly coarsens its own cut: the bytes of the stream sit in
+// the smallest regions that can hold them, and a viewer that needs a few regions fetches little.
+// (Levels that stopped earlier, at quantiles of the cost shared out between them, kept the
+// stream's order closer to one queue's but left a third of the splits to the root, which every
+// view needs: docs/design-notes.md.) One τ for all the regions of a level keeps a region of
+// smooth field coarsening further than one of detail, as one queue would.
 #include <algorithm>
 #include <cmath>
 
@@ -31,8 +32,11 @@ namespace tetstream::simplify_detail {
 
 namespace {
 
-constexpr double kQuantileReach = 1.0;
-constexpr double kQuantileCap = 0.5;
+// A level takes at most this share of its queued vertices' costs: the last tenth, where the
+// estimate of the one queue's last cost is least sure, is left to the levels above and the
+// root. Without the cap the coarsest bases (a few tens of vertices) lost the input's boundary
+// where the one queue keeps it, and the base's field error grew by a tenth.
+constexpr double kLevelShareCap = 0.9;
 
 // Appends collapse c of `src` (whose begin arrays have no closing entry yet) to `dst`.
 void appendCollapse(CollapseLog& dst, const CollapseLog& src, uint32_t c) {
@@ -128,18 +132,13 @@ void Simplifier::runTree(uint32_t target) {
       keys.push_back(queueKey(v));
       if (inner_[v]) entries[region[v]].push_back({queueKey(v), v});
     }
-    // This level keeps `keep` of the vertices (and tets) it starts with, as every level after it.
-    const double stages = tree.depth - level + 1;
-    auto keepOf = [&](double now, double goal) { return goal > 0 && now > goal ? std::pow(goal / now, 1 / stages) : 1; };
-    const double keep = std::max(keepOf(alive_, target), opt_.targetTets ? keepOf(tetsAlive_, opt_.targetTets) : 0.0);
-    double planned = (1 - keep) * alive_;
-    if (keys.empty() || planned < 1) continue;
-    size_t at = size_t(std::min(kQuantileCap * double(keys.size() - 1), kQuantileReach * planned));
-    if (getenv("TS_FINAL")) {
-      const double goal = std::max<double>(target, opt_.targetTets ? alive_ * double(opt_.targetTets) / tetsAlive_ : 0.0);
-      planned = (alive_ - goal) * atof(getenv("TS_FINAL"));
-      at = size_t(std::min<double>(double(keys.size() - 1), planned));
-    }
+    // The one queue of the whole mesh would stop, at the target, at about the cost that many of
+    // the queued vertices have now (an underestimate: costs rise as neighbours collapse).
+    const double goal = std::max<double>(
+        target, opt_.targetTets && tetsAlive_ ? double(alive_) * opt_.targetTets / tetsAlive_ : 0.0);
+    if (keys.empty() || alive_ <= goal + 1) continue;
+    const double share = std::min((double(alive_) - goal) / keys.size(), kLevelShareCap);
+    const size_t at = size_t(std::min<double>(double(keys.size() - 1), share * keys.size()));
     std::nth_element(keys.begin(), keys.begin() + ptrdiff_t(at), keys.end());
     const float tau = keys[at];
     // Regions go to the threads largest first, to the one with less work so far.
@@ -195,7 +194,6 @@ void Simplifier::runTree(uint32_t target) {
       tetsAlive_ -= c.tetsRemoved;
       collapsedAll += c.collapsed;
     }
-    if (getenv("TS_DEBUG_TREE")) fprintf(stderr, "level %u: planned %.0f keys %zu tau %g -> alive %u tets %u\n", level, planned, keys.size(), tau, alive_, tetsAlive_);
   }
   out_.regionCollapses = collapsedAll;
 }

@@ -102,7 +102,7 @@ class Encoder {
     span_ = 0;
     if (C && (spans_.empty() || spans_.back().end != C))  // (a log in no section: one node, the root)
       spans_.assign(1, Span{1, 0, C});
-    stats_ = regionStats(mesh_, s_);
+    stats_ = regionStats(mesh_, s_, m_);
     indexOf_.assign(std::max<uint32_t>(tree.nodes(), 2), -1);
   }
 
