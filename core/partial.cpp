@@ -82,7 +82,7 @@ VertexIdMap idMapFor(const PartialDataset& pd, uint32_t k) {
 
 }  // namespace
 
-Result applyNode(PartialDataset& pd, uint32_t k, const ChunkSource& read) {
+Result applyNode(PartialDataset& pd, uint32_t k, const ChunkSource& read, std::vector<uint32_t>* changedOut) {
   const Manifest& m = pd.manifest;
   if (k >= m.nodes.size()) return fail(Status::BadArgument, "no node " + std::to_string(k));
   const NodeInfo& node = m.nodes[k];
@@ -92,7 +92,8 @@ Result applyNode(PartialDataset& pd, uint32_t k, const ChunkSource& read) {
   const VertexIdMap ids = idMapFor(pd, k);
   const uint32_t splitsBefore = pd.pm.splitsApplied(), vertexStart = pd.pm.vertexCount();
   std::vector<uint8_t> file;
-  std::vector<uint32_t> changed;
+  std::vector<uint32_t> own;
+  std::vector<uint32_t>& changed = changedOut ? *changedOut : own;
   auto undo = [&](Result r) {
     while (pd.pm.splitsApplied() > splitsBefore) undoSplit(pd.pm, changed);
     r.message = nodeName(m, k) + ": " + r.message;
@@ -107,7 +108,7 @@ Result applyNode(PartialDataset& pd, uint32_t k, const ChunkSource& read) {
     if (Result r = beginSplits(pd.reader, payload, info, m); !r) return undo(r);
     pd.reader.ids = &ids;
     for (uint32_t s = 0; s < info.splits; ++s) {
-      changed.clear();
+      if (!changedOut) changed.clear();
       if (Result r = applyNextSplit(pd.reader, pd.pm, pd.quant, changed); !r) return undo(r);
     }
     if (Result r = endSplits(pd.reader); !r) return undo(r);
@@ -118,6 +119,21 @@ Result applyNode(PartialDataset& pd, uint32_t k, const ChunkSource& read) {
   pd.applied.push_back(k);
   pd.bytesLoaded += bytes;
   return Result::success();
+}
+
+void undoLastNode(PartialDataset& pd, std::vector<uint32_t>* changedOut) {
+  if (pd.applied.empty()) return;
+  const uint32_t k = pd.applied.back();
+  const NodeInfo& node = pd.manifest.nodes[k];
+  std::vector<uint32_t> own;
+  std::vector<uint32_t>& changed = changedOut ? *changedOut : own;
+  for (uint32_t s = node.vertexBegin; s < node.vertexEnd; ++s) {
+    if (!changedOut) changed.clear();
+    undoSplit(pd.pm, changed);
+  }
+  pd.vertexStart[k] = PartialDataset::kNotLoaded;
+  pd.applied.pop_back();
+  for (uint32_t c = node.firstChunk; c < node.firstChunk + node.chunkCount; ++c) pd.bytesLoaded -= pd.manifest.chunks[c].bytes;
 }
 
 namespace {

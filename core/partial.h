@@ -54,8 +54,11 @@ Result openPartial(PartialDataset& pd, std::string_view manifestJson, const Chun
 
 // Applies node `node`'s chunks. Its parent must be applied and the node not yet. On failure
 // (a missing, corrupt or hostile chunk) the mesh is left as it was, and the message names the
-// node's region.
-Result applyNode(PartialDataset& pd, uint32_t node, const ChunkSource& read);
+// node's region. `changed`, when given, receives the changed tets (progressive.h's contract).
+Result applyNode(PartialDataset& pd, uint32_t node, const ChunkSource& read, std::vector<uint32_t>* changed = nullptr);
+
+// Undoes the node applied last (none of its descendants can be applied: they came after it).
+void undoLastNode(PartialDataset& pd, std::vector<uint32_t>* changed = nullptr);
 
 // Native: opens DIR and applies `nodes` (with their ancestors), parents first.
 Result loadPartialDir(const std::string& dir, std::span<const uint32_t> nodes, PartialDataset& pd);
