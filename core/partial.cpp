@@ -133,7 +133,8 @@ void undoLastNode(PartialDataset& pd, std::vector<uint32_t>* changedOut) {
   }
   pd.vertexStart[k] = PartialDataset::kNotLoaded;
   pd.applied.pop_back();
-  for (uint32_t c = node.firstChunk; c < node.firstChunk + node.chunkCount; ++c) pd.bytesLoaded -= pd.manifest.chunks[c].bytes;
+  for (uint32_t c = node.firstChunk; c < node.firstChunk + node.chunkCount; ++c)
+    pd.bytesLoaded -= pd.manifest.chunks[c].bytes;
 }
 
 namespace {

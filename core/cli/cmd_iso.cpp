@@ -33,8 +33,7 @@ Runner addIso(CLI::App& app) {
   addLevelOptions(sub, o->level);
   addReadOptions(sub, o->read);
   return [o] {
-    if (o->selective)
-      return runSelectiveIso({o->input, o->field, o->out, o->value, o->json, !o->noCheck});
+    if (o->selective) return runSelectiveIso({o->input, o->field, o->out, o->value, o->json, !o->noCheck});
     Input in;
     if (Result r = loadInput(o->input, in, o->level, o->read); !r) return reportError(r, o->json);
     Result r;

@@ -14,8 +14,7 @@ namespace tetstream::cli {
 int runSelectiveIso(const SelectiveIsoOptions& o) {
   if (!isPackedDir(o.dir))
     return reportError(fail(Status::BadArgument, "--selective needs a packed dataset folder, not " + o.dir), o.json);
-  if (!std::isfinite(o.value))
-    return reportError(fail(Status::BadArgument, "--value must be a finite number"), o.json);
+  if (!std::isfinite(o.value)) return reportError(fail(Status::BadArgument, "--value must be a finite number"), o.json);
   std::string manifestJson;
   Manifest m;
   if (Result r = readManifestFile(o.dir, manifestJson); !r) return reportError(r, o.json);
@@ -82,8 +81,8 @@ int runSelectiveIso(const SelectiveIsoOptions& o) {
                 m.tets, loadMs);
     if (!hierarchy) std::printf("  note      this dataset has no patch hierarchy: every chunk is needed\n");
     if (o.check)
-      std::printf("  check     %s\n", exact ? "the same triangles as the full mesh's surface"
-                                            : "DIFFERS from the full mesh's surface");
+      std::printf("  check     %s\n",
+                  exact ? "the same triangles as the full mesh's surface" : "DIFFERS from the full mesh's surface");
     if (!o.out.empty()) std::printf("wrote %s\n", o.out.c_str());
   }
   return o.check && !exact ? 1 : 0;

@@ -46,7 +46,7 @@ struct PackSummary {
   uint32_t movedMasks = 0;  // splits that carry a mask of T_moved (it does not follow from T_new)
   uint64_t queuePops = 0, requeued = 0, costEvaluations = 0;  // simplifier work, for benchmarks
   uint32_t regionCollapses = 0;  // of the collapses, those made below the root (two threads at once)
-  std::string stopReason;      // why simplification stopped
+  std::string stopReason;        // why simplification stopped
   double prepareMs = 0, simplifyMs = 0, encodeMs = 0, writeMs = 0;  // prepare: checks, orientation, grid
   std::vector<std::string> notes;                                   // what the packer changed or found, in plain words
 };

@@ -284,7 +284,7 @@ class Simplifier {
   // What the collapse loop works with (a queue and its log, not a thread): the queue of the whole
   // mesh, or of one region of the tree (runTree), with its own log and scratch.
   struct Queue {
-    uint32_t node = 1;  // the region (RegionTree numbering); 1: the whole mesh
+    uint32_t node = 1;    // the region (RegionTree numbering); 1: the whole mesh
     bool region = false;  // a region below the root: collapses only inner_ vertices
     Heap heap;
     CollapseLog ownLog;  // a region's collapses (appended to out_.log after its level)

@@ -135,7 +135,7 @@ struct SimplifyResult {
   uint64_t queuePops = 0, requeued = 0;  // pops of current entries, and those pushed back costlier
   uint32_t regionCollapses = 0;          // collapses made below the root, on two threads at once
   RegionTree tree;
-  std::string stopReason;                // "target reached", "no legal collapse left", "error bound"
+  std::string stopReason;  // "target reached", "no legal collapse left", "error bound"
 };
 
 // Why a single collapse is or is not allowed (for tests and diagnostics).

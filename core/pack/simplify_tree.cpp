@@ -16,13 +16,12 @@
 //
 // How far a level goes: its regions collapse every queued inner vertex up to one cost τ, the
 // cost at which the one queue of the whole mesh would stop at the target (estimated from the
-// costs queued now, at most kLevelShareCap of the way). So the regions coarsen as far as the base will be coarse wherever their
-// cuts allow, and each level above mostly coarsens its own cut: the bytes of the stream sit in
-// the smallest regions that can hold them, and a viewer that needs a few regions fetches little.
-// (Levels that stopped earlier, at quantiles of the cost shared out between them, kept the
-// stream's order closer to one queue's but left a third of the splits to the root, which every
-// view needs: docs/design-notes.md.) One τ for all the regions of a level keeps a region of
-// smooth field coarsening further than one of detail, as one queue would.
+// costs queued now, at most kLevelShareCap of the way). So the regions coarsen as far as the base will be coarse
+// wherever their cuts allow, and each level above mostly coarsens its own cut: the bytes of the stream sit in the
+// smallest regions that can hold them, and a viewer that needs a few regions fetches little. (Levels that stopped
+// earlier, at quantiles of the cost shared out between them, kept the stream's order closer to one queue's but left a
+// third of the splits to the root, which every view needs: docs/design-notes.md.) One τ for all the regions of a level
+// keeps a region of smooth field coarsening further than one of detail, as one queue would.
 #include <algorithm>
 #include <cmath>
 
@@ -134,8 +133,8 @@ void Simplifier::runTree(uint32_t target) {
     }
     // The one queue of the whole mesh would stop, at the target, at about the cost that many of
     // the queued vertices have now (an underestimate: costs rise as neighbours collapse).
-    const double goal = std::max<double>(
-        target, opt_.targetTets && tetsAlive_ ? double(alive_) * opt_.targetTets / tetsAlive_ : 0.0);
+    const double goal =
+        std::max<double>(target, opt_.targetTets && tetsAlive_ ? double(alive_) * opt_.targetTets / tetsAlive_ : 0.0);
     if (keys.empty() || alive_ <= goal + 1) continue;
     const double share = std::min((double(alive_) - goal) / keys.size(), kLevelShareCap);
     const size_t at = size_t(std::min<double>(double(keys.size() - 1), share * keys.size()));

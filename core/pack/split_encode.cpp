@@ -77,7 +77,8 @@ class Encoder {
       ++inChunk_;
       if (opt_.progress && (c & 4095) == 0) opt_.progress(split + 1, C);
       const uint32_t nodeEnd = spans_[span_].end;
-      if (recordBytes() >= target_ * ratio_ || split + 1 == nodeEnd || tapers(split + 1 - spans_[span_].first, nodeEnd - split - 1))
+      if (recordBytes() >= target_ * ratio_ || split + 1 == nodeEnd ||
+          tapers(split + 1 - spans_[span_].first, nodeEnd - split - 1))
         if (Result r = flushChunk(split + 1); !r) {
           collect();
           return r;
@@ -574,14 +575,14 @@ class Encoder {
   uint32_t prevJ_ = 0, inChunk_ = 0;
   uint64_t target_ = 0;
   std::vector<Span> spans_;
-  size_t span_ = 0;             // the node being encoded
-  NodeInfo node_;               // its manifest entry so far
-  RegionStats stats_;           // per node of the tree
-  std::vector<int32_t> indexOf_;  // per node of the tree: its index in out_.nodes, -1 before
-  uint32_t measuredLevel_ = ~0u;  // the level of the tree the last measurement was for
+  size_t span_ = 0;                      // the node being encoded
+  NodeInfo node_;                        // its manifest entry so far
+  RegionStats stats_;                    // per node of the tree
+  std::vector<int32_t> indexOf_;         // per node of the tree: its index in out_.nodes, -1 before
+  uint32_t measuredLevel_ = ~0u;         // the level of the tree the last measurement was for
   std::vector<LevelError> levelErrors_;  // per node of that level
-  float range_ = 0;             // the isoField's range (no estimate exceeds it)
-  uint64_t flushedRaw_ = 0;  // record bytes of the chunks before the current one
+  float range_ = 0;                      // the isoField's range (no estimate exceeds it)
+  uint64_t flushedRaw_ = 0;              // record bytes of the chunks before the current one
   double ratio_ = 2.5;
 };
 

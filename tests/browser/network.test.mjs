@@ -226,7 +226,8 @@ test('over a slow link the chunks come one after another at the full rate, not a
   // chunks say so), so its lead is 150 KB/s × 30 ms × 1.25 = 5.6 KB whatever the speed of the
   // machine. The server holds the split chunks until the viewer runs (this server is fast: they
   // would all be in before it), and the last 16 KB of one chunk until the test releases them.
-  const { dir } = makePack(tmp, 'h40', { n: 40, packArgs: ['--chunk-kb', '64'] });
+  // (One node, the root: a sequence of chunks of 16 to 64 KB, as a stream of every node in order.)
+  const { dir } = makePack(tmp, 'h40', { n: 40, packArgs: ['--chunk-kb', '64', '--leaf-vertices', '0'] });
   const list = readManifest(dir).chunks;
   assert.ok(list.length >= 7, `a stream of several chunks (${list.length})`);
   const k = list.length - 2;

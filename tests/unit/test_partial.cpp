@@ -150,7 +150,8 @@ TEST(Partial, AnySetOfNodesWithTheirParentsIsAValidMeshInAnyOrder) {
       for (uint32_t k = 0; k < m.nodes.size(); ++k)
         if (std::uniform_real_distribution<double>(0, 1)(rng) < p) some.push_back(k);
       const std::vector<uint32_t> set = withAncestors(m, some);
-      const std::string what = c.name + ", " + std::to_string(set.size()) + " of " + std::to_string(m.nodes.size()) + " nodes";
+      const std::string what =
+          c.name + ", " + std::to_string(set.size()) + " of " + std::to_string(m.nodes.size()) + " nodes";
       PartialDataset a, b;
       loadInOrder(dir, randomParentFirstOrder(m, set, rng), a);
       loadInOrder(dir, randomParentFirstOrder(m, set, rng), b);
@@ -207,12 +208,13 @@ TEST(Partial, TheNodesAnIsovalueNeedsGiveItsSurfaceExactly) {
         IsoSurface part, full;
         extractIsosurface(pd.pm.mesh, pd.pm.mesh.fields[f].values, iso, x, part);
         extractIsosurface(whole.pm.mesh, whole.pm.mesh.fields[f].values, iso, x, full);
-        EXPECT_TRUE(sameTriangles(part, full)) << what << ": " << part.triangleCount() << " triangles against "
-                                               << full.triangleCount();
+        EXPECT_TRUE(sameTriangles(part, full))
+            << what << ": " << part.triangleCount() << " triangles against " << full.triangleCount();
         fewest = std::min(fewest, pd.bytesLoaded);
       }
     }
-    std::printf("%s: the fewest bytes an isovalue needed: %.0f%% of %llu\n", c.name.c_str(), 100.0 * fewest / m.totalBytes(), (unsigned long long)m.totalBytes());
+    std::printf("%s: the fewest bytes an isovalue needed: %.0f%% of %llu\n", c.name.c_str(),
+                100.0 * fewest / m.totalBytes(), (unsigned long long)m.totalBytes());
     EXPECT_LT(fewest, m.totalBytes()) << c.name << ": some isovalue needs less than the whole (benchmarks: how much)";
   }
 }
@@ -296,7 +298,7 @@ TEST(Partial, ADamagedNodeIsRefusedAndChangesNothing) {
       if (index == chunk && how == 0) return fail(Status::IoError, "cannot read " + m.chunks[index].file);
       file = loadBytes(dir + "/" + m.chunks[index].file);
       if (index == chunk && how == 1) file[file.size() / 2] ^= 0x40;  // fails its hash
-      if (index == chunk && how == 2) file.resize(file.size() - 1);  // truncated
+      if (index == chunk && how == 2) file.resize(file.size() - 1);   // truncated
       return Result::success();
     };
   };
