@@ -68,9 +68,15 @@ void copyState(Dataset& to, const Dataset& from) {
   to.pm = from.pm;
   to.chunksReceived = from.chunksReceived;
   to.bytesReceived = from.bytesReceived;
+  to.received = from.received;
   to.payloads = from.payloads;
   to.chunkFirstSplit = from.chunkFirstSplit;
+  to.tetsAfter = from.tetsAfter;
+  to.nodeIds = from.nodeIds;
+  to.nodeChunksReceived = from.nodeChunksReceived;
+  to.inManifestOrder = from.inManifestOrder;
   to.recordStart = from.recordStart;
+  to.stableJ = from.stableJ;
   to.splitsDecoded = from.splitsDecoded;
   to.reader = from.reader;
 }

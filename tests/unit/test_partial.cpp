@@ -312,3 +312,63 @@ TEST(Partial, ADamagedNodeIsRefusedAndChangesNothing) {
   EXPECT_TRUE(applyNode(pd, child, dirSource(dir, m)));
   expectValidLevel(pd.pm.mesh, "after the damaged node came whole");
 }
+
+// The viewer's dataset takes chunks in any order that puts each node's parent first (a plan by
+// isovalue and view), and its level slider moves back and forth over them in that order.
+TEST(Partial, ADatasetReceivesNodesInAnyParentFirstOrder) {
+  std::mt19937 rng(13);
+  const Case c{"grid", harmonic(16)};
+  const std::string dir = packCase(c);
+  const std::string json = loadFile(dir + "/manifest.json");
+  Dataset ds;
+  ASSERT_TRUE(openDataset(ds, json));
+  const Manifest& m = ds.manifest;
+  const std::vector<uint32_t> nodes = withAncestors(m, nodesForIsovalue(m, 0, 0.2f));
+  const std::vector<uint32_t> order = randomParentFirstOrder(m, nodes, rng);
+  auto file = [&](uint32_t index) { return loadBytes(dir + "/" + m.chunks[index].file); };
+  ASSERT_TRUE(receiveChunk(ds, 0, file(0)));
+  std::vector<uint32_t> changed;
+  bool reached = false;
+  for (uint32_t k : order) {
+    const NodeInfo& n = m.nodes[k];
+    // Out of turn: a later chunk of the node first, or a child before it.
+    if (n.chunkCount > 1) EXPECT_FALSE(ds.canReceive(n.firstChunk + 1));
+    for (uint32_t ch = n.firstChunk; ch < n.firstChunk + n.chunkCount; ++ch) {
+      ASSERT_TRUE(receiveChunk(ds, ch, file(ch))) << "chunk " << ch;
+      // Half the time the level follows at once, else it catches up later.
+      if (rng() % 2) ASSERT_TRUE(stepTowards(ds, ds.splitsReceived(), ~0u, changed, &reached));
+    }
+  }
+  ASSERT_TRUE(stepTowards(ds, ds.splitsReceived(), ~0u, changed, &reached) && reached);
+  // The mesh in stable ids: each node's vertices come where its first chunk was received.
+  auto stableIds = [&] {
+    std::vector<uint32_t> ids(ds.pm.vertexCount());
+    for (uint32_t v = 0; v < ds.pm.baseVertices; ++v) ids[v] = v;
+    for (uint32_t place = 1; place < ds.received.size(); ++place) {
+      const uint32_t before = m.chunks[ds.received[place] - 1].vertices;  // stable id of its first split's vertex
+      for (uint32_t s = ds.chunkFirstSplit[place]; s < ds.chunkFirstSplit[place + 1]; ++s)
+        if (ds.pm.baseVertices + s < ids.size()) ids[ds.pm.baseVertices + s] = before + (s - ds.chunkFirstSplit[place]);
+    }
+    return ids;
+  };
+  PartialDataset pd;
+  ASSERT_TRUE(loadPartialDir(dir, nodes, pd));
+  const StableMesh want = stableMesh(pd);
+  EXPECT_TRUE(stableMesh(ds.pm.mesh, stableIds()) == want);
+  expectValidLevel(ds.pm.mesh, "every planned node");
+  // Back to the base and forward again over the same records (redo re-reads them).
+  ASSERT_TRUE(stepTowards(ds, 0, ~0u, changed, &reached) && reached);
+  EXPECT_EQ(ds.pm.vertexCount(), ds.pm.baseVertices);
+  const uint32_t half = ds.splitsReceived() / 2;
+  ASSERT_TRUE(stepTowards(ds, half, ~0u, changed, &reached) && reached);
+  expectValidLevel(ds.pm.mesh, "half of the planned splits");
+  ASSERT_TRUE(stepTowards(ds, ds.splitsReceived(), ~0u, changed, &reached) && reached);
+  EXPECT_TRUE(stableMesh(ds.pm.mesh, stableIds()) == want);
+  // A node whose parent is missing cannot come.
+  for (uint32_t k = 0; k < m.nodes.size(); ++k)
+    if (m.nodes[k].parent >= 0 && !ds.nodeComplete(uint32_t(m.nodes[k].parent)) && ds.nodeChunksReceived[k] == 0) {
+      EXPECT_FALSE(ds.canReceive(m.nodes[k].firstChunk));
+      EXPECT_FALSE(receiveChunk(ds, m.nodes[k].firstChunk, file(m.nodes[k].firstChunk)));
+      break;
+    }
+}
