@@ -333,6 +333,7 @@ export class ChunkLoader {
       this.failAt(i, e.message);
       return;
     }
+    if (!this.position.has(i)) return; // the page replanned without it meanwhile
     if (damage) {
       this.refused++;
       this.note({ event: 'refused', index: i, cause: 'damaged' });
@@ -449,6 +450,7 @@ export class ChunkLoader {
       if (!this.arrived.has(i) || this.unchecked.has(i)) return;
       const bytes = this.arrived.get(i);
       this.arrived.delete(i);
+      this.nextPos++; // before deliver(): a replan from there keeps chunk i in the plan
       let accepted;
       try {
         accepted = this.deliver(i, bytes);
@@ -462,7 +464,6 @@ export class ChunkLoader {
         return;
       }
       this.deliveredBytes += bytes.length;
-      this.nextPos++;
     }
   }
 

@@ -299,6 +299,20 @@ test('a replan drops the requests for chunks it left, keeps the others, and wake
   run.loader.stop();
 });
 
+test('a replan from deliver() keeps the chunk being handed over', async () => {
+  const run = makeLoader({ chunks: 4, order: [0, 1, 2, 3], onIdle: () => {} });
+  run.loader.deliver = (i) => {
+    run.delivered.push(i);
+    if (i === 0) run.loader.replan([2, 1]);
+    return true;
+  };
+  run.loader.pump();
+  await answerAll(run.net, run.size);
+  assert.deepEqual(run.delivered, [0, 2, 1]);
+  assert.deepEqual(run.loader.plan, [0, 2, 1]);
+  run.loader.stop();
+});
+
 test('a replan cancels the backoff of a chunk it left', async () => {
   const run = makeLoader({ chunks: 4, order: [0, 1, 2, 3], onIdle: () => {} });
   run.loader.pump();
