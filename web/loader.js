@@ -248,8 +248,9 @@ export class ChunkLoader {
   }
 
   pump() {
-    if (this.paused || this.stopped || this.failure) return;
-    const end = Math.min(this.allowed, this.plan.length,
+    if (this.paused || this.stopped) return;
+    // After a failure only the chunks before it, which are handed over before it is reported.
+    const end = Math.min(this.allowed, this.failure ? this.position.get(this.failure.index) : this.plan.length,
       this.warmed ? this.nextPos + MAX_AHEAD : this.programNearlyIn ? 2 : 1);
     let ahead = 0, outstanding = 0;
     for (const b of this.arrived.values()) ahead += b.length;

@@ -409,3 +409,23 @@ test('without onChunkFailed a 404 stops the stream after the chunks before it in
   assert.ok(run.result.done);
   assert.deepEqual(requests(run.loader).map((e) => e.index), [0, 3, 1, 4]);
 });
+
+test('a chunk that fails for a while before one that cannot be had is still fetched again', async () => {
+  const run = makeLoader({ chunks: 4 });
+  run.loader.pump();
+  await settle();
+  const [r0, r1, r2] = run.net.open();
+  run.net.fail(r2, notFound());
+  await settle();
+  run.net.fail(r1, new FetchError('connection lost', { kind: 'network', transient: true }));
+  await settle();
+  run.net.send(r0, run.size);
+  run.net.finish(r0);
+  await settle();
+  run.clock.advance(60000);
+  assert.deepEqual(requests(run.loader).map((e) => [e.index, e.reason]),
+    [[0, 'first'], [1, 'first'], [2, 'first'], [3, 'first'], [1, 'retry']]);
+  await answerAll(run.net, run.size);
+  assert.deepEqual(run.delivered, [0, 1]);
+  assert.match(run.result.failed, /^Could not download part 3 of 4 .* Showing the last complete level\.$/);
+});
