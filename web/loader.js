@@ -206,7 +206,7 @@ export class ChunkLoader {
     }
     for (const j of [...this.unavailable.keys()]) if (left(j)) this.unavailable.delete(j);
     for (const set of [this.dropped, this.wokenOnline]) for (const j of [...set]) if (left(j)) set.delete(j);
-    if (this.nextPos < this.plan.length) this.idle = false;
+    if (this.nextPos < Math.min(this.allowed, this.plan.length)) this.idle = false;
     this.deliverReady();
     this.pump();
   }
