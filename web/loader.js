@@ -93,7 +93,8 @@ export class ChunkLoader {
     this.setTail(order ?? urls.map((_, i) => i));
     this.idle = false;             // onIdle() called at the end of the plan, waiting for more
     this.handingOver = false;      // in deliverReady() (a callback may replan meanwhile)
-    // Maps keyed by chunk index; each holds chunks of the plan only.
+    // By chunk index. The first four hold chunks the plan has yet to hand over; trouble also
+    // keeps those a replan left (their failure counts hold if they come back).
     this.inFlight = new Map();     // index -> { controller, received }
     this.arrived = new Map();      // index -> bytes, checked, waiting for an earlier chunk
     this.waiting = new Map();      // index -> { at, timer }: to be fetched again at time `at`
@@ -143,7 +144,7 @@ export class ChunkLoader {
     const plan = this.plan.slice(0, this.nextPos);
     const position = new Map(plan.map((i, p) => [i, p]));
     for (const i of tail) {
-      if (!Number.isInteger(i) || i < 0 || i >= this.total) throw new RangeError(`No chunk ${i} in a plan of ${this.total} chunks.`);
+      if (!Number.isInteger(i) || i < 0 || i >= this.total) throw new RangeError(`No chunk ${i} of ${this.total}.`);
       if (position.has(i)) continue;
       position.set(i, plan.length);
       plan.push(i);
