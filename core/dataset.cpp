@@ -102,9 +102,10 @@ VertexIdMap idMapOf(const Dataset& ds, uint32_t k) {
 
 Result receiveChunk(Dataset& ds, uint32_t index, std::span<const uint8_t> file, bool hashChecked) {
   if (!ds.canReceive(index))
-    return fail(Status::BadArgument, "chunk " + std::to_string(index) + " received out of order" +
-                                         (ds.manifest.nodes.empty() ? " (next is " + std::to_string(ds.chunksReceived) + ")"
-                                                                    : " (its node's parent is not complete)"));
+    return fail(Status::BadArgument,
+                "chunk " + std::to_string(index) + " received out of order" +
+                    (ds.manifest.nodes.empty() ? " (next is " + std::to_string(ds.chunksReceived) + ")"
+                                               : " (its node's parent is not complete)"));
   const ChunkInfo& info = ds.manifest.chunks[index];
   std::span<const uint8_t> payload;
   if (Result r = openChunk(ds.decoder, info, index, file, payload, hashChecked); !r) return r;

@@ -29,8 +29,8 @@ struct Dataset {
   Quantizer quant;
   ProgressiveMesh pm;  // the current level (empty until the base is received)
   ChunkDecoder decoder;
-  uint32_t chunksReceived = 0;                 // verified chunks, base included
-  uint64_t bytesReceived = 0;                  // compressed bytes of the verified chunks
+  uint32_t chunksReceived = 0;  // verified chunks, base included
+  uint64_t bytesReceived = 0;   // compressed bytes of the verified chunks
   // Per received chunk, in the order received (its place): its index in the manifest.
   std::vector<uint32_t> received;
   std::vector<std::vector<uint8_t>> payloads;  // per place: split records (empty for the base)
@@ -44,9 +44,10 @@ struct Dataset {
   bool inManifestOrder = true;
   std::vector<uint32_t> recordStart;  // per split decoded so far, plus the next: where its record starts in each column
                                       // (SplitReader::tell)
-  std::vector<uint32_t> stableJ;      // per split decoded so far: its kept vertex's stable id (the next record's delta is from it)
-  uint32_t splitsDecoded = 0;         // splits read at least once (the frontier)
-  SplitReader reader;                 // scratch
+  std::vector<uint32_t>
+      stableJ;  // per split decoded so far: its kept vertex's stable id (the next record's delta is from it)
+  uint32_t splitsDecoded = 0;  // splits read at least once (the frontier)
+  SplitReader reader;          // scratch
 
   uint32_t splitsReceived() const { return chunkFirstSplit.empty() ? 0 : chunkFirstSplit.back(); }
   // Whether chunk `index` can be received next: the base first, then (without nodes) the next in
@@ -55,6 +56,13 @@ struct Dataset {
   // The node of chunk `index` (-1: the base, or a dataset without nodes).
   int32_t nodeOfChunk(uint32_t index) const;
   bool nodeComplete(uint32_t node) const { return nodeChunksReceived[node] == manifest.nodes[node].chunkCount; }
+  // Whether chunk `index` is received.
+  bool hasChunk(uint32_t index) const {
+    if (chunksReceived == 0 || index >= manifest.chunks.size()) return false;
+    const int32_t k = nodeOfChunk(index);
+    if (index == 0 || k < 0) return index < chunksReceived;
+    return index < manifest.nodes[size_t(k)].firstChunk + nodeChunksReceived[size_t(k)];
+  }
   uint32_t splitsApplied() const { return pm.splitsApplied(); }
   // Chunks whose every split is applied (the base counts once received), in places.
   uint32_t chunksApplied() const;

@@ -273,7 +273,8 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
     if (Result r = writeFile(fs::path(outDir) / info.file, enc.files[c].data(), enc.files[c].size()); !r) return r;
     m.chunks.push_back(info);
   }
-  m.nodes = std::move(enc.nodes);
+  // One region alone (a small mesh, --leaf-vertices 0) is no hierarchy: one sequence of chunks.
+  if (enc.nodes.size() > 1) m.nodes = std::move(enc.nodes);
 
   // Remove chunk files an earlier pack left behind (only our own *.tsc names).
   for (const auto& entry : fs::directory_iterator(fs::path(outDir) / "chunks", ec)) {
