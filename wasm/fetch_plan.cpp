@@ -107,7 +107,8 @@ std::vector<uint32_t> plannedChunks(const ViewerState& s, uint32_t limit) {
     const uint32_t k = ready.top().second;
     ready.pop();
     const NodeInfo& n = m.nodes[k];
-    for (uint32_t c = n.firstChunk + ds.nodeChunksReceived[k]; c < n.firstChunk + n.chunkCount && out.size() < limit; ++c)
+    for (uint32_t c = n.firstChunk + ds.nodeChunksReceived[k]; c < n.firstChunk + n.chunkCount && out.size() < limit;
+         ++c)
       out.push_back(c);
     for (uint32_t child : p.children[k]) offer(child);
   }

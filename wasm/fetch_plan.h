@@ -24,9 +24,9 @@ struct FetchPlan {
   // Bumped whenever what is needed may have changed (isovalue, field, slice, mode, a node given
   // up): the page asks for the plan again (docs/js-api.md).
   uint32_t version = 0;
-  std::vector<uint8_t> needed;  // per node: the view needs it (with its ancestors)
-  std::vector<uint8_t> broken;  // per node: one of its chunks could not be had (its subtree is skipped)
-  uint32_t missing = 0;         // chunks of needed, unbroken nodes not received yet
+  std::vector<uint8_t> needed;                  // per node: the view needs it (with its ancestors)
+  std::vector<uint8_t> broken;                  // per node: one of its chunks could not be had (its subtree is skipped)
+  uint32_t missing = 0;                         // chunks of needed, unbroken nodes not received yet
   std::vector<std::vector<uint32_t>> children;  // per node
   // What a region covers on screen (0: out of view), from the camera; null: every region alike.
   std::function<double(const Bounds&)> screenWeight;
