@@ -124,3 +124,32 @@ test('a node whose chunk is missing leaves its region coarse, in words, and the 
     await new Promise((resolve) => server.close(resolve));
   }
 });
+
+test('the slice plane fetches the regions it crosses: the slice is at full resolution too', async () => {
+  const server = createServer({ mounts: [{ prefix: '/data', dir }, { prefix: '/', dir: webDir }] });
+  const url = await listen(server);
+  const { min, max } = manifest.fields[0];
+  const iso = min + 0.85 * (max - min);
+  try {
+    const { page, problems } = await openViewer(await browser, `${url}/index.html?data=/data/manifest.json&iso=${iso}`);
+    const before = await waitForExact(page);
+    await page.evaluate(() => window.tetstream.setSlice({ on: true, normal: [0, 0, 1], offset: 0.1 }));
+    await page.waitForFunction((n) => window.tetstream.stats().nodesLoaded > n, before.nodesLoaded, { timeout: 120000 });
+    const sliced = await waitForExact(page);
+    assert.ok(sliced.slice.triangles > 0);
+    // Every node: the slice does not change (the regions it crosses were all in already).
+    await page.evaluate(() => window.tetstream.setFetchEverything(true));
+    await page.waitForFunction(() => {
+      const t = window.tetstream.stats();
+      return t.state === 'complete' && t.chunksReceived === t.chunksTotal;
+    }, null, { timeout: 120000 });
+    const all = await page.evaluate(() => window.tetstream.stats());
+    assert.equal(sliced.slice.triangles, all.slice.triangles, 'the slice at full resolution');
+    assert.ok(Math.abs(sliced.slice.area - all.slice.area) <= 1e-9 * all.slice.area);
+    assert.ok(sliced.bytesReceived < all.bytesReceived);
+    assert.deepEqual(problems, []);
+    await page.close();
+  } finally {
+    await new Promise((resolve) => server.close(resolve));
+  }
+});
