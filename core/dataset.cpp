@@ -5,9 +5,8 @@
 #include <vector>
 
 namespace tetstream {
-namespace {
 
-Result readFile(const std::string& path, uint64_t limit, std::vector<uint8_t>& out) {
+Result readFileBytes(const std::string& path, uint64_t limit, std::vector<uint8_t>& out) {
   std::FILE* f = std::fopen(path.c_str(), "rb");
   if (!f) return fail(Status::IoError, path + ": cannot open");
   out.clear();
@@ -20,13 +19,10 @@ Result readFile(const std::string& path, uint64_t limit, std::vector<uint8_t>& o
     }
     out.insert(out.end(), buf, buf + n);
   }
-  bool err = std::ferror(f);
+  const bool err = std::ferror(f);
   std::fclose(f);
-  if (err) return fail(Status::IoError, path + ": read error");
-  return Result::success();
+  return err ? fail(Status::IoError, path + ": read error") : Result::success();
 }
-
-}  // namespace
 
 uint32_t Dataset::chunksApplied() const {
   if (chunksReceived == 0) return 0;
@@ -230,7 +226,7 @@ bool isPackedDir(const std::string& path) {
 
 Result loadPackedDir(const std::string& dir, Dataset& ds, int maxChunks, uint32_t maxVertices) {
   std::vector<uint8_t> bytes;
-  if (Result r = readFile(dir + "/manifest.json", 16u << 20, bytes); !r) return r;
+  if (Result r = readFileBytes(dir + "/manifest.json", 16u << 20, bytes); !r) return r;
   if (Result r = openDataset(ds, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size())); !r)
     return r;
   size_t n = ds.manifest.chunks.size();
@@ -239,7 +235,7 @@ Result loadPackedDir(const std::string& dir, Dataset& ds, int maxChunks, uint32_
   for (uint32_t i = 0; i < n; ++i) {
     if (i > 0 && ds.pm.vertexCount() >= maxVertices) break;
     const ChunkInfo& c = ds.manifest.chunks[i];
-    if (Result r = readFile(dir + "/" + c.file, c.bytes, bytes); !r) {
+    if (Result r = readFileBytes(dir + "/" + c.file, c.bytes, bytes); !r) {
       if (r.status == Status::TooLarge) r.status = Status::SizeMismatch;
       return r;
     }

@@ -94,6 +94,9 @@ Result applyChunk(Dataset& ds, uint32_t index, std::span<const uint8_t> file);
 // when negative) from DIR, stopping inside a chunk once the mesh has `maxVertices` vertices.
 Result loadPackedDir(const std::string& dir, Dataset& ds, int maxChunks = -1, uint32_t maxVertices = ~0u);
 
+// Reads a whole file, refusing one larger than `limit` bytes (TooLarge).
+Result readFileBytes(const std::string& path, uint64_t limit, std::vector<uint8_t>& out);
+
 // True when DIR looks like a packed dataset (has a manifest.json).
 bool isPackedDir(const std::string& path);
 

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "dataset.h"
+
 namespace tetstream {
 
 std::vector<uint32_t> nodesForIsovalue(const Manifest& m, int field, float isovalue) {
@@ -137,31 +139,9 @@ void undoLastNode(PartialDataset& pd, std::vector<uint32_t>* changedOut) {
     pd.bytesLoaded -= pd.manifest.chunks[c].bytes;
 }
 
-namespace {
-
-Result readWhole(const std::string& path, uint64_t limit, std::vector<uint8_t>& out) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) return fail(Status::IoError, path + ": cannot open");
-  out.clear();
-  uint8_t buf[1 << 16];
-  size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) {
-    if (out.size() + n > limit) {
-      std::fclose(f);
-      return fail(Status::SizeMismatch, path + ": larger than " + std::to_string(limit) + " bytes");
-    }
-    out.insert(out.end(), buf, buf + n);
-  }
-  const bool err = std::ferror(f);
-  std::fclose(f);
-  return err ? fail(Status::IoError, path + ": read error") : Result::success();
-}
-
-}  // namespace
-
 Result readManifestFile(const std::string& dir, std::string& json) {
   std::vector<uint8_t> bytes;
-  if (Result r = readWhole(dir + "/manifest.json", 16u << 20, bytes); !r) return r;
+  if (Result r = readFileBytes(dir + "/manifest.json", 16u << 20, bytes); !r) return r;
   json.assign(bytes.begin(), bytes.end());
   return Result::success();
 }
@@ -171,7 +151,9 @@ Result loadPartialDir(const std::string& dir, std::span<const uint32_t> nodes, P
   if (Result r = readManifestFile(dir, json); !r) return r;
   ChunkSource read = [&](uint32_t index, std::vector<uint8_t>& file) {
     const ChunkInfo& c = pd.manifest.chunks[index];
-    return readWhole(dir + "/" + c.file, c.bytes, file);
+    Result r = readFileBytes(dir + "/" + c.file, c.bytes, file);
+    if (r.status == Status::TooLarge) r.status = Status::SizeMismatch;
+    return r;
   };
   if (Result r = openPartial(pd, json, read); !r) return r;
   for (uint32_t k : nodes)

@@ -38,24 +38,31 @@ std::vector<uint8_t> readAll(const std::filesystem::path& p) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
+// `mesh` packed with `o` into a scratch folder, read back whole.
+Context packedContext(TetMesh mesh, PackOptions o, const char* tag) {
+  o.zstdLevel = 1;
+  o.chunkKb = 1;
+  const auto dir = std::filesystem::temp_directory_path() / (std::string(tag) + "-" + std::to_string(getpid()));
+  PackSummary summary;
+  if (!packMesh(std::move(mesh), dir.string(), o, summary))
+    fuzzCheckFailed("packing the fuzz dataset", __FILE__, __LINE__);
+  Context c;
+  std::vector<uint8_t> json = readAll(dir / "manifest.json");
+  c.manifestJson.assign(json.begin(), json.end());
+  for (const ChunkInfo& info : summary.manifest.chunks) c.files.push_back(readAll(dir / info.file));
+  std::filesystem::remove_all(dir);
+  return c;
+}
+
 const Context& context() {
   static const Context ctx = [] {
     TetMesh mesh = makeGridMesh(6);
     addHarmonicField(mesh);
     mesh.name = "fuzz";
     PackOptions o;
-    o.zstdLevel = 1;
     o.baseVertices = 24;
     o.minBaseVertices = 8;
-    o.chunkKb = 1;
-    const auto dir = std::filesystem::temp_directory_path() / ("tetstream-fuzz-" + std::to_string(getpid()));
-    PackSummary summary;
-    if (!packMesh(mesh, dir.string(), o, summary)) fuzzCheckFailed("packing the fuzz dataset", __FILE__, __LINE__);
-    Context c;
-    std::vector<uint8_t> json = readAll(dir / "manifest.json");
-    c.manifestJson.assign(json.begin(), json.end());
-    for (const ChunkInfo& info : summary.manifest.chunks) c.files.push_back(readAll(dir / info.file));
-    std::filesystem::remove_all(dir);
+    Context c = packedContext(std::move(mesh), o, "tetstream-fuzz");
     if (c.files.size() < 3) fuzzCheckFailed("the fuzz dataset needs two split chunks", __FILE__, __LINE__);
     return c;
   }();
@@ -213,18 +220,11 @@ const Context& nodeContext() {
     addHarmonicField(mesh);
     mesh.name = "fuzz-nodes";
     PackOptions o;
-    o.zstdLevel = 1;
     o.leafVertices = 64;
-    o.chunkKb = 1;
-    const auto dir = std::filesystem::temp_directory_path() / ("tetstream-fuzz-nodes-" + std::to_string(getpid()));
-    PackSummary summary;
-    if (!packMesh(mesh, dir.string(), o, summary)) fuzzCheckFailed("packing the fuzz dataset", __FILE__, __LINE__);
-    Context c;
-    std::vector<uint8_t> json = readAll(dir / "manifest.json");
-    c.manifestJson.assign(json.begin(), json.end());
-    for (const ChunkInfo& info : summary.manifest.chunks) c.files.push_back(readAll(dir / info.file));
-    std::filesystem::remove_all(dir);
-    if (summary.manifest.nodes.size() < 4) fuzzCheckFailed("the fuzz dataset needs a hierarchy", __FILE__, __LINE__);
+    Context c = packedContext(std::move(mesh), o, "tetstream-fuzz-nodes");
+    Manifest m;
+    if (!parseManifest(c.manifestJson, m) || m.nodes.size() < 4)
+      fuzzCheckFailed("the fuzz dataset needs a hierarchy", __FILE__, __LINE__);
     return c;
   }();
   return ctx;
