@@ -62,7 +62,7 @@ Result openChunk(ChunkDecoder& dec, const ChunkInfo& info, uint32_t index, std::
   if (got < kChunkHeaderBytes) return fail(Status::Truncated, name + ": shorter than its header");
   const uint8_t* h = dec.raw.data();
   if (std::memcmp(h, kChunkMagic, 4) != 0) return fail(Status::BadMagic, name + ": not a tetstream chunk (magic)");
-  if (readU16(h + 4) != kFormatVersion)
+  if (readU16(h + 4) != kChunkVersion)
     return fail(Status::UnsupportedVersion, name + ": chunk format version " + std::to_string(readU16(h + 4)));
   uint16_t kind = readU16(h + 6);
   if (kind != uint16_t(info.kind))

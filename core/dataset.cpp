@@ -5,9 +5,8 @@
 #include <vector>
 
 namespace tetstream {
-namespace {
 
-Result readFile(const std::string& path, uint64_t limit, std::vector<uint8_t>& out) {
+Result readFileBytes(const std::string& path, uint64_t limit, std::vector<uint8_t>& out) {
   std::FILE* f = std::fopen(path.c_str(), "rb");
   if (!f) return fail(Status::IoError, path + ": cannot open");
   out.clear();
@@ -20,13 +19,10 @@ Result readFile(const std::string& path, uint64_t limit, std::vector<uint8_t>& o
     }
     out.insert(out.end(), buf, buf + n);
   }
-  bool err = std::ferror(f);
+  const bool err = std::ferror(f);
   std::fclose(f);
-  if (err) return fail(Status::IoError, path + ": read error");
-  return Result::success();
+  return err ? fail(Status::IoError, path + ": read error") : Result::success();
 }
-
-}  // namespace
 
 uint32_t Dataset::chunksApplied() const {
   if (chunksReceived == 0) return 0;
@@ -42,6 +38,24 @@ uint32_t Dataset::splitsThroughChunk(uint32_t index) const {
   return n;
 }
 
+int32_t Dataset::nodeOfChunk(uint32_t index) const {
+  const std::vector<NodeInfo>& nodes = manifest.nodes;
+  if (nodes.empty() || index == 0) return -1;
+  auto after = std::upper_bound(nodes.begin(), nodes.end(), index,
+                                [](uint32_t i, const NodeInfo& n) { return i < n.firstChunk; });
+  return int32_t(after - nodes.begin()) - 1;
+}
+
+bool Dataset::canReceive(uint32_t index) const {
+  if (index >= manifest.chunks.size()) return false;
+  if (chunksReceived == 0) return index == 0;
+  if (manifest.nodes.empty()) return index == chunksReceived;
+  const int32_t k = nodeOfChunk(index);
+  if (k < 0) return false;
+  const NodeInfo& n = manifest.nodes[size_t(k)];
+  return index == n.firstChunk + nodeChunksReceived[size_t(k)] && (n.parent < 0 || nodeComplete(uint32_t(n.parent)));
+}
+
 Result openDataset(Dataset& ds, std::string_view manifestJson) {
   Manifest m;
   if (Result r = parseManifest(manifestJson, m); !r) return r;
@@ -50,17 +64,44 @@ Result openDataset(Dataset& ds, std::string_view manifestJson) {
   ds.pm = ProgressiveMesh{};
   ds.chunksReceived = 0;
   ds.bytesReceived = 0;
+  ds.received.clear();
   ds.payloads.clear();
   ds.chunkFirstSplit.clear();
+  ds.tetsAfter.clear();
+  ds.nodeIds.assign(ds.manifest.nodes.size(), {});
+  ds.nodeChunksReceived.assign(ds.manifest.nodes.size(), 0);
+  ds.inManifestOrder = true;
   ds.recordStart.assign(kSplitColumns, 0);
+  ds.stableJ.clear();
   ds.splitsDecoded = 0;
   return Result::success();
 }
 
+namespace {
+
+// The stable ids node k's records may name (FORMAT.md §1.1): the base's, its ancestors' and its
+// own, which come next in the mesh.
+VertexIdMap idMapOf(const Dataset& ds, uint32_t k) {
+  VertexIdMap map;
+  const Manifest& m = ds.manifest;
+  const NodeInfo& own = m.nodes[k];
+  map.runs.push_back({own.vertexBegin, own.vertexEnd, ds.pm.baseVertices + ds.splitsReceived()});
+  for (int32_t a = own.parent; a >= 0; a = m.nodes[size_t(a)].parent) {
+    const VertexIdMap& up = ds.nodeIds[size_t(a)];
+    map.runs.push_back(up.runs.front());  // (each map's first run is its node's own)
+  }
+  map.runs.push_back({0, m.chunks[0].vertices, 0});
+  return map;
+}
+
+}  // namespace
+
 Result receiveChunk(Dataset& ds, uint32_t index, std::span<const uint8_t> file, bool hashChecked) {
-  if (index != ds.chunksReceived || index >= ds.manifest.chunks.size())
-    return fail(Status::BadArgument, "chunk " + std::to_string(index) + " received out of order (next is " +
-                                         std::to_string(ds.chunksReceived) + ")");
+  if (!ds.canReceive(index))
+    return fail(Status::BadArgument,
+                "chunk " + std::to_string(index) + " received out of order" +
+                    (ds.manifest.nodes.empty() ? " (next is " + std::to_string(ds.chunksReceived) + ")"
+                                               : " (its node's parent is not complete)"));
   const ChunkInfo& info = ds.manifest.chunks[index];
   std::span<const uint8_t> payload;
   if (Result r = openChunk(ds.decoder, info, index, file, payload, hashChecked); !r) return r;
@@ -70,27 +111,40 @@ Result receiveChunk(Dataset& ds, uint32_t index, std::span<const uint8_t> file, 
     initProgressive(ds.pm, std::move(mesh));
     ds.payloads.assign(1, {});
     ds.chunkFirstSplit.assign({0, 0});
+    ds.tetsAfter.assign(1, ds.pm.baseTets);
   } else {
     if (Result r = beginSplits(ds.reader, payload, info, ds.manifest); !r) return r;
+    if (const int32_t k = ds.nodeOfChunk(index); k >= 0) {
+      if (ds.nodeChunksReceived[size_t(k)] == 0) ds.nodeIds[size_t(k)] = idMapOf(ds, uint32_t(k));
+      ++ds.nodeChunksReceived[size_t(k)];
+    }
+    ds.inManifestOrder = ds.inManifestOrder && index == ds.chunksReceived;
     ds.payloads.emplace_back(payload.begin(), payload.end());
     ds.chunkFirstSplit.push_back(ds.chunkFirstSplit.back() + info.splits);
+    ds.tetsAfter.push_back(ds.tetsAfter.back() + (info.tets - ds.manifest.chunks[index - 1].tets));
   }
-  ds.chunksReceived = index + 1;
+  ds.received.push_back(index);
+  ds.chunksReceived = uint32_t(ds.received.size());
   ds.bytesReceived += info.bytes;
   return Result::success();
 }
 
 namespace {
 
-// Drops received chunks from `chunk` on (after a decode failure inside it).
-void dropChunksFrom(Dataset& ds, uint32_t chunk) {
-  ds.payloads.resize(chunk);
-  ds.chunkFirstSplit.resize(chunk + 1);
-  ds.chunksReceived = chunk;
+// Drops received chunks from place `place` on (after a decode failure inside it).
+void dropChunksFrom(Dataset& ds, uint32_t place) {
+  for (uint32_t c = place; c < ds.received.size(); ++c)
+    if (const int32_t k = ds.nodeOfChunk(ds.received[c]); k >= 0) --ds.nodeChunksReceived[size_t(k)];
+  ds.received.resize(place);
+  ds.payloads.resize(place);
+  ds.chunkFirstSplit.resize(place + 1);
+  ds.tetsAfter.resize(place);
+  ds.chunksReceived = place;
   ds.bytesReceived = 0;
-  for (uint32_t c = 0; c < chunk; ++c) ds.bytesReceived += ds.manifest.chunks[c].bytes;
+  for (uint32_t index : ds.received) ds.bytesReceived += ds.manifest.chunks[index].bytes;
   ds.splitsDecoded = std::min(ds.splitsDecoded, ds.chunkFirstSplit.back());
   ds.recordStart.resize(kSplitColumns * (size_t(ds.splitsDecoded) + 1));
+  ds.stableJ.resize(ds.splitsDecoded);
 }
 
 // Applies split g = ds.splitsApplied() from its chunk's payload.
@@ -99,18 +153,21 @@ Result redoNext(Dataset& ds, std::vector<uint32_t>& changed) {
   uint32_t c = 1;
   while (ds.chunkFirstSplit[c + 1] <= g) ++c;
   const uint32_t first = ds.chunkFirstSplit[c], end = ds.chunkFirstSplit[c + 1];
+  const uint32_t index = ds.received[c];
+  const int32_t node = ds.nodeOfChunk(index);
   SplitReader& r = ds.reader;
   // The chunk's header was checked when it was received: this only sets the cursors.
-  Result res = beginSplits(r, ds.payloads[c], ds.manifest.chunks[c], ds.manifest);
+  Result res = beginSplits(r, ds.payloads[c], ds.manifest.chunks[index], ds.manifest);
+  r.ids = ds.inManifestOrder || node < 0 ? nullptr : &ds.nodeIds[size_t(node)];
   if (res && g != first) {
     r.seek(&ds.recordStart[kSplitColumns * size_t(g)]);
     r.remaining = end - g;
-    r.prevJ = ds.pm.splitJ[g - 1];
+    r.prevJ = ds.stableJ[g - 1];
   }
   if (res) res = applyNextSplit(r, ds.pm, ds.quant, changed);
+  r.ids = nullptr;
   if (res && g + 1 == end) {
-    const ChunkInfo& info = ds.manifest.chunks[c];
-    if (ds.pm.vertexCount() != info.vertices || ds.pm.tetCount() != info.tets)
+    if (ds.pm.vertexCount() != ds.pm.baseVertices + end || ds.pm.tetCount() != ds.tetsAfter[c])
       res = fail(Status::Corrupt, "split chunk: counts after the chunk differ from the manifest");
     else if (!r.atEnd())
       res = fail(Status::Corrupt, "split chunk: bytes after the last split");
@@ -119,12 +176,13 @@ Result redoNext(Dataset& ds, std::vector<uint32_t>& changed) {
   if (!res) {
     while (ds.splitsApplied() > first) undoSplit(ds.pm, changed);
     dropChunksFrom(ds, c);
-    res.message = "chunk " + std::to_string(c) + ": " + res.message;
+    res.message = "chunk " + std::to_string(index) + ": " + res.message;
     return res;
   }
   if (g == ds.splitsDecoded) {
     ds.recordStart.resize(kSplitColumns * (size_t(g) + 2));
     r.tell(&ds.recordStart[kSplitColumns * (size_t(g) + 1)]);
+    ds.stableJ.push_back(r.prevJ);
     ++ds.splitsDecoded;
   }
   return res;
@@ -168,7 +226,7 @@ bool isPackedDir(const std::string& path) {
 
 Result loadPackedDir(const std::string& dir, Dataset& ds, int maxChunks, uint32_t maxVertices) {
   std::vector<uint8_t> bytes;
-  if (Result r = readFile(dir + "/manifest.json", 16u << 20, bytes); !r) return r;
+  if (Result r = readFileBytes(dir + "/manifest.json", 16u << 20, bytes); !r) return r;
   if (Result r = openDataset(ds, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size())); !r)
     return r;
   size_t n = ds.manifest.chunks.size();
@@ -177,7 +235,7 @@ Result loadPackedDir(const std::string& dir, Dataset& ds, int maxChunks, uint32_
   for (uint32_t i = 0; i < n; ++i) {
     if (i > 0 && ds.pm.vertexCount() >= maxVertices) break;
     const ChunkInfo& c = ds.manifest.chunks[i];
-    if (Result r = readFile(dir + "/" + c.file, c.bytes, bytes); !r) {
+    if (Result r = readFileBytes(dir + "/" + c.file, c.bytes, bytes); !r) {
       if (r.status == Status::TooLarge) r.status = Status::SizeMismatch;
       return r;
     }

@@ -1,5 +1,7 @@
 #include "isosurface.h"
 
+#include <algorithm>
+#include <array>
 #include <cassert>
 #include <cmath>
 
@@ -105,6 +107,33 @@ double surfaceArea(const IsoSurface& s) {
     area += 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz);
   }
   return area;
+}
+
+}  // namespace tetstream
+
+namespace tetstream {
+namespace {
+
+using Corners = std::array<float, 9>;
+
+std::vector<Corners> canonicalTriangles(const IsoSurface& s) {
+  std::vector<Corners> out(s.triangleCount());
+  for (uint32_t t = 0; t < s.triangleCount(); ++t) {
+    std::array<std::array<float, 3>, 3> c;
+    for (int k = 0; k < 3; ++k)
+      for (int a = 0; a < 3; ++a) c[size_t(k)][size_t(a)] = s.positions[3 * size_t(s.indices[3 * t + k]) + a];
+    const size_t first = size_t(std::min_element(c.begin(), c.end()) - c.begin());
+    for (size_t k = 0; k < 3; ++k)
+      for (size_t a = 0; a < 3; ++a) out[t][3 * k + a] = c[(first + k) % 3][a];
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+}  // namespace
+
+bool sameTriangles(const IsoSurface& a, const IsoSurface& b) {
+  return a.triangleCount() == b.triangleCount() && canonicalTriangles(a) == canonicalTriangles(b);
 }
 
 }  // namespace tetstream

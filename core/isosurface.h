@@ -75,3 +75,14 @@ void extractIsosurface(const TetMesh& mesh, std::span<const float> field, float 
 double surfaceArea(const IsoSurface& s);
 
 }  // namespace tetstream
+
+namespace tetstream {
+
+// Whether two surfaces have the same triangles, bit for bit, whatever their vertex and triangle
+// order: each triangle as its three corner positions, turned to start at its smallest corner
+// (its orientation kept). Surfaces of two meshes that share the tets cut, with the same values
+// at their vertices, compare equal however the meshes number them (cutEdge() orders each edge
+// by value, not by id).
+bool sameTriangles(const IsoSurface& a, const IsoSurface& b);
+
+}  // namespace tetstream

@@ -1,5 +1,6 @@
 #include "manifest.h"
 
+#include <cassert>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
@@ -95,6 +96,13 @@ struct Reader {
     }
     return true;
   }
+  // Positions and ranges are stored as floats: a finite double beyond float range (1e39) would
+  // become infinite, so it is refused like any other non-finite number.
+  static bool finiteFloat(const json& x, float& out) {
+    if (!x.is_number()) return false;
+    out = float(x.get<double>());
+    return std::isfinite(x.get<double>()) && std::isfinite(out);
+  }
   bool vec3(const json& obj, const char* key, const std::string& path, float out[3]) {
     const json* v = member(obj, key, path);
     if (!v) return false;
@@ -103,14 +111,34 @@ struct Reader {
       return false;
     }
     for (int k = 0; k < 3; ++k) {
-      const json& x = (*v)[size_t(k)];
-      if (!x.is_number() || !std::isfinite(x.get<double>())) {
+      if (!finiteFloat((*v)[size_t(k)], out[k])) {
         error = "'" + path + key + "' must hold finite numbers";
         return false;
       }
-      out[k] = float(x.get<double>());
     }
     return true;
+  }
+  // [a, b]: two non-negative integers, each at most hi.
+  bool integerPair(const json& obj, const char* key, const std::string& path, uint64_t hi, uint64_t out[2]) {
+    const json* v = member(obj, key, path);
+    if (!v) return false;
+    if (!v->is_array() || v->size() != 2 || !(*v)[0].is_number_unsigned() || !(*v)[1].is_number_unsigned()) {
+      error = "'" + path + key + "' must be an array of 2 non-negative integers";
+      return false;
+    }
+    for (size_t k = 0; k < 2; ++k) {
+      out[k] = (*v)[k].get<uint64_t>();
+      if (out[k] > hi) {
+        error = "'" + path + key + "' holds " + std::to_string(out[k]) + ", above " + std::to_string(hi);
+        return false;
+      }
+    }
+    return true;
+  }
+  // Optional measured error (files written before it lack the key): -1 when absent, else >= 0.
+  void optionalError(const json& obj, const char* key, const std::string& path, double& out) {
+    if (obj.contains(key) && number(obj, key, path, out) && out < 0)
+      error = "'" + path + key + "' must not be negative";
   }
 };
 
@@ -126,6 +154,108 @@ bool validChunkFileName(const std::string& f) {
 }
 
 Result bad(const std::string& msg) { return fail(Status::BadManifest, "manifest: " + msg); }
+
+bool within(const Range& inner, const Range& outer) { return inner.min >= outer.min && inner.max <= outer.max; }
+bool within(const Bounds& inner, const Bounds& outer) {
+  for (int k = 0; k < 3; ++k)
+    if (inner.min[k] < outer.min[k] || inner.max[k] > outer.max[k]) return false;
+  return true;
+}
+
+// A node's per-field [min, max] list: one finite pair per field, min <= max, inside the field's
+// range and inside the parent's (selection by isovalue relies on the ranges nesting).
+Result parseRanges(const json& n, const std::string& path, const Manifest& m, const NodeInfo* parent, NodeInfo& node) {
+  auto it = n.find("ranges");
+  if (it == n.end()) return bad("missing key '" + path + "ranges'");
+  if (!it->is_array() || it->size() != m.fields.size())
+    return bad("'" + path + "ranges' must be an array of " + std::to_string(m.fields.size()) +
+               " [min, max] pairs, one per field");
+  for (size_t f = 0; f < m.fields.size(); ++f) {
+    const json& p = (*it)[f];
+    const std::string at = "'" + path + "ranges[" + std::to_string(f) + "]'";
+    Range r;
+    if (!p.is_array() || p.size() != 2 || !Reader::finiteFloat(p[0], r.min) || !Reader::finiteFloat(p[1], r.max))
+      return bad(at + " must be [min, max], two finite numbers");
+    if (r.min > r.max) return bad(at + " has min > max");
+    if (!within(r, m.fields[f].range)) return bad(at + " is outside the range of field '" + m.fields[f].name + "'");
+    if (parent && !within(r, parent->ranges[f])) return bad(at + " is outside the parent's range");
+    node.ranges.push_back(r);
+  }
+  return Result::success();
+}
+
+// FORMAT.md §1.1. Run after the chunks: the nodes' vertex and tet ids must agree with their counts.
+Result parseNodes(Reader& r, const json& list, Manifest& m) {
+  const size_t splitChunks = m.chunks.size() - 1;
+  if (!list.is_array() || list.size() > splitChunks)
+    return bad("'nodes' must be an array of at most one node per split chunk (" + std::to_string(splitChunks) + ")");
+  uint64_t nextChunk = 1;  // the first chunk in no node yet (chunk 0 is the base)
+  for (size_t k = 0; k < list.size(); ++k) {
+    const json& n = list[k];
+    const std::string name = "nodes[" + std::to_string(k) + "]", path = name + ".";
+    if (!n.is_object()) return bad("'" + name + "' must be an object");
+    NodeInfo node;
+    // Parents come first, so the list is a forest in application order and has no cycle.
+    const json* p = r.member(n, "parent", path);
+    if (!p) return bad(r.error);
+    const bool isBase = p->is_number_integer() && !p->is_number_unsigned() && p->get<int64_t>() == -1;
+    if (!isBase && !(p->is_number_unsigned() && p->get<uint64_t>() < k))
+      return bad("'" + path + "parent' must be -1 (the base) or the index of an earlier node");
+    node.parent = isBase ? -1 : int32_t(p->get<uint64_t>());
+    const NodeInfo* parent = isBase ? nullptr : &m.nodes[size_t(node.parent)];
+
+    uint64_t chunks[2], vertices[2], tets[2];
+    r.integerPair(n, "chunks", path, kMaxChunks, chunks);
+    r.integerPair(n, "vertices", path, kMaxCount, vertices);
+    r.integerPair(n, "tets", path, kMaxCount, tets);
+    if (!r.error.empty()) return bad(r.error);
+    // The nodes' chunks follow each other: together every split chunk once, in order.
+    if (chunks[1] < 1) return bad("'" + path + "chunks' must hold at least one chunk");
+    if (chunks[0] != nextChunk)
+      return bad("'" + path + "chunks' must start at chunk " + std::to_string(nextChunk) +
+                 (k == 0 ? " (the first split chunk)" : ", where the previous node ends"));
+    if (chunks[0] + chunks[1] > m.chunks.size()) return bad("'" + path + "chunks' runs past the last chunk");
+    nextChunk = chunks[0] + chunks[1];
+    node.firstChunk = uint32_t(chunks[0]);
+    node.chunkCount = uint32_t(chunks[1]);
+    // Stable ids: what the node's splits create in the whole stream's numbering.
+    const ChunkInfo &before = m.chunks[node.firstChunk - 1], &last = m.chunks[nextChunk - 1];
+    if (vertices[0] != before.vertices || vertices[1] != last.vertices)
+      return bad("'" + path + "vertices' must be [" + std::to_string(before.vertices) + ", " +
+                 std::to_string(last.vertices) + "], the counts before and after its chunks");
+    if (tets[0] != before.tets || tets[1] != last.tets)
+      return bad("'" + path + "tets' must be [" + std::to_string(before.tets) + ", " + std::to_string(last.tets) +
+                 "], the counts before and after its chunks");
+    node.vertexBegin = uint32_t(vertices[0]);
+    node.vertexEnd = uint32_t(vertices[1]);
+    node.tetBegin = uint32_t(tets[0]);
+    node.tetEnd = uint32_t(tets[1]);
+
+    const json* b = r.member(n, "bounds", path);
+    if (!b) return bad(r.error);
+    if (!b->is_object()) return bad("'" + path + "bounds' must be an object");
+    r.vec3(*b, "min", path + "bounds.", node.bounds.min);
+    r.vec3(*b, "max", path + "bounds.", node.bounds.max);
+    if (!r.error.empty()) return bad(r.error);
+    for (int a = 0; a < 3; ++a)
+      if (node.bounds.min[a] > node.bounds.max[a]) return bad("'" + path + "bounds.min' exceeds 'bounds.max'");
+    if (!within(node.bounds, m.bounds)) return bad("'" + path + "bounds' is outside the top-level 'bounds'");
+    if (parent && !within(node.bounds, parent->bounds)) return bad("'" + path + "bounds' is outside the parent's");
+
+    if (Result rr = parseRanges(n, path, m, parent, node); !rr) return rr;
+    if (r.number(n, "fieldError", path, node.fieldError) && node.fieldError < 0)
+      r.error = "'" + path + "fieldError' must not be negative";
+    r.optionalError(n, "fieldRms", path, node.fieldRms);
+    r.optionalError(n, "fieldMax", path, node.fieldMax);
+    if (!r.error.empty()) return bad(r.error);
+    m.nodes.push_back(std::move(node));
+  }
+  if (!m.nodes.empty() && nextChunk != m.chunks.size())
+    return bad("'nodes[" + std::to_string(m.nodes.size() - 1) + "].chunks' stops before chunk " +
+               std::to_string(nextChunk) + ": every split chunk (1 to " + std::to_string(m.chunks.size() - 1) +
+               ") belongs to a node");
+  return Result::success();
+}
 
 }  // namespace
 
@@ -157,9 +287,9 @@ Result parseManifest(std::string_view text, Manifest& m) {
   {
     const json* v = r.member(doc, "formatVersion", "");
     if (!v) return bad(r.error);
-    if (!v->is_number_unsigned() || v->get<uint64_t>() != kFormatVersion) {
+    if (!v->is_number_unsigned() || v->get<uint64_t>() < 1 || v->get<uint64_t>() > kFormatVersion) {
       return fail(Status::UnsupportedVersion,
-                  "manifest: formatVersion " + v->dump() + " is not supported (this reader reads version 1)");
+                  "manifest: formatVersion " + v->dump() + " is not supported (this reader reads versions 1 and 2)");
     }
     version = v->get<uint64_t>();
   }
@@ -196,6 +326,8 @@ Result parseManifest(std::string_view text, Manifest& m) {
     r.number(f, "max", path, hi);
     if (!r.error.empty()) return bad(r.error);
     if (fi.name.empty() || fi.name.size() > 256) return bad("'" + path + "name' must have 1 to 256 characters");
+    if (!std::isfinite(float(lo)) || !std::isfinite(float(hi)))
+      return bad("'" + path + "min' and 'max' must be finite as 32-bit floats");
     if (lo > hi) return bad("'" + path + "min' exceeds max");
     if (m.findField(fi.name) >= 0) return bad("field name '" + fi.name + "' appears twice");
     fi.range = {float(lo), float(hi)};
@@ -240,9 +372,8 @@ Result parseManifest(std::string_view text, Manifest& m) {
     r.integer(c, "splits", path, 0, kMaxCount, s);
     r.number(c, "fieldError", path, ci.fieldError);
     // Measured errors (format 1 files written before them lack the keys: -1, not shown).
-    for (auto [key, out] : {std::pair{"fieldRms", &ci.fieldRms}, std::pair{"fieldMax", &ci.fieldMax}})
-      if (c.contains(key) && r.number(c, key, path, *out) && *out < 0)
-        r.error = "'" + path + key + "' must not be negative";
+    r.optionalError(c, "fieldRms", path, ci.fieldRms);
+    r.optionalError(c, "fieldMax", path, ci.fieldMax);
     if (!r.error.empty()) return bad(r.error);
     if (!validChunkFileName(ci.file)) return bad("'" + path + "file' is not a plain name under chunks/");
     if (kind != (i == 0 ? "base" : "splits"))
@@ -267,7 +398,12 @@ Result parseManifest(std::string_view text, Manifest& m) {
   }
   if (m.chunks.back().vertices != m.vertices || m.chunks.back().tets != m.tets)
     return bad("the last chunk's counts differ from 'vertices'/'tets'");
-  return Result::success();
+  // Version 1 has no nodes (a key of that name is unknown there, so ignored); version 2 must
+  // say, even when empty (one sequence of split chunks).
+  if (version < 2) return Result::success();
+  const json* nodes = r.member(doc, "nodes", "");
+  if (!nodes) return bad(r.error);
+  return parseNodes(r, *nodes, m);
 }
 
 std::string writeManifest(const Manifest& m) {
@@ -303,6 +439,26 @@ std::string writeManifest(const Manifest& m) {
     if (c.fieldMax >= 0) chunks.back()["fieldMax"] = c.fieldMax;
   }
   doc["chunks"] = chunks;
+  assert(m.formatVersion >= 2 || m.nodes.empty());  // version 1 cannot hold nodes
+  if (m.formatVersion >= 2) {
+    json nodes = json::array();
+    for (const NodeInfo& n : m.nodes) {
+      json ranges = json::array();
+      for (const Range& r : n.ranges) ranges.push_back({r.min, r.max});
+      nodes.push_back({{"parent", n.parent},
+                       {"chunks", {n.firstChunk, n.chunkCount}},
+                       {"vertices", {n.vertexBegin, n.vertexEnd}},
+                       {"tets", {n.tetBegin, n.tetEnd}},
+                       {"bounds",
+                        {{"min", {n.bounds.min[0], n.bounds.min[1], n.bounds.min[2]}},
+                         {"max", {n.bounds.max[0], n.bounds.max[1], n.bounds.max[2]}}}},
+                       {"ranges", ranges},
+                       {"fieldError", n.fieldError}});
+      if (n.fieldRms >= 0) nodes.back()["fieldRms"] = n.fieldRms;
+      if (n.fieldMax >= 0) nodes.back()["fieldMax"] = n.fieldMax;
+    }
+    doc["nodes"] = nodes;
+  }
   return doc.dump(1) + "\n";
 }
 

@@ -11,7 +11,11 @@
 
 namespace tetstream {
 
-inline constexpr uint32_t kFormatVersion = 1;
+// Manifests are written as version 2 (a hierarchy of nodes, FORMAT.md §1.1); version 1 (one
+// sequence of chunks, no nodes) is still read. Chunk files did not change: their header keeps
+// its own version, kChunkVersion.
+inline constexpr uint32_t kFormatVersion = 2;
+inline constexpr uint32_t kChunkVersion = 1;
 inline constexpr const char* kLibraryVersion = "0.3.0";
 
 // The most a chunk of `bytes` compressed bytes may declare after decompression: zstd on mesh
@@ -44,6 +48,21 @@ struct ChunkInfo {
   double fieldRms = -1, fieldMax = -1;
 };
 
+// A node of the patch hierarchy (FORMAT.md §1.1): a region of the mesh and the splits that
+// refine it. Its splits need those of its ancestors and of nothing else, so any set of nodes
+// that holds every selected node's parent, applied parents first, is a valid mesh.
+struct NodeInfo {
+  int32_t parent = -1;                      // index in Manifest::nodes, below this node's; -1: the base
+  uint32_t firstChunk = 0, chunkCount = 0;  // its chunks: Manifest::chunks[firstChunk, +chunkCount)
+  // Stable ids its splits create, whatever other nodes are loaded: vertices [vertexBegin,
+  // vertexEnd) (one a split) and tets [tetBegin, tetEnd), in the numbering of the whole stream.
+  uint32_t vertexBegin = 0, vertexEnd = 0, tetBegin = 0, tetEnd = 0;
+  Bounds bounds;              // of its region's input vertices
+  std::vector<Range> ranges;  // per field (manifest order): min and max over its region at full resolution
+  double fieldError = 0;      // estimated (simplifier) field error in its region before its splits, isoField units
+  double fieldRms = -1, fieldMax = -1;  // measured there at the input's vertices; -1 when not given
+};
+
 struct Manifest {
   uint32_t formatVersion = kFormatVersion;
   std::string generator;
@@ -55,6 +74,7 @@ struct Manifest {
   bool lossless = false;
   int positionBits = 16, fieldBits = 16;
   std::vector<ChunkInfo> chunks;
+  std::vector<NodeInfo> nodes;  // version 2; empty for version 1 (one sequence)
 
   uint64_t totalBytes() const;
   int findField(std::string_view name) const;

@@ -9,6 +9,14 @@ namespace {
 
 Result corrupt(const std::string& what) { return fail(Status::Corrupt, "split chunk: " + what); }
 
+bool toLocal(const SplitReader& r, uint32_t stable, uint32_t& local) {
+  if (!r.ids) {
+    local = stable;
+    return true;
+  }
+  return r.ids->toLocal(stable, local);
+}
+
 }  // namespace
 
 void SplitReader::tell(uint32_t* offsets) const {
@@ -79,9 +87,9 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
   uint32_t u;
   if (!r.column(SplitColumn::KeptVertex).varint(u)) return fail(Status::Truncated, "split chunk: record ends early");
   const int64_t j64 = int64_t(r.prevJ) + unzigzag(u);
-  if (j64 < 0 || j64 >= V)
+  uint32_t j = uint32_t(j64);
+  if (j64 < 0 || j64 > int64_t(UINT32_MAX) || !toLocal(r, uint32_t(j64), j) || j >= V)
     return fail(Status::OutOfRange, "split chunk: kept vertex " + std::to_string(j64) + " does not exist");
-  const uint32_t j = uint32_t(j64);
 
   // T_moved: a bit per tet around j, in ascending tet order, or (a marker byte says which)
   // found from T_new below.
@@ -118,7 +126,11 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
   const uint32_t nc = uint32_t(r.candidates.size());
   ByteReader& tetsIn = r.column(SplitColumn::NewTets);
   // A vertex by its place among j's neighbours, or past them its id.
-  auto named = [&](uint32_t x) { return x < nc ? r.candidates[x] : x - nc; };
+  // (an id that the map does not hold becomes V: invalid below)
+  auto named = [&](uint32_t x) {
+    uint32_t v = V;
+    return x < nc ? r.candidates[x] : toLocal(r, x - nc, v) ? v : V;
+  };
   auto read = [&](uint32_t& v) {
     uint32_t x;
     if (!tetsIn.varint(x)) return false;
@@ -210,7 +222,7 @@ Result applyNextSplit(SplitReader& r, ProgressiveMesh& pm, const Quantizer& q, s
   pm.keptFixed = true;
   SplitOp op{j, r.moved, r.newTets, position, r.fields.data(), r.keptCount ? r.jFields.data() : nullptr};
   applySplit(pm, op, changed);
-  r.prevJ = j;
+  r.prevJ = uint32_t(j64);  // (stable: the next record's delta is from it)
   --r.remaining;
   return Result::success();
 }

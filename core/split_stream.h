@@ -45,6 +45,25 @@ enum class RingMode : uint32_t {
 };
 inline constexpr uint32_t kMaxNewTetsPerSplit = 4096;
 
+// Stable vertex ids (FORMAT.md §1.1) to the ids of a mesh that holds some of a dataset's nodes:
+// the base's and, for the node being applied, its ancestors' and its own, each a run of ids.
+// A record of the node may name no other vertex.
+struct VertexIdMap {
+  struct Run {
+    uint32_t stableBegin, stableEnd, localBegin;
+  };
+  std::vector<Run> runs;  // ascending and disjoint (a node's ids follow its ancestors')
+
+  bool toLocal(uint32_t stable, uint32_t& local) const {
+    for (const Run& r : runs)  // (a chain of a few tens of nodes at most)
+      if (stable >= r.stableBegin && stable < r.stableEnd) {
+        local = r.localBegin + (stable - r.stableBegin);
+        return true;
+      }
+    return false;
+  }
+};
+
 struct SplitReader {
   // One cursor per column; records in one row (no kSplitFlagColumns) use in[0] for every field.
   ByteReader in[kSplitColumns];
@@ -60,6 +79,9 @@ struct SplitReader {
   std::vector<uint32_t> star, candidates, moved, newTets, ring;
   std::vector<float> fields, jFields;  // jFields: keptCount values
   VertexLink link;                     // of j, for ring walks and T_moved
+  // Records name vertices by stable id; with a map they are translated (a partial mesh), without
+  // one they are the mesh's own (every node applied in stream order).
+  const VertexIdMap* ids = nullptr;
 
   ByteReader& column(SplitColumn c) { return in[columns ? uint32_t(c) : 0]; }
   // Where the next record starts (one offset per column), and going back there.

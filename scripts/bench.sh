@@ -12,6 +12,8 @@ for mod_pkg in vtk:python3-vtk9 matplotlib:python3-matplotlib; do
   fi
 done
 /usr/bin/python3 tests/bench/run_bench.py "$@"
+# What an isovalue needs of the patch hierarchy (bytes and nodes against the whole).
+/usr/bin/python3 tests/bench/selective_bench.py
 # The browser over a simulated 10 Mbit/s, 50 ms link (medians of 3 loads), and its timeline plot.
 node tests/bench/stream_bench.mjs --runs 3
 /usr/bin/python3 tests/bench/plot_timeline.py

@@ -33,7 +33,22 @@ bool reserveHeap(uint64_t bytes) {
 constexpr uint64_t kUiAndTransferBytes = 16u << 20;
 
 // Strings handed to the page stay valid until the next call that returns one of the same kind.
-std::string g_statsBuffer, g_viewBuffer;
+std::string g_statsBuffer, g_viewBuffer, g_planBuffer;
+
+// What a region covers on screen (fetch_plan.h): the square of its bounding sphere's angular
+// radius, 0 when the sphere lies wholly outside the view cone.
+double screenWeight(const Bounds& b) {
+  const OrbitCamera& c = g_app.view.camera;
+  const glm::vec3 lo(b.min[0], b.min[1], b.min[2]), hi(b.max[0], b.max[1], b.max[2]);
+  const glm::vec3 center = 0.5f * (lo + hi), eye = c.eye();
+  const float r = 0.5f * glm::length(hi - lo), d = glm::length(center - eye);
+  if (d <= r) return 1.0;  // the eye inside: it covers the view
+  const float aspect = g_app.canvas.height > 0 ? float(g_app.canvas.width) / float(g_app.canvas.height) : 1.f;
+  const float halfView = 0.5f * c.fovY * std::max(1.f, aspect);
+  const float off = std::acos(std::clamp(glm::dot(center - eye, glm::normalize(c.target - eye)) / d, -1.f, 1.f));
+  if (off - std::asin(r / d) > halfView) return 0.0;
+  return double(r / d) * double(r / d);
+}
 
 const Manifest& manifest() { return g_app.state.dataset.manifest; }
 
@@ -61,6 +76,47 @@ EMSCRIPTEN_KEEPALIVE int ts_open_manifest(const char* json, int len) {
 }
 
 EMSCRIPTEN_KEEPALIVE int ts_chunk_count() { return int(manifest().chunks.size()); }
+
+EMSCRIPTEN_KEEPALIVE int ts_node_count() { return int(manifest().nodes.size()); }
+
+// The chunks to fetch next, most important first, as a JSON array of indices (fetch_plan.h); at
+// most as many as memory allows. Changes whenever ts_plan_version() does.
+EMSCRIPTEN_KEEPALIVE const char* ts_plan_json() {
+  ViewerState& s = g_app.state;
+  s.fetch.screenWeight = screenWeight;
+  const uint32_t room =
+      s.memory.chunksAllowed > s.dataset.chunksReceived ? s.memory.chunksAllowed - s.dataset.chunksReceived : 0;
+  g_planBuffer = "[";
+  for (uint32_t c : plannedChunks(s, room)) g_planBuffer += (g_planBuffer.size() > 1 ? "," : "") + std::to_string(c);
+  g_planBuffer += "]";
+  return g_planBuffer.c_str();
+}
+
+EMSCRIPTEN_KEEPALIVE int ts_plan_version() { return int(g_app.state.fetch.version); }
+
+// Chunks the view needs that are not in yet (every chunk not in, without nodes).
+EMSCRIPTEN_KEEPALIVE int ts_chunks_missing() { return int(g_app.state.fetch.missing); }
+
+// Compressed bytes of the chunks the view needs, base included (every chunk without nodes).
+EMSCRIPTEN_KEEPALIVE double ts_needed_bytes() { return double(neededBytes(g_app.state)); }
+
+// 1 when chunk `index` has been added.
+EMSCRIPTEN_KEEPALIVE int ts_has_chunk(int index) {
+  return index >= 0 && g_app.state.dataset.hasChunk(uint32_t(index)) ? 1 : 0;
+}
+
+// The page gave up on a chunk (it cannot be had): its region stays coarse (chunkUnavailable).
+EMSCRIPTEN_KEEPALIVE void ts_chunk_unavailable(int index, const char* message) {
+  requestRedraw();
+  if (index >= 0) chunkUnavailable(g_app.state, uint32_t(index), message ? message : "");
+}
+
+// 1: fetch every node; 0: the nodes the view needs (the default).
+EMSCRIPTEN_KEEPALIVE void ts_set_fetch_everything(int on) {
+  requestRedraw();
+  setFetchMode(g_app.state, on ? FetchMode::Everything : FetchMode::Needed);
+  workOnChange();
+}
 
 EMSCRIPTEN_KEEPALIVE int ts_chunks_allowed() { return int(g_app.state.memory.chunksAllowed); }
 

@@ -52,6 +52,7 @@ struct FramePacing {
 
 struct App {
   ViewerState state;
+  uint32_t planVersionSent = 0;  // the fetch plan's version the page was last told of (fetch_plan.h)
   Renderer renderer;
   Canvas canvas;
   CameraControl view;

@@ -56,21 +56,51 @@ void section(const char* title) {
   ImGui::Separator();
 }
 
+// With a patch hierarchy (FORMAT.md §1.1): whether the surface is exact, what was fetched of
+// the whole, and the choice to fetch everything.
+void selectionLines(ViewerState& s) {
+  const Dataset& ds = s.dataset;
+  const Manifest& m = ds.manifest;
+  if (m.nodes.empty() || ds.chunksReceived == 0) return;
+  char line[160];
+  const char* field = s.field >= 0 ? m.fields[size_t(s.field)].name.c_str() : "";
+  if (exactSurface(s))
+    std::snprintf(line, sizeof line, "exact for %s = %.4g", field, s.isovalue);
+  else
+    std::snprintf(line, sizeof line, "refining towards the exact surface for %.4g", s.isovalue);
+  ImGui::TextUnformatted(line);
+  std::snprintf(line, sizeof line, "%u of %zu regions, %s of %s", nodesLoaded(s), m.nodes.size(),
+                formatBytes(ds.bytesReceived).c_str(), formatBytes(m.totalBytes()).c_str());
+  ImGui::TextDisabled("%s", line);
+  if (!s.unavailable.empty()) coloredWrapped(kWarning, s.unavailable);
+  bool everything = s.fetch.mode == FetchMode::Everything;
+  if (ImGui::Checkbox("load everything", &everything))
+    setFetchMode(s, everything ? FetchMode::Everything : FetchMode::Needed);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip(everything ? "Every region is fetched, whatever the isovalue."
+                                 : "Only the regions the isovalue (and the slice) need are fetched.");
+}
+
 void downloadSection(ViewerState& s, float width, float pixelsPerCssPixel) {
   const Dataset& ds = s.dataset;
-  const uint64_t total = ds.manifest.totalBytes();
-  const bool allReceived = ds.chunksReceived == s.chunksTotal;
+  const bool selective = !ds.manifest.nodes.empty();
+  const uint64_t total = selective ? neededBytes(s) : ds.manifest.totalBytes();
+  const bool allReceived = selective ? s.fetch.missing == 0 : ds.chunksReceived == s.chunksTotal;
   section("download");
   const NetworkStatus& net = s.network;
   if (s.state == LoadState::Loading && !net.paused)
     ImGui::TextUnformatted("loading the base mesh...");
-  else if (allReceived)
+  else if (allReceived && !selective)
     ImGui::Text("all %u parts received", s.chunksTotal);
+  else if (allReceived)
+    ImGui::Text("all %u parts this view needs received", ds.chunksReceived);
   else
-    ImGui::Text("%u of %u parts received", ds.chunksReceived, s.chunksTotal);
+    ImGui::Text("%u of %u parts received", ds.chunksReceived,
+                selective ? ds.chunksReceived + s.fetch.missing : s.chunksTotal);
+  selectionLines(s);
 
   const uint64_t have = allReceived ? ds.bytesReceived : std::max(net.receivedBytes, ds.bytesReceived);
-  std::string label = formatBytes(have) + " of " + formatBytes(total);
+  std::string label = formatBytes(have) + " of " + formatBytes(std::max(total, have));
   ImGui::ProgressBar(total ? float(double(have) / double(total)) : 0.f, ImVec2(width, 0), label.c_str());
 
   s.telemetry.screen.pauseButton = {};
@@ -125,11 +155,11 @@ void levelSection(ViewerState& s, float width, float pixelsPerCssPixel) {
     ImGui::Text("refining: %s splits to go", grouped(std::min(s.level.targetSplits, received) - applied).c_str());
   else if (applied > s.level.targetSplits)
     ImGui::Text("coarsening: %s splits to undo", grouped(applied - s.level.targetSplits).c_str());
-  else if (!s.level.live && ds.chunksReceived < s.chunksTotal && s.state != LoadState::Error)
+  else if (!s.level.live && s.fetch.missing > 0 && s.state != LoadState::Error)
     ImGui::TextDisabled("held here; move to the right end to follow new data");
   else if (!s.level.live)
     ImGui::TextDisabled("held here");
-  else if (ds.chunksReceived < s.chunksTotal && s.state != LoadState::Error)
+  else if (s.fetch.missing > 0 && s.state != LoadState::Error)
     ImGui::TextDisabled(s.network.paused ? "follows new data once the download resumes"
                                          : "follows new data as it arrives");
 
@@ -312,7 +342,10 @@ PanelActions drawPanel(ViewerState& s, float uiScale, float pixelsPerCssPixel) {
   const bool haveDataset = !m.chunks.empty();
   ImGui::TextUnformatted(!haveDataset ? "no dataset" : m.name.empty() ? "(unnamed dataset)" : m.name.c_str());
   if (s.state == LoadState::Idle) ImGui::TextDisabled("waiting for a dataset");
-  if (s.state == LoadState::Complete) ImGui::TextDisabled("complete: every part received and applied");
+  if (s.state == LoadState::Complete)
+    ImGui::TextDisabled(s.fetch.mode == FetchMode::Needed && !m.nodes.empty()
+                            ? "complete: every part this view needs received and applied"
+                            : "complete: every part received and applied");
   if (s.state == LoadState::Error) coloredWrapped(kError, (s.memory.limited ? "Stopped: " : "Error: ") + s.error);
   if (ImGui::SmallButton("copy link")) actions.copyLink = true;
   if (ImGui::IsItemHovered())

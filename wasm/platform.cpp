@@ -385,6 +385,10 @@ void frame() {
   a.pacing.lastFrameStart = start;
   syncCanvasSize();
   noteComplete(s);
+  if (s.fetch.version != a.planVersionSent) {
+    a.planVersionSent = s.fetch.version;
+    tsjs_plan_changed();
+  }
   if (refining(s) || treePending(s)) queueWork();
   if (downloading(s) && start - a.pacing.lastDrawStart >= kProgressRedrawMs)
     requestRedraw(1);  // progress and rate move

@@ -8,6 +8,7 @@ void tsjs_copy_link();
 void tsjs_screenshot();
 void tsjs_capture();
 void tsjs_pause_change(int paused);
+void tsjs_plan_changed();
 void tsjs_queue_work();
 int tsjs_software_gl();
 int tsjs_antialias();

@@ -25,6 +25,12 @@ mergeInto(LibraryManager.library, {
     if (Module.onPauseChange) Module.onPauseChange(!!paused);
   },
 
+  // What the view needs changed (isovalue, field, slice, fetch mode, a node given up): the page
+  // asks for the plan again (ts_plan_json) and hands it to its chunk loader.
+  tsjs_plan_changed: function () {
+    if (Module.onPlanChanged) Module.onPlanChanged();
+  },
+
   // A message to a MessageChannel port runs as its own task soon after, without setTimeout's
   // 4 ms clamp; rendering, input and network callbacks get their turns in between.
   tsjs_queue_work: function () {

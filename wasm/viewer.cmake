@@ -32,6 +32,7 @@ add_executable(tetstream_viewer
   ${CMAKE_CURRENT_LIST_DIR}/api.cpp
   ${CMAKE_CURRENT_LIST_DIR}/viewer_state.cpp
   ${CMAKE_CURRENT_LIST_DIR}/telemetry.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/fetch_plan.cpp
   ${CMAKE_CURRENT_LIST_DIR}/colourmap.cpp
   ${CMAKE_CURRENT_LIST_DIR}/viewer_memory.cpp
   ${CMAKE_CURRENT_LIST_DIR}/camera.cpp

@@ -97,7 +97,7 @@ void stopForMemory(ViewerState& s) {
   const Manifest& m = s.dataset.manifest;
   const uint32_t k = s.dataset.chunksReceived;
   char level[32];
-  std::snprintf(level, sizeof level, "%.1f%%", m.vertices ? 100.0 * m.chunks[k - 1].vertices / m.vertices : 0.0);
+  std::snprintf(level, sizeof level, "%.1f%%", m.vertices ? 100.0 * s.dataset.pm.vertexCount() / m.vertices : 0.0);
   s.memory.limited = true;
   failLoad(s, "This dataset needs about " + formatBytes(s.memory.neededBytes) + " of memory at full detail, more " +
                   "than the " + formatBytes(s.memory.limitBytes) + " this page may use. Streaming stopped after " +
@@ -109,7 +109,7 @@ void updateState(ViewerState& s) {
   const Dataset& ds = s.dataset;
   if (ds.chunksReceived == 0)
     s.state = LoadState::Loading;
-  else if (ds.chunksReceived == s.chunksTotal && ds.splitsApplied() == ds.splitsReceived())
+  else if (s.fetch.missing == 0 && ds.splitsApplied() == ds.splitsReceived())
     s.state = LoadState::Complete;
   else
     s.state = LoadState::Streaming;
@@ -156,6 +156,7 @@ Result openManifest(ViewerState& s, std::string_view manifestJson) {
   s.level.live = true;
   s.network = {};
   s.pendingChunks.clear();
+  s.unavailable.clear();
   s.telemetry.completeMs = -1;
   s.memory.neededBytes = 0;
   s.memory.chunksAllowed = 0;
@@ -178,6 +179,7 @@ Result openManifest(ViewerState& s, std::string_view manifestJson) {
   if (f >= 0) s.isovalue = middleOf(m.fields[size_t(f)].range);
   s.slice.setPlane({0, 0, 1}, 0.5f * (m.bounds.min[2] + m.bounds.max[2]));
 
+  resetPlan(s);
   s.memory.neededBytes = s.memory.baseBytes + estimateLevelBytes(m, s.chunksTotal);
   s.memory.chunksAllowed = s.chunksTotal;
   if (s.memory.limitBytes) {
@@ -208,19 +210,25 @@ ChunkCheck offerChunk(ViewerState& s, uint32_t index, uint8_t* bytes, size_t siz
   PendingChunk chunk;
   chunk.bytes.reset(bytes);
   chunk.size = size;
-  if ((s.state != LoadState::Loading && s.state != LoadState::Streaming) || index >= s.memory.chunksAllowed ||
-      index < s.dataset.chunksReceived)
+  if ((s.state != LoadState::Loading && s.state != LoadState::Streaming && s.state != LoadState::Complete) ||
+      s.dataset.chunksReceived >= s.memory.chunksAllowed || s.dataset.hasChunk(index))
     return ChunkCheck::NoSuchChunk;
   if (ChunkCheck c = checkChunk(s, index, {bytes, size}); c != ChunkCheck::Ok) return c;
   s.pendingChunks.insert_or_assign(index, std::move(chunk));
-  // Every chunk whose turn has come, in order; one that fails ends in Error (addChunk says why).
-  for (auto next = s.pendingChunks.find(s.dataset.chunksReceived); next != s.pendingChunks.end();
-       next = s.pendingChunks.find(s.dataset.chunksReceived)) {
-    const uint32_t i = next->first;
-    const PendingChunk ready = std::move(next->second);
-    s.pendingChunks.erase(next);
-    if (!addChunk(s, i, {ready.bytes.get(), ready.size}, /*hashChecked=*/true).ok()) {
-      s.pendingChunks.clear();
+  // Every chunk whose turn has come (after the chunks of its node before it and its node's
+  // parent); one that fails ends in Error (addChunk says why).
+  for (bool added = true; added;) {
+    added = false;
+    for (auto next = s.pendingChunks.begin(); next != s.pendingChunks.end(); ++next) {
+      if (!s.dataset.canReceive(next->first)) continue;
+      const uint32_t i = next->first;
+      const PendingChunk ready = std::move(next->second);
+      s.pendingChunks.erase(next);
+      if (!addChunk(s, i, {ready.bytes.get(), ready.size}, /*hashChecked=*/true).ok()) {
+        s.pendingChunks.clear();
+        return ChunkCheck::Ok;
+      }
+      added = true;
       break;
     }
   }
@@ -228,14 +236,14 @@ ChunkCheck offerChunk(ViewerState& s, uint32_t index, uint8_t* bytes, size_t siz
 }
 
 Result addChunk(ViewerState& s, uint32_t index, std::span<const uint8_t> bytes, bool hashChecked) {
-  if (s.state != LoadState::Loading && s.state != LoadState::Streaming) {
+  if (s.state != LoadState::Loading && s.state != LoadState::Streaming && s.state != LoadState::Complete) {
     Result r = fail(Status::BadArgument, std::string("chunk ") + std::to_string(index) +
                                              " arrived while the viewer is " + loadStateName(s.state));
     if (s.state != LoadState::Error) failLoad(s, r.message);
     return r;
   }
   Dataset& ds = s.dataset;
-  if (index >= s.memory.chunksAllowed) {
+  if (ds.chunksReceived >= s.memory.chunksAllowed) {
     Result r = fail(Status::TooLarge, partName(s, index) + " does not fit in memory");
     failLoad(s, r.message);
     return r;
@@ -244,7 +252,7 @@ Result addChunk(ViewerState& s, uint32_t index, std::span<const uint8_t> bytes, 
   // here with a message instead of failing an allocation half way through. With the base, the
   // arrays are sized for the last level that will come (reserveLevel), so that much is asked
   // for first; if the browser will not give it now, the arrays grow as levels come instead.
-  const uint64_t need = s.memory.baseBytes + estimateLevelBytes(ds.manifest, index + 1);
+  const uint64_t need = s.memory.baseBytes + estimateLevelBytes(ds.manifest, ds.chunksReceived + 1);
   const bool reserveAll =
       index == 0 &&
       (!s.memory.reserveHeap ||
@@ -263,6 +271,7 @@ Result addChunk(ViewerState& s, uint32_t index, std::span<const uint8_t> bytes, 
                     (ds.chunksReceived ? ". Showing the last complete level." : "."));
     return r;
   }
+  notePlannedChunk(s, index);
   if (ds.chunksReceived == 1) {  // the base: shown at once
     if (reserveAll) reserveLevel(s);
     extract(s);
@@ -272,7 +281,7 @@ Result addChunk(ViewerState& s, uint32_t index, std::span<const uint8_t> bytes, 
   }
   if (s.level.live) s.level.targetSplits = ds.splitsReceived();
   updateState(s);
-  if (ds.chunksReceived == s.memory.chunksAllowed && s.memory.chunksAllowed < s.chunksTotal) stopForMemory(s);
+  if (ds.chunksReceived == s.memory.chunksAllowed && s.fetch.missing > 0) stopForMemory(s);
   return Result::success();
 }
 
@@ -349,6 +358,8 @@ void setIsovalue(ViewerState& s, float value) {
   if (!std::isfinite(value) || value == s.isovalue) return;
   s.isovalue = value;
   extract(s);
+  replan(s);
+  updateState(s);
 }
 
 bool setField(ViewerState& s, int index) {
@@ -358,6 +369,8 @@ bool setField(ViewerState& s, int index) {
   s.isovalue = middleOf(m.fields[size_t(index)].range);
   s.surface.reset();  // another field: the interval tree is built again
   extract(s);
+  replan(s);
+  updateState(s);
   return true;
 }
 
@@ -423,11 +436,17 @@ void setSliceEnabled(ViewerState& s, bool on) {
   s.sliceOn = on;
   if (on && s.colour.field < 0 && s.field >= 0) setColourField(s, s.field);
   extractSlice(s);
+  replan(s);
+  updateState(s);
 }
 
 bool setSlicePlane(ViewerState& s, std::array<float, 3> normal, float offset) {
   const bool changed = s.slice.setPlane(normal, offset);
   if (changed) extractSlice(s);
+  if (changed && s.sliceOn) {
+    replan(s);
+    updateState(s);
+  }
   return changed || (std::isfinite(offset) && (normal[0] != 0 || normal[1] != 0 || normal[2] != 0));
 }
 
@@ -441,13 +460,33 @@ void failLoad(ViewerState& s, std::string_view message) {
   s.error = message.empty() ? "Unknown error." : std::string(message);
 }
 
+void setFetchMode(ViewerState& s, FetchMode mode) {
+  if (mode == s.fetch.mode) return;
+  s.fetch.mode = mode;
+  replan(s);
+  updateState(s);
+}
+
+void chunkUnavailable(ViewerState& s, uint32_t index, std::string_view message) {
+  const Dataset& ds = s.dataset;
+  const int32_t k = ds.nodeOfChunk(index);
+  if (k < 0) return failLoad(s, message);
+  const Bounds& b = ds.manifest.nodes[size_t(k)].bounds;
+  char region[160];
+  std::snprintf(region, sizeof region, "The region [%g, %g, %g] .. [%g, %g, %g] stays coarse: ", b.min[0], b.min[1],
+                b.min[2], b.max[0], b.max[1], b.max[2]);
+  s.unavailable = region + std::string(message);
+  giveUpChunk(s, index);
+  updateState(s);
+}
+
 uint64_t memoryInUse(const ViewerState& s) {
   return datasetMemoryBytes(s.dataset) + s.surface.memoryBytes() + s.hull.memoryBytes() + s.slice.memoryBytes();
 }
 
 bool downloading(const ViewerState& s) {
   return (s.state == LoadState::Loading || s.state == LoadState::Streaming) && !s.network.paused &&
-         s.dataset.chunksReceived < s.memory.chunksAllowed;
+         s.fetch.missing > 0 && s.dataset.chunksReceived < s.memory.chunksAllowed;
 }
 
 bool treePending(const ViewerState& s) {
@@ -491,8 +530,11 @@ double fieldErrorBound(const ViewerState& s) {
 }
 
 const ChunkInfo* levelChunk(const ViewerState& s) {
-  uint32_t c = s.dataset.chunksApplied();
-  return c ? &s.dataset.manifest.chunks[c - 1] : nullptr;
+  // A chunk's figures are those of the stream in manifest order up to it: a level made of other
+  // chunks (a plan of nodes, fetch_plan.h) has none.
+  const Dataset& ds = s.dataset;
+  const uint32_t c = ds.chunksApplied();
+  return c && ds.inManifestOrder ? &ds.manifest.chunks[ds.received[c - 1]] : nullptr;
 }
 
 nlohmann::json viewObject(const ViewerState& s) {

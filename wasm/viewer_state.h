@@ -40,6 +40,7 @@
 
 #include "colourmap.h"
 #include "dataset.h"
+#include "fetch_plan.h"
 #include "hull.h"
 #include "isosurface_incremental.h"
 #include "slice.h"
@@ -50,7 +51,8 @@ namespace tetstream::viewer {
 
 enum class LoadState : uint8_t { Idle, Loading, Streaming, Complete, Error };
 // "idle", "loading" (no base yet), "streaming" (base shown; chunks still to come or splits not
-// yet applied), "complete" (every chunk received and every split applied), "error".
+// yet applied), "complete" (every chunk the view needs received and every split applied; with a
+// patch hierarchy, the view's nodes: fetch_plan.h), "error".
 const char* loadStateName(LoadState s);
 
 // The network as the page reports it (one snapshot, docs/js-api.md: ts_set_network): the page
@@ -111,7 +113,8 @@ struct ViewOptions {
 struct ViewerState {
   Dataset dataset;
   LoadState state = LoadState::Idle;
-  std::string error;  // plain words, shown in the panel; empty unless state == Error
+  std::string error;        // plain words, shown in the panel; empty unless state == Error
+  std::string unavailable;  // a region left coarse because its chunk could not be had (chunkUnavailable)
   uint32_t chunksTotal = 0;
   std::map<uint32_t, PendingChunk> pendingChunks;  // checked, waiting for an earlier chunk
   NetworkStatus network;                           // from the page
@@ -134,6 +137,7 @@ struct ViewerState {
 
   MemoryBudget memory;
   Telemetry telemetry;
+  FetchPlan fetch;  // which chunks the view needs, most important first (fetch_plan.h)
 
   // Scratch, reused every frame.
   std::vector<uint32_t> changed, splitVertices;
@@ -194,6 +198,13 @@ void sliceOffsetRange(const ViewerState& s, float& lo, float& hi);
 
 // Reports a failure from outside the model (network, platform) in plain words.
 void failLoad(ViewerState& s, std::string_view message);
+
+// Fetch what the view needs (the default) or everything (fetch_plan.h).
+void setFetchMode(ViewerState& s, FetchMode mode);
+// A chunk that cannot be had (the page gave up on it): with a patch hierarchy its node's region
+// stays coarse, said in plain words, and the rest of the view goes on; without one the stream
+// stops there (failLoad).
+void chunkUnavailable(ViewerState& s, uint32_t index, std::string_view message);
 
 // Checks a downloaded chunk against the manifest (size, then content hash) without changing
 // anything: the page fetches a chunk again when it does not match.

@@ -94,8 +94,9 @@ function getState() {
   };
 }
 
+// Parts of what the view needs are still to come.
 function partsComing() {
-  return page.viewer._ts_chunks_received() < page.viewer._ts_chunk_count();
+  return page.viewer._ts_chunks_missing() > 0;
 }
 
 function setLevel(fraction) {
@@ -182,7 +183,7 @@ function setState(p = {}) {
 function stateQuery(st) {
   const q = new URLSearchParams();
   if (st.dataset) q.set('data', st.dataset);
-  for (const keep of ['maxMemoryMB', 'stallSeconds', 'antialias']) if (params.get(keep) !== null) q.set(keep, params.get(keep));
+  for (const keep of ['maxMemoryMB', 'stallSeconds', 'antialias', 'fetch']) if (params.get(keep) !== null) q.set(keep, params.get(keep));
   if (st.field === null) return q;
   q.set('field', st.field);
   q.set('iso', shortFloat(st.isovalue));
@@ -279,6 +280,13 @@ export function applyLinkState() {
   const cam = numbers(params.get('cam'), 6);
   if (cam) setCamera({ target: cam.slice(0, 3), distance: cam[3], yaw: cam[4], pitch: cam[5] });
   if (params.get('boundary') === '0') setViewOption('boundary', false);
+  if (params.get('fetch') === 'all') setFetchEverything(true);
+}
+
+// A dataset of nodes (FORMAT.md §1.1): fetch every node (true) or only what the view needs (the
+// default). ?fetch=all asks for everything from the start.
+function setFetchEverything(on) {
+  if (viewerReady()) page.viewer._ts_set_fetch_everything(on ? 1 : 0);
 }
 
 window.tetstream = {
@@ -294,6 +302,7 @@ window.tetstream = {
   setLevel,
   setSlice,
   setCamera,
+  setFetchEverything,
   get colourMaps() {
     return colourMaps();
   },

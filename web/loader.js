@@ -1,10 +1,18 @@
-// Streams a packed dataset's chunks: fetched ahead a few at a time, each checked against the
-// manifest (size, content hash) before it is handed over, handed over strictly in order. A chunk
-// that fails in a way that may pass (connection lost, no data for the stall time, HTTP 5xx,
-// 408, 429, damaged bytes) is fetched again after a backoff, bypassing caches; one that cannot
-// pass (404 and other 4xx, damaged every time) stops the stream after every chunk before it has
-// been handed over, so the viewer keeps the level it reached. Nothing here blocks: every step
-// runs in a network callback and takes well under a millisecond (the check hashes in wasm).
+// Streams a packed dataset's chunks along a plan: an order of chunk indices, by default every
+// chunk in manifest order. A dataset of nodes (FORMAT.md §1.1) is read a part at a time: the
+// page plans the nodes its view needs, most important first, each after its parent, and
+// replans when the view changes (replan(): what was handed over stays, the rest of the plan is
+// replaced, and requests for chunks it no longer holds are dropped). Chunks are fetched a few
+// plan places ahead, each checked against the manifest (size, content hash) before it is handed
+// over, handed over strictly in plan order. A chunk that fails in a way that may pass (connection
+// lost, no data for the stall time, HTTP 5xx, 408, 429, damaged bytes) is fetched again after a
+// backoff, bypassing caches. One that cannot pass (404 and other 4xx, damaged every time) waits
+// until every chunk before it in the plan has been handed over, then either stops the stream,
+// so the viewer keeps the level it reached, or, when the page takes such failures
+// (onChunkFailed), is left out of the plan while the rest goes on (the page replans without
+// what needs it). At the end of the plan the stream ends, or, when the page plans more
+// (onIdle), waits for the next plan. Nothing here blocks: every step runs in a network callback
+// and takes well under a millisecond (the check hashes in wasm).
 //
 // The loader may start before the viewer program is ready, from the manifest's chunk names
 // alone (the shell checks each against FORMAT.md's file rule first): the base chunk at once,
@@ -29,7 +37,7 @@ export const STARTUP_SECONDS = 1;
 // ... until the base is in: it alone decides when the first surface appears, so it shares the
 // link with one more request only (which keeps the link busy while the base's last bytes come).
 export const MAX_IN_FLIGHT_BEFORE_BASE = 2;
-export const MAX_AHEAD = 12;                // chunks fetched past the next one the viewer needs
+export const MAX_AHEAD = 12;                // plan places fetched past the next one the viewer needs
 export const MAX_AHEAD_BYTES = 64 << 20;    // ... and at most this much held in the page
 export const MAX_DAMAGED = 4;               // a chunk damaged this often in a row is broken at the source
 export const LOG_LIMIT = 2000;              // entries kept in ChunkLoader.log (the newest)
@@ -56,24 +64,41 @@ const pageClock = {
 
 export class ChunkLoader {
   // urls, names (as the manifest gives them, for messages), sizes: per chunk.
+  // order: the plan, chunk indices (default: every chunk in manifest order), each after the
+  // chunks it needs (a node's after its parent's, FORMAT.md §1.1); the loader keeps its order.
   // fail(message): the stream cannot go on (called once, after the chunks before the bad one
-  // have been delivered). done(): every allowed chunk delivered, or stopped.
+  // have been delivered). done(): every allowed chunk of the plan delivered, or stopped.
+  // onIdle(): given, the end of the plan does not end the stream: it is called once there, and
+  // the loader waits for replan() to give it more.
+  // onChunkFailed(index, message): given, a chunk that cannot be had does not end the stream:
+  // once every chunk before it in the plan has been delivered, it is left out of the plan and
+  // this is called before anything after it is handed over, so the page can replan without the
+  // chunks that need it.
   // check, deliver, allowed: see attach(); given here, the loader is attached from the start.
   // fetch, clock, timing: the network, the clock and timers, and the network's timing of a
   // finished request (net.js fetchBytes, the page's clock, Resource Timing unless given).
-  constructor({ urls, names = urls, sizes, allowed = urls.length, stallMs = STALL_SECONDS * 1000, check = null,
-    deliver = null, fail, done, fetch = fetchBytes, clock = pageClock, timing = networkTiming }) {
+  constructor({ urls, names = urls, sizes, order = null, allowed = urls.length, stallMs = STALL_SECONDS * 1000,
+    check = null, deliver = null, fail, done, onIdle = null, onChunkFailed = null, fetch = fetchBytes,
+    clock = pageClock, timing = networkTiming }) {
     Object.assign(this, { urls, names, sizes, allowed, stallMs, check, deliver, failed: fail, done });
-    Object.assign(this, { fetch, clock, timing });
+    Object.assign(this, { onIdle, onChunkFailed, fetch, clock, timing });
     this.attached = !!check;
     this.warmed = this.attached;   // before: the program is still downloading, only the base
     this.programNearlyIn = false;  // its last bytes are coming: the first split chunk too
     this.unchecked = new Set();    // arrived before attach()
     this.total = urls.length;
-    this.next = 0;                 // next chunk to hand over
+    this.plan = [];                // chunk indices in the order they are handed over
+    this.position = new Map();     // chunk index -> its place in the plan
+    this.nextPos = 0;              // place in the plan of the next chunk to hand over
+    this.setTail(order ?? urls.map((_, i) => i));
+    this.idle = false;             // onIdle() called at the end of the plan, waiting for more
+    this.handingOver = false;      // in deliverReady() (a callback may replan meanwhile)
+    // By chunk index. The first four hold chunks the plan has yet to hand over; trouble also
+    // keeps those a replan left (their failure counts hold if they come back).
     this.inFlight = new Map();     // index -> { controller, received }
     this.arrived = new Map();      // index -> bytes, checked, waiting for an earlier chunk
     this.waiting = new Map();      // index -> { at, timer }: to be fetched again at time `at`
+    this.unavailable = new Map();  // index -> message: cannot be had, skipped in its turn
     this.trouble = new Map();      // index -> { failures, damaged, last }: chunks that failed
     this.deliveredBytes = 0;
     this.networkBytes = 0;         // off the wire, failed and aborted requests included
@@ -93,6 +118,11 @@ export class ChunkLoader {
     //   { event: 'response', index, bytes }   { event: 'failure', index, cause, transient }
     //   { event: 'refused', index, cause }    { event: 'backoff', index, delayMs }
     //   { event: 'online', waiting }          { event: 'pause' }   { event: 'resume' }
+    //   { event: 'replan', count }: the plan past what was handed over is now `count` chunks.
+    //   { event: 'drop', index, reason: 'replan' }: a request under way for a chunk it left.
+    //   { event: 'discard', index, bytes }: a chunk it left that had arrived.
+    //   { event: 'skip', index }: a chunk that cannot be had, left out (onChunkFailed).
+    //   { event: 'idle' }: the end of the plan, waiting for more (onIdle).
     // Each has `seq`, its place in the whole log.
     this.log = [];
     this.logged = 0;
@@ -109,24 +139,75 @@ export class ChunkLoader {
     return `part ${i + 1} of ${this.total}`;
   }
 
+  // The plan past what was handed over becomes `tail`, less what was handed over and repeats.
+  setTail(tail) {
+    const plan = this.plan.slice(0, this.nextPos);
+    const position = new Map(plan.map((i, p) => [i, p]));
+    for (const i of tail) {
+      if (!Number.isInteger(i) || i < 0 || i >= this.total) throw new RangeError(`No chunk ${i} of ${this.total}.`);
+      if (position.has(i)) continue;
+      position.set(i, plan.length);
+      plan.push(i);
+    }
+    Object.assign(this, { plan, position });
+  }
+
+  inPlanOrder(indices) {
+    return [...indices].sort((a, b) => this.position.get(a) - this.position.get(b));
+  }
+
   // The viewer is ready. check(i, bytes): null when the bytes are chunk i, else what is wrong in
   // words. deliver(i, bytes): hands chunk i over; false = the viewer stopped (it says why
-  // itself). allowed: chunks to fetch (fewer than urls.length when memory is short).
+  // itself). allowed: plan places to fetch (fewer than the plan's when memory is short).
   attach({ check, deliver, allowed = this.urls.length }) {
     Object.assign(this, { check, deliver, allowed, attached: true, warmed: true });
     for (const [j, e] of [...this.inFlight]) {
-      if (j >= allowed) {
+      if (this.position.get(j) >= allowed) {
         e.controller.abort();
         this.inFlight.delete(j);
       }
     }
-    for (const j of [...this.arrived.keys()]) if (j >= allowed) this.arrived.delete(j);
-    for (const i of [...this.unchecked].sort((a, b) => a - b)) {
+    for (const j of [...this.arrived.keys()]) if (this.position.get(j) >= allowed) this.arrived.delete(j);
+    for (const i of this.inPlanOrder(this.unchecked)) {
       this.unchecked.delete(i);
       if (this.stopped) return;
-      if (this.failure && i > this.failure.index) this.arrived.delete(i);
+      if (this.failure && this.position.get(i) > this.position.get(this.failure.index)) this.arrived.delete(i);
       else if (this.arrived.has(i)) this.accept(i, this.arrived.get(i));
     }
+    this.deliverReady();
+    this.pump();
+  }
+
+  // The view changed: what was handed over stays, the rest of the plan becomes `tail` (chunk
+  // indices; those handed over and repeats are ignored). Chunks it keeps are kept wherever they
+  // are (under way, arrived, waiting on a backoff); requests for the others are dropped, their
+  // bytes discarded and their backoffs cancelled. Once the stream has ended (stopped, or a chunk
+  // it cannot do without failed) the plan stays as it is.
+  replan(tail) {
+    if (this.stopped || this.failure) return;
+    this.setTail(tail);
+    this.note({ event: 'replan', count: this.plan.length - this.nextPos });
+    const left = (j) => !this.position.has(j);
+    for (const [j, e] of [...this.inFlight]) {
+      if (!left(j)) continue;
+      e.controller.abort();
+      this.inFlight.delete(j);
+      this.note({ event: 'drop', index: j, reason: 'replan' });
+    }
+    for (const [j, bytes] of [...this.arrived]) {
+      if (!left(j)) continue;
+      this.arrived.delete(j);
+      this.unchecked.delete(j);
+      this.note({ event: 'discard', index: j, bytes: bytes.length });
+    }
+    for (const [j, w] of [...this.waiting]) {
+      if (!left(j)) continue;
+      this.clock.clearTimeout(w.timer);
+      this.waiting.delete(j);
+    }
+    for (const j of [...this.unavailable.keys()]) if (left(j)) this.unavailable.delete(j);
+    for (const set of [this.dropped, this.wokenOnline]) for (const j of [...set]) if (left(j)) set.delete(j);
+    if (this.nextPos < Math.min(this.allowed, this.plan.length)) this.idle = false;
     this.deliverReady();
     this.pump();
   }
@@ -168,8 +249,10 @@ export class ChunkLoader {
   }
 
   pump() {
-    if (this.paused || this.stopped || this.failure) return;
-    const end = Math.min(this.allowed, this.warmed ? this.next + MAX_AHEAD : this.programNearlyIn ? 2 : 1);
+    if (this.paused || this.stopped) return;
+    // After a failure only the chunks before it, which are handed over before it is reported.
+    const end = Math.min(this.allowed, this.failure ? this.position.get(this.failure.index) : this.plan.length,
+      this.warmed ? this.nextPos + MAX_AHEAD : this.programNearlyIn ? 2 : 1);
     let ahead = 0, outstanding = 0;
     for (const b of this.arrived.values()) ahead += b.length;
     for (const [j, e] of this.inFlight) {
@@ -179,10 +262,12 @@ export class ChunkLoader {
     // Once the program is in, the base has at most a few round trips left: open the other
     // requests now, as the main thread may be busy starting the program for a while (no
     // callbacks run then, so requests not opened before it would wait).
-    const limit = this.next === 0 && !this.arrived.has(0) && !this.warmed ? MAX_IN_FLIGHT_BEFORE_BASE : MAX_IN_FLIGHT;
-    for (let i = this.next; i < end && this.inFlight.size < limit; i++) {
-      if (this.arrived.has(i) || this.inFlight.has(i) || this.waiting.has(i)) continue;
-      if (i > this.next && ahead + this.sizes[i] > MAX_AHEAD_BYTES) break;
+    const baseComing = this.nextPos === 0 && !this.arrived.has(this.plan[0]) && !this.warmed;
+    const limit = baseComing ? MAX_IN_FLIGHT_BEFORE_BASE : MAX_IN_FLIGHT;
+    for (let p = this.nextPos; p < end && this.inFlight.size < limit; p++) {
+      const i = this.plan[p];
+      if (this.arrived.has(i) || this.inFlight.has(i) || this.waiting.has(i) || this.unavailable.has(i)) continue;
+      if (p > this.nextPos && ahead + this.sizes[i] > MAX_AHEAD_BYTES) break;
       if (this.inFlight.size > 0 && outstanding >= this.lead()) break;
       this.fetchChunk(i, outstanding);
       ahead += this.sizes[i];
@@ -218,7 +303,7 @@ export class ChunkLoader {
         if (this.inFlight.size < MAX_IN_FLIGHT) this.pump(); // outstanding bytes dropped
       },
     }).then((bytes) => {
-      if (this.inFlight.get(i) !== entry) return; // dropped meanwhile (pause, stop)
+      if (this.inFlight.get(i) !== entry) return; // dropped meanwhile (pause, replan, stop)
       this.inFlight.delete(i);
       this.note({ event: 'response', index: i, bytes: bytes.length });
       this.measure(i, entry, bytes.length);
@@ -230,11 +315,12 @@ export class ChunkLoader {
       }
       this.pump();
     }, (e) => {
-      if (this.inFlight.get(i) === entry) this.inFlight.delete(i);
+      if (this.inFlight.get(i) !== entry) return; // dropped meanwhile: its failure is no news
+      this.inFlight.delete(i);
       if (e.kind === 'aborted' || this.stopped) return;
       this.note({ event: 'failure', index: i, cause: causeOf(e), transient: !!e.transient });
       if (e.transient) this.retryLater(i, e);
-      else this.failAt(i, `Could not download ${this.part(i)} of the dataset (${this.names[i]}): ${e.message}.`);
+      else this.cannotHave(i, `Could not download ${this.part(i)} of the dataset (${this.names[i]}): ${e.message}.`);
       this.pump();
     });
   }
@@ -249,6 +335,7 @@ export class ChunkLoader {
       this.failAt(i, e.message);
       return;
     }
+    if (!this.position.has(i)) return; // the page replanned without it meanwhile
     if (damage) {
       this.refused++;
       this.note({ event: 'refused', index: i, cause: 'damaged' });
@@ -267,7 +354,7 @@ export class ChunkLoader {
     t.last = error;
     this.trouble.set(i, t);
     if (t.damaged >= MAX_DAMAGED) {
-      this.failAt(i, `${this.part(i)[0].toUpperCase()}${this.part(i).slice(1)} of the dataset arrived damaged ` +
+      this.cannotHave(i, `${this.part(i)[0].toUpperCase()}${this.part(i).slice(1)} of the dataset arrived damaged ` +
         `${t.damaged} times in a row (${error.message}): the copy on the server does not match its manifest.`);
       return;
     }
@@ -291,25 +378,39 @@ export class ChunkLoader {
     this.pump();
   }
 
-  // Chunk i cannot be had: the chunks before it that are still coming are delivered first,
-  // then the failure is reported. Nothing after it is fetched any more.
+  // Chunk i cannot be had (a 4xx, damaged every time): skipped in its turn when the page takes
+  // that (onChunkFailed), else the end of the stream.
+  cannotHave(i, message) {
+    if (!this.onChunkFailed) {
+      this.failAt(i, message);
+      return;
+    }
+    this.unavailable.set(i, message);
+    this.deliverReady();
+  }
+
+  // Chunk i cannot be had and the stream cannot go on without it: the chunks before it in the
+  // plan that are still coming are delivered first, then the failure is reported. Nothing after
+  // it is fetched any more.
   failAt(i, message) {
-    if (this.failure && this.failure.index <= i) return;
+    const place = this.position.get(i);
+    if (place === undefined) return; // left the plan meanwhile
+    if (this.failure && this.position.get(this.failure.index) <= place) return;
     this.failure = { index: i, message };
     for (const [j, e] of [...this.inFlight]) {
-      if (j > i) {
+      if (this.position.get(j) > place) {
         e.controller.abort();
         this.inFlight.delete(j);
       }
     }
     for (const [j, w] of [...this.waiting]) {
-      if (j >= i) {
+      if (this.position.get(j) >= place) {
         this.clock.clearTimeout(w.timer);
         this.waiting.delete(j);
       }
     }
     for (const j of [...this.arrived.keys()]) {
-      if (j > i) {
+      if (this.position.get(j) > place) {
         this.arrived.delete(j);
         this.unchecked.delete(j);
       }
@@ -318,19 +419,40 @@ export class ChunkLoader {
   }
 
   reportFailure() {
-    if (!this.failure || this.next < this.failure.index || this.stopped) return;
-    if (!this.attached && this.failure.index > 0) return; // the chunks before it first
-    const { index, message } = this.failure;
+    if (!this.failure || this.stopped) return;
+    const place = this.position.get(this.failure.index);
+    if (this.nextPos < place) return;
+    if (!this.attached && place > 0) return; // the chunks before it first
+    const { message } = this.failure;
     this.stop();
-    this.failed(index > 0 ? `${message} Showing the last complete level.` : message);
+    this.failed(place > 0 ? `${message} Showing the last complete level.` : message);
   }
 
   deliverReady() {
-    if (!this.attached) return;
-    while (!this.stopped && this.arrived.has(this.next) && !this.unchecked.has(this.next)) {
-      const i = this.next;
+    if (!this.attached || this.handingOver) return; // a hand-over under way goes on from the new state
+    this.handingOver = true;
+    try {
+      this.handOver();
+    } finally {
+      this.handingOver = false;
+    }
+    if (this.stopped) return;
+    if (this.nextPos >= Math.min(this.allowed, this.plan.length)) this.endOfPlan();
+    this.reportFailure();
+  }
+
+  // Hands over the chunks that are next in the plan and here, and skips those that cannot be had.
+  handOver() {
+    while (!this.stopped && this.nextPos < this.plan.length) {
+      const i = this.plan[this.nextPos];
+      if (this.unavailable.has(i)) {
+        this.skip(i);
+        continue;
+      }
+      if (!this.arrived.has(i) || this.unchecked.has(i)) return;
       const bytes = this.arrived.get(i);
       this.arrived.delete(i);
+      this.nextPos++; // before deliver(): a replan from there keeps chunk i in the plan
       let accepted;
       try {
         accepted = this.deliver(i, bytes);
@@ -344,10 +466,30 @@ export class ChunkLoader {
         return;
       }
       this.deliveredBytes += bytes.length;
-      this.next++;
     }
-    if (this.next >= this.allowed) this.stop();
-    this.reportFailure();
+  }
+
+  // Chunk i, next in the plan, cannot be had: out of the plan, and the page told (it may replan).
+  skip(i) {
+    const message = this.unavailable.get(i);
+    this.unavailable.delete(i);
+    this.plan.splice(this.nextPos, 1);
+    this.position.delete(i);
+    for (let p = this.nextPos; p < this.plan.length; p++) this.position.set(this.plan[p], p);
+    this.note({ event: 'skip', index: i });
+    this.onChunkFailed(i, message);
+  }
+
+  // Every allowed chunk of the plan is delivered: the end, or a wait for the next plan.
+  endOfPlan() {
+    if (!this.onIdle) {
+      this.stop();
+      return;
+    }
+    if (this.idle) return;
+    this.idle = true;
+    this.note({ event: 'idle' });
+    this.onIdle();
   }
 
   // Bytes of the dataset in hand: delivered, arrived and partly downloaded.
@@ -358,11 +500,13 @@ export class ChunkLoader {
     return have;
   }
 
-  // What the network side is doing, in plain words, or '' when all is well: the earliest chunk
-  // that failed and is waiting or being fetched again.
+  // What the network side is doing, in plain words, or '' when all is well: the chunk earliest
+  // in the plan that failed and is waiting or being fetched again.
   notice(now = this.clock.now()) {
-    if (this.stopped || this.failure || this.paused || !this.trouble.size) return '';
-    const i = Math.min(...this.trouble.keys());
+    if (this.stopped || this.failure || this.paused) return '';
+    const troubled = [...this.trouble.keys()].filter((j) => this.position.has(j) && !this.unavailable.has(j));
+    if (!troubled.length) return '';
+    const i = this.inPlanOrder(troubled)[0];
     const { last, failures } = this.trouble.get(i);
     const what = this.part(i);
     let cause;

@@ -90,9 +90,13 @@ export function updateStatus(network) {
       : net.secondsLeft > 0 ? ', less than a second left' : '';
     if (s.state === 'loading') {
       text = `Loading ${name}: ${formatBytes(have)} of ${formatBytes(page.datasetTotal)}${rate}…`;
-    } else if (s.chunksReceived < s.chunksAllowed) {
-      text = `${name}: ${s.chunksReceived} of ${s.chunksTotal} parts, ${formatBytes(have)} of ` +
+    } else if (s.state === 'streaming' && s.chunksReceived < s.chunksAllowed) {
+      text = `${name}: ${s.chunksReceived} parts, ${formatBytes(have)} of ` +
         `${formatBytes(page.datasetTotal)}${net.paused ? ' (paused)' : `${rate}${left}`}; level ${(100 * s.level).toFixed(1)}%`;
+    } else if (s.chunksReceived < s.chunksTotal) {
+      // A dataset of nodes: what the view needs is in (FORMAT.md §1.1).
+      text = `${name}: ${s.chunksReceived} of ${s.chunksTotal} parts, ${formatBytes(have)} of ` +
+        `${formatBytes(network.datasetBytes())}: all this view needs; level ${(100 * s.level).toFixed(1)}%`;
     } else {
       text = `${name}: all ${s.chunksTotal} parts, ${formatBytes(network.datasetBytes())}; level ${(100 * s.level).toFixed(1)}%`;
     }

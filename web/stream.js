@@ -143,7 +143,8 @@ const CHUNK_FILE = /^chunks\/[0-9a-z.-]+$/;
 export function peekChunks(bytes) {
   try {
     const m = JSON.parse(new TextDecoder().decode(bytes));
-    if (m.format !== 'tetstream' || m.formatVersion !== 1 || !Array.isArray(m.chunks)) return null;
+    // Versions 1 and 2 list their chunk files alike (FORMAT.md §1); nodes are the viewer's to read.
+    if (m.format !== 'tetstream' || ![1, 2].includes(m.formatVersion) || !Array.isArray(m.chunks)) return null;
     if (!m.chunks.length || m.chunks.length > 65536) return null;
     const names = [], sizes = [];
     for (const c of m.chunks) {
@@ -220,6 +221,26 @@ function chunksOfViewer() {
   return { names, sizes };
 }
 
+// A dataset of nodes (FORMAT.md §1.1): the loader fetches what the viewer's plan says (the
+// nodes the view needs, most important first) and follows it as the view changes; a chunk that
+// cannot be had leaves its region coarse instead of stopping the stream.
+function followPlan(viewer, loader) {
+  const plan = () => JSON.parse(wasmString(viewer._ts_plan_json()));
+  const follow = () => {
+    if (page.loader !== loader || loader.stopped) return;
+    loader.replan(plan());
+    page.datasetTotal = viewer._ts_needed_bytes();
+    network.report();
+  };
+  loader.onIdle = () => network.report();
+  loader.onChunkFailed = (i, message) => {
+    viewer.ccall('ts_chunk_unavailable', null, ['number', 'string'], [i, message]);
+    follow();
+  };
+  viewer.onPlanChanged = follow;
+  follow();
+}
+
 // The viewer said no: its error, on the page too.
 function viewerStopped() {
   const error = wasmString(page.viewer._ts_error());
@@ -276,8 +297,10 @@ async function stream(manifestUrl) {
   if (!page.loader) startLoader({ names, sizes }, manifestUrl);
   const allowed = viewer._ts_chunks_allowed();
   page.datasetTotal = sizes.slice(0, allowed).reduce((a, b) => a + b, 0);
+  const selective = viewer._ts_node_count() > 0;
+  if (selective) followPlan(viewer, page.loader);
   page.loader.attach({
-    allowed,
+    allowed: selective ? Infinity : allowed, // (the viewer's plan holds what memory allows)
     // The one hand-over: copied into wasm memory once, checked (size, hash) once there, kept
     // by the viewer and added in order. The viewer frees the copy.
     check(i, bytes) {
@@ -285,10 +308,10 @@ async function stream(manifestUrl) {
       network.report(); // the rate counts these bytes now, not at the next status tick
       return code === 1 ? null : damageText(code, bytes.length, sizes[i]);
     },
-    // The loader's turn for chunk i: the viewer added it when it was offered in order.
+    // The loader's turn for chunk i: the viewer added it when it was offered in turn.
     deliver(i) {
       startViewer(); // the base is in: show it as soon as possible
-      if (viewer._ts_chunks_received() > i && viewer._ts_load_state() !== ERROR_STATE) return true;
+      if (viewer._ts_has_chunk(i) && viewer._ts_load_state() !== ERROR_STATE) return true;
       viewerStopped();
       return false;
     },

@@ -63,15 +63,11 @@ Runner addInfo(CLI::App& app) {
         j["readMs"] = readMs;
       }
       if (in.packed) {
-        j["format"] = {{"formatVersion", in.manifest.formatVersion},
-                       {"generator", in.manifest.generator},
-                       {"chunks", in.manifest.chunks.size()},
-                       {"chunksApplied", in.chunksApplied},
-                       {"splitsApplied", in.splitsApplied},
-                       {"fullVertices", in.manifest.vertices},
-                       {"fullTets", in.manifest.tets},
-                       {"bytes", in.manifest.totalBytes()},
-                       {"isoField", in.manifest.isoField}};
+        j["format"] = {{"formatVersion", in.manifest.formatVersion}, {"generator", in.manifest.generator},
+                       {"chunks", in.manifest.chunks.size()},        {"nodes", in.manifest.nodes.size()},
+                       {"chunksApplied", in.chunksApplied},          {"splitsApplied", in.splitsApplied},
+                       {"fullVertices", in.manifest.vertices},       {"fullTets", in.manifest.tets},
+                       {"bytes", in.manifest.totalBytes()},          {"isoField", in.manifest.isoField}};
       }
       printJson(j);
       return 0;
@@ -87,9 +83,9 @@ Runner addInfo(CLI::App& app) {
       std::printf("  field     %-24s [%g, %g]\n", f.name.c_str(), r.min, r.max);
     }
     if (in.packed) {
-      std::printf("  format    v%u, %zu chunk(s), %llu bytes, by %s\n", in.manifest.formatVersion,
-                  in.manifest.chunks.size(), static_cast<unsigned long long>(in.manifest.totalBytes()),
-                  in.manifest.generator.c_str());
+      std::printf("  format    v%u, %zu chunk(s), %zu node(s), %llu bytes, by %s\n", in.manifest.formatVersion,
+                  in.manifest.chunks.size(), in.manifest.nodes.size(),
+                  static_cast<unsigned long long>(in.manifest.totalBytes()), in.manifest.generator.c_str());
       std::printf("  level     %u of %zu chunks, %u splits: %.1f%% of %u vertices, %.1f%% of %u tets\n",
                   in.chunksApplied, in.manifest.chunks.size(), in.splitsApplied,
                   100.0 * m.vertexCount() / in.manifest.vertices, in.manifest.vertices,

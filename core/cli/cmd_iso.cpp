@@ -1,4 +1,4 @@
-// tetstream iso INPUT|PACKDIR --value V [--field NAME] [-o SURFACE.ply] [--json]
+// tetstream iso INPUT|PACKDIR --value V [--field NAME] [-o SURFACE.ply] [--json] [--selective [--no-check]]
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -7,6 +7,7 @@
 #include "commands.h"
 #include "io/ply_writer.h"
 #include "isosurface.h"
+#include "selective_iso.h"
 
 namespace tetstream::cli {
 
@@ -14,7 +15,7 @@ Runner addIso(CLI::App& app) {
   struct Opts {
     std::string input, field, out;
     double value = 0;
-    bool json = false;
+    bool json = false, selective = false, noCheck = false;
     LevelOption level;
     ReadOptions read;
   };
@@ -25,9 +26,14 @@ Runner addIso(CLI::App& app) {
   sub->add_option("--field", o->field, "scalar field (default: the dataset's first or iso field)");
   sub->add_option("-o,--output", o->out, "write the surface as binary PLY with normals");
   sub->add_flag("--json", o->json, "print the result as JSON on stdout");
+  sub->add_flag("--selective", o->selective,
+                "packed datasets: load only the nodes this isovalue needs, check the surface against the "
+                "full mesh's and report what was needed");
+  sub->add_flag("--no-check", o->noCheck, "with --selective: do not load the full mesh to compare");
   addLevelOptions(sub, o->level);
   addReadOptions(sub, o->read);
   return [o] {
+    if (o->selective) return runSelectiveIso({o->input, o->field, o->out, o->value, o->json, !o->noCheck});
     Input in;
     if (Result r = loadInput(o->input, in, o->level, o->read); !r) return reportError(r, o->json);
     Result r;

@@ -75,7 +75,7 @@ Runner addPack(CLI::App& app) {
     std::string input, out, field, name;
     std::vector<double> weights;
     double baseFraction = 0.01, maxError = -1, maxMemoryGb = 0;
-    uint32_t baseVertices = 0, baseTets = 0, chunkKb = 256;
+    uint32_t baseVertices = 0, baseTets = 0, chunkKb = 256, leafVertices = PackOptions{}.leafVertices;
     int level = 18, threads = 2;
     bool lossless = false, json = false, samples = false, compact = false;
     ReadOptions read;
@@ -115,6 +115,10 @@ Runner addPack(CLI::App& app) {
                 "inside each chunk the splits go by kept vertex, not by cost");
   sub->add_option("--chunk-kb", o->chunkKb, "largest split chunk in KB; the first chunks are smaller")
       ->check(CLI::Range(1u, 65536u))
+      ->capture_default_str();
+  sub->add_option("--leaf-vertices", o->leafVertices,
+                  "largest region of the patch hierarchy, in vertices (smaller: a viewer fetches less for one "
+                  "isovalue, in more files; 0: one region)")
       ->capture_default_str();
   sub->add_option("--zstd-level", o->level, "zstd compression level")->check(CLI::Range(1, 22))->capture_default_str();
   sub->add_option("--max-memory", o->maxMemoryGb,
@@ -157,6 +161,7 @@ Runner addPack(CLI::App& app) {
     opt.lossless = o->lossless;
     opt.orderSplits = o->compact;
     opt.chunkKb = o->chunkKb;
+    opt.leafVertices = o->leafVertices;
     opt.maxMemoryBytes = o->maxMemoryGb * 1e9;
     opt.progress = [&bar](const char* phase, uint64_t done, uint64_t planned) { bar.update(phase, done, planned); };
     PackSummary s;
@@ -196,7 +201,7 @@ Runner addPack(CLI::App& app) {
                  {"flatTetsRemoved", s.flatTetsRemoved},
                  {"flatTetsLeft", s.flatTetsLeft},
                  {"queuePops", s.queuePops},
-                 {"slabCollapses", s.slabCollapses},
+                 {"regionCollapses", s.regionCollapses},
                  {"requeued", s.requeued},
                  {"costEvaluations", s.costEvaluations},
                  {"readMs", readMs},

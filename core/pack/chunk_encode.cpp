@@ -28,7 +28,7 @@ void putArray(std::vector<uint8_t>& b, const std::vector<T>& a) {  // little-end
 
 void beginChunk(std::vector<uint8_t>& raw, ChunkKind kind, uint32_t index) {
   raw.insert(raw.end(), kChunkMagic, kChunkMagic + 4);
-  putU16(raw, uint16_t(kFormatVersion));
+  putU16(raw, uint16_t(kChunkVersion));
   putU16(raw, uint16_t(kind));
   putU32(raw, index);
   putU32(raw, 0);

@@ -44,6 +44,22 @@ class LevelErrorMeter {
   void begin(std::span<const float> positions, std::span<const float> values, const TetMesh& level, size_t field,
              std::vector<uint32_t> levelOf, std::span<const uint32_t> baseOf, std::span<const uint32_t> intoOf);
   LevelError total() const;
+  // The error of the last measurement (begin() or current()) by group: out[g] over the input
+  // vertices v with groupOf(v) = g (out sized by the caller; groups past its end are skipped).
+  template <typename GroupOf>
+  void totalByGroup(GroupOf groupOf, std::vector<LevelError>& out) const {
+    std::vector<double> sum(out.size(), 0.0);
+    std::vector<uint32_t> count(out.size(), 0);
+    for (uint32_t v = 0; v < samples_.size(); ++v) {
+      const Sample& s = samples_[v];
+      const uint32_t g = groupOf(v);
+      if (g >= out.size() || s.tet == kNone || !std::isfinite(s.err)) continue;
+      sum[g] += double(s.err) * s.err;
+      out[g].max = std::max(out[g].max, double(s.err));
+      ++count[g];
+    }
+    for (size_t g = 0; g < out.size(); ++g) out[g].rms = count[g] ? std::sqrt(sum[g] / count[g]) : 0.0;
+  }
 
   // After applySplit() restored input vertex `input` next to level vertex j, moving the listed
   // tets from j to the new vertex (`stars`: the level's). When the split gave p_j a value back,

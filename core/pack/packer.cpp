@@ -194,7 +194,7 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   so.weightField = opt.weights[1];
   so.weightShape = opt.weights[2];
   so.threads = opt.threads;
-  so.slabMinVertices = opt.slabMinVertices;
+  so.leafVertices = opt.leafVertices;
   so.fitValues = opt.fitValues;
   so.field = iso;
   so.recordReadSets = opt.orderSplits;
@@ -218,7 +218,7 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   summary.flatTetsRemoved = simplified.flatTetsRemoved;
   summary.flatTetsLeft = simplified.flatTetsLeft;
   summary.queuePops = simplified.queuePops;
-  summary.slabCollapses = simplified.slabCollapses;
+  summary.regionCollapses = simplified.regionCollapses;
   summary.requeued = simplified.requeued;
   summary.costEvaluations = simplified.costEvaluations;
 
@@ -273,6 +273,8 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
     if (Result r = writeFile(fs::path(outDir) / info.file, enc.files[c].data(), enc.files[c].size()); !r) return r;
     m.chunks.push_back(info);
   }
+  // One region alone (a small mesh, --leaf-vertices 0) is no hierarchy: one sequence of chunks.
+  if (enc.nodes.size() > 1) m.nodes = std::move(enc.nodes);
 
   // Remove chunk files an earlier pack left behind (only our own *.tsc names).
   for (const auto& entry : fs::directory_iterator(fs::path(outDir) / "chunks", ec)) {

@@ -31,7 +31,7 @@ struct PackOptions {
   bool orderSplits = false;          // splits by kept vertex inside each chunk (pack --compact)
   double maxMemoryBytes = 0;         // refuse meshes that need more (0: 90% of physical memory)
   int threads = 2;                   // threads that evaluate collapse costs and measure levels (1 or 2; same output)
-  uint32_t slabMinVertices = 10000;  // simplify in slabs at once from this size (SimplifyOptions)
+  uint32_t leafVertices = 1024;      // largest region of the patch hierarchy (SimplifyOptions)
   uint32_t renumberMinTets = 50000;  // renumber scattered meshes from this size (pack/renumber.h)
   // Progress for displays: phase ("validate", "simplify", "encode", "write"), items done and
   // planned in that phase (collapses, splits; 0 planned when not countable).
@@ -45,8 +45,8 @@ struct PackSummary {
   uint32_t flatTetsRemoved = 0, flatTetsLeft = 0;
   uint32_t movedMasks = 0;  // splits that carry a mask of T_moved (it does not follow from T_new)
   uint64_t queuePops = 0, requeued = 0, costEvaluations = 0;  // simplifier work, for benchmarks
-  uint32_t slabCollapses = 0;  // of the collapses, those made in slabs at once (the parallel phase)
-  std::string stopReason;      // why simplification stopped
+  uint32_t regionCollapses = 0;  // of the collapses, those made below the root (two threads at once)
+  std::string stopReason;        // why simplification stopped
   double prepareMs = 0, simplifyMs = 0, encodeMs = 0, writeMs = 0;  // prepare: checks, orientation, grid
   std::vector<std::string> notes;                                   // what the packer changed or found, in plain words
 };

@@ -5,7 +5,7 @@
 //   simplify_cost.cpp      one vertex's out-edges: legality, then the cost in refining stages
 //   simplify_link.cpp      the link condition
 //   simplify_collapse.cpp  a collapse and its log entry
-//   simplify_slabs.cpp     the parallel phase: slabs of a large mesh, one thread each
+//   simplify_tree.cpp      the tree of regions below the root, two threads at once
 //   simplify_refit.cpp     the last level's values, fitted again at the end
 // Internal to the packer: nothing outside these files includes it but the tests (SimplifyTuning).
 #pragma once
@@ -136,11 +136,11 @@ class Simplifier {
 
   // The value s at x that minimises the field quadric (x, s): its derivative in s is zero.
   // (q is the upper triangle of the 5×5 form: q[12] is (s, s), q[3], q[7], q[10] are (x, s),
-  // (y, s), (z, s), q[13] is (s, 1).) Kept inside the field's range, which the stream's
-  // quantization grid covers.
-  double fitted(const FieldQuadric& f, const double* x, double fallback) const {
+  // (y, s), (z, s), q[13] is (s, 1).) Kept inside [lo, hi]: the input field's range over the
+  // region collapsing (simplify.h), within the field's range, which the quantization grid covers.
+  static double fitted(const FieldQuadric& f, const double* x, double fallback, double lo, double hi) {
     const double a = f.q[12], b = f.q[3] * x[0] + f.q[7] * x[1] + f.q[10] * x[2] + f.q[13];
-    return a > 0 ? std::clamp(-b / a, fieldMin_, fieldMax_) : fallback;
+    return a > 0 ? std::clamp(-b / a, lo, hi) : fallback;
   }
 
   // Vertex v's position, from the floats of vert_ (exact in double; a copy in double took 24
@@ -220,6 +220,7 @@ class Simplifier {
     }
     uint32_t stamp = 0;
     uint64_t evaluations = 0;
+    double fitLo = 0, fitHi = 0;  // the range fitted values keep to: the region's (fitted())
   };
 
   // A small open-addressing table of edge keys with a byte of state, emptied in O(1) by
@@ -281,14 +282,14 @@ class Simplifier {
   using Heap = std::priority_queue<Entry, std::vector<Entry>, EntryAfter>;
 
   // What the collapse loop works with (a queue and its log, not a thread): the queue of the whole
-  // mesh, or of one slab in the parallel phase (runSlabs), with its own log and scratch.
+  // mesh, or of one region of the tree (runTree), with its own log and scratch.
   struct Queue {
-    int slab = -1;  // -1: the whole mesh; else the slab
+    uint32_t node = 1;    // the region (RegionTree numbering); 1: the whole mesh
+    bool region = false;  // a region below the root: collapses only inner_ vertices
     Heap heap;
-    CollapseLog ownLog;  // a slab's collapses in this round (merged into out_.log after it)
+    CollapseLog ownLog;  // a region's collapses (appended to out_.log after its level)
     CollapseLog* log = &ownLog;
-    std::vector<float> keys;             // a slab's collapses: the queue key each was taken at
-    Scratch* scratch = nullptr;          // link condition and collapse (and a slab's evaluations): its thread's
+    Scratch* scratch = nullptr;          // link condition and collapse (and a region's evaluations): its thread's
     std::atomic<uint32_t> collapsed{0};  // (read by the progress report on the other thread)
     uint32_t tetsRemoved = 0;
     uint64_t pops = 0, requeued = 0, rejectedByLink = 0, flatTetsRemoved = 0, linkMismatches = 0;
@@ -385,23 +386,28 @@ class Simplifier {
   // Collapses i along its cheapest legal out-edge (evaluated in sc) unless that costs more than
   // slack_ × `next`, the key of the next entry: then i goes back into the queue under its new
   // cost. Most pops find that the cost went up since a neighbour collapsed. On meshes large
-  // enough to be cut in slabs, those within 10% are taken anyway: far fewer pops (each
+  // enough for the tree of regions, those within 10% are taken anyway: far fewer pops (each
   // evaluates every out-edge of i) for a slightly higher field error and a slightly smaller
   // stream. Small meshes pack in moments: they keep the exact order, where the slack would cost
   // relatively more error.
   static constexpr float kLargeMeshSlack = 1.1f;
+  static constexpr uint32_t kSlackMinVertices = 10000;
   void tryCollapse(Queue& Q, uint32_t i, Scratch& sc, float next);
 
-  // ------------------------------------------------------------------ the parallel phase
-  // How slabs, rounds and these constants were chosen: simplify_slabs.cpp.
-  static constexpr double kSlabShare = 0.98;
-  static constexpr float kTauGrowth = 1.41421356f;
-  static constexpr uint32_t kMaxSlabs = 3;
-
-  uint32_t slabsOf(const std::vector<uint32_t>& order, bool staggered, std::vector<uint8_t>& slab) const;
-  void runSlabs(uint32_t planned);
-  void mergeRound(uint32_t slabs);
-  void markInner(const std::vector<uint8_t>& slab);
+  // ------------------------------------------------------------------ the tree of regions
+  // How the tree is cut and how far each level goes: simplify_tree.cpp.
+  void buildTree();
+  void runTree(uint32_t target);
+  void runRegion(Queue& Q, float tau);
+  void markInner(const std::vector<uint32_t>& region);
+  // The range fitted values keep to in `node` (fitted()); the field's whole range at the root.
+  double nodeLo(uint32_t node) const { return nodeRange_.empty() ? fieldMin_ : nodeRange_[node].min; }
+  double nodeHi(uint32_t node) const { return nodeRange_.empty() ? fieldMax_ : nodeRange_[node].max; }
+  std::vector<Range> nodeRange_;  // per node (RegionTree numbering): the steering field's input range
+  // Per vertex: the node of the last collapse onto it (1: the root, or none). The refit keeps its
+  // value in that node's range: while the node's splits are not applied, its region shows
+  // that value, and the node's range must bound it (simplify.h).
+  std::vector<uint32_t> lastNode_;
   static constexpr uint32_t kTwoThreadScan = 200000;  // tets: markInner() on two threads from here
 
   // ------------------------------------------------------------------ link condition
@@ -452,7 +458,7 @@ class Simplifier {
   bool locate(uint32_t x, uint32_t t, uint32_t* vertices, double* w) const;
 
   // ------------------------------------------------------------------ the collapse
-  void collapse(Queue& Q, uint32_t i, uint32_t j, float fieldErr, float key);
+  void collapse(Queue& Q, uint32_t i, uint32_t j, float fieldErr);
 
   const TetMesh& mesh_;
   const SimplifyOptions& opt_;
@@ -490,9 +496,9 @@ class Simplifier {
   std::vector<double> qualitySum_;          // per vertex: Σ 3/κ over its star
   std::vector<uint8_t> queued_;             // per vertex: has an entry in the queue (or in the current round)
   Scratch mainScratch_;
-  std::vector<Scratch> scratches_;  // one per entry of a round (and per thread in init() and runSlabs())
-  // The one queue's scratches (all but the two of the first costs and the slabs) get their
-  // per-vertex arrays only now, after the slabs, when less memory is in use (peak memory).
+  std::vector<Scratch> scratches_;  // one per entry of a round (and per thread in init() and runTree())
+  // The one queue's scratches (all but the two of the first costs and the regions') get their
+  // per-vertex arrays only now, after the regions, when less memory is in use (peak memory).
   void readyScratches() {
     if (mainScratch_.seen.size() != V_) mainScratch_.reset(V_);
     for (Scratch& sc : scratches_)
@@ -504,9 +510,10 @@ class Simplifier {
   bool trackChanges_ = false;      // collapses keep changed_ (the one queue's rounds of several)
   uint32_t roundStamp_ = 0;
   Queue main_;                  // the one queue of the whole mesh (its log is out_.log)
-  Queue slabs_[kMaxSlabs];      // the slabs of the parallel phase
   float slack_ = 1.0f;          // see tryCollapse
-  std::vector<uint8_t> inner_;  // per vertex: every neighbour is in its slab (runSlabs)
+  std::vector<uint8_t> inner_;  // per vertex: every tet around it lies in its region (runTree)
+  uint64_t regionPops_ = 0, regionRequeued_ = 0, regionRejectedByLink_ = 0, regionFlatRemoved_ = 0,
+           regionLinkMismatches_ = 0;  // the regions' queues' counts (Queue's), summed
 };
 
 }  // namespace tetstream::simplify_detail

@@ -13,8 +13,8 @@
 // queued meanwhile comes first; otherwise the entry goes back. The result is therefore exactly
 // that of the one-thread loop, whatever the timing (tests compare the two).
 //
-// Before that, a large mesh is simplified in slabs, one thread each, in rounds of rising cost
-// (runSlabs, simplify_slabs.cpp). simplifier.h lists where the rest of the class lives.
+// Before that, a large mesh is simplified in a tree of regions, level by level from the leaves,
+// two threads at once (runTree, simplify_tree.cpp). simplifier.h lists where the rest of the class lives.
 #include "simplify.h"
 
 #include <cassert>
@@ -53,9 +53,9 @@ Result Simplifier::run() {
   tetsAlive_ = T_;
   Queue& Q = main_;
   Q.log = &out_.log;
-  slack_ = V_ >= opt_.slabMinVertices ? kLargeMeshSlack : 1.0f;
-  if (V_ >= opt_.slabMinVertices) runSlabs(planned);
-  for (uint32_t v = 0; v < V_; ++v)  // (after the slabs: what they left queued)
+  slack_ = V_ >= kSlackMinVertices ? kLargeMeshSlack : 1.0f;
+  runTree(target);
+  for (uint32_t v = 0; v < V_; ++v)  // (after the regions: what they left queued)
     if (out_.vertexAlive[v] && queued_[v]) Q.heap.push({queueKey(v), v});
   readyScratches();
   const bool parallel = opt_.threads > 1 && V_ >= opt_.parallelMinVertices;
@@ -105,8 +105,16 @@ Result Simplifier::run() {
     tune_.linkMismatches += w.linkMismatches;
   };
   count(main_);
-  for (const Queue& w : slabs_) count(w);
+  out_.queuePops += regionPops_;
+  out_.requeued += regionRequeued_;
+  out_.rejectedByLink += regionRejectedByLink_;
+  out_.flatTetsRemoved += regionFlatRemoved_;
+  tune_.linkMismatches += regionLinkMismatches_;
   alive_ -= Q.collapsed;
+  if (out_.log.size() > (out_.tree.sectionEnd.empty() ? 0 : out_.tree.sectionEnd.back())) {
+    out_.tree.sectionNode.push_back(1);  // the root's collapses
+    out_.tree.sectionEnd.push_back(out_.log.size());
+  }
   tetsAlive_ -= Q.tetsRemoved;
   out_.vertices = alive_;
   out_.costEvaluations += mainScratch_.evaluations;
@@ -145,7 +153,7 @@ void Simplifier::tryCollapse(Queue& Q, uint32_t i, Scratch& sc, float next) {
       Q.errorBound = true;
       return;
     }
-    if (Q.slab >= 0 && !inner_[cand.j]) {  // a slab leaves it to the whole mesh's queue
+    if (Q.region && !inner_[cand.j]) {  // a region leaves it to the regions above
       queued_[i] = 1;
       return;
     }
@@ -154,7 +162,7 @@ void Simplifier::tryCollapse(Queue& Q, uint32_t i, Scratch& sc, float next) {
       sc.candidates.erase(sc.candidates.begin() + c);
       continue;
     }
-    collapse(Q, i, cand.j, cand.fieldErr, float(cand.cost));
+    collapse(Q, i, cand.j, cand.fieldErr);
     return;
   }
   if (first) lastCost_[i] = float(kInf);

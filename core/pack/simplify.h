@@ -42,19 +42,22 @@
 // disappear (when they contain the collapsed edge) or become proper.
 //
 // Order: one priority queue of vertices by the cost of their cheapest out-edge, updated lazily.
-// Meshes of slabMinVertices or more are first simplified in slabs, one thread each (cut
-// along the vertex numbering or an axis, whichever crosses fewest vertices), each slab
-// collapsing only vertices whose whole neighbourhood is its own, so the two threads touch
-// disjoint data. Rounds of rising cost alternate between two slabs cut at the median and three
-// cut at the quartiles, so no vertex waits along a cut for long; each round's logs are merged by
-// cost, and the one queue of the whole mesh then takes the last collapses. On such meshes a
-// vertex whose cost rose by at most 10% since it was queued is collapsed without going back into
-// the queue.
+// Meshes of 2·leafVertices or more are first simplified in a tree of regions (simplify_tree.cpp):
+// the vertices are bisected recursively into 2^depth leaves; level by level from the leaves up,
+// each region collapses only vertices whose whole neighbourhood is its own, up to a cost shared
+// by its level, on one of two threads; what the regions had to leave (the cuts between them) is
+// inside the region above. The one queue of the whole mesh, the root, takes the last collapses.
+// Each region's collapses are one section of the log, so its splits depend on those of the
+// regions above it and on no other (FORMAT.md §1.1). A fitted value is kept within the range of
+// the input field over the region that fitted it: a region whose range misses an isovalue then
+// shows no surface at any level. On such meshes a vertex whose cost rose by at most 10% since
+// it was queued is collapsed without going back into the queue.
 //
 // The result is a log of collapses for the encoder (split_encode.h); the simplifier knows
 // nothing of the file format. Deterministic: same input and options, same log, whatever the
 // number of threads.
 #pragma once
+#include <bit>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -93,12 +96,29 @@ struct SimplifyOptions {
   // vertices (below that, starting rounds costs more than it saves).
   int threads = 2;
   uint32_t parallelMinVertices = 20000;
-  // Meshes of at least this many vertices are simplified in slabs at once for most of the
-  // way (simplify_slabs.cpp); the result depends on this, not on `threads`. Above it slabs save
-  // about a third of the time at the same field error and stream size; on much smaller meshes
-  // the cuts are a large share of the vertices, the coarse levels' error grows and little time
-  // is saved.
-  uint32_t slabMinVertices = 10000;
+  // Largest leaf of the tree of regions, in vertices; meshes of fewer than twice this are one
+  // region (0: always). The result depends on this, not on `threads`. Smaller leaves let a
+  // viewer fetch less for a given isovalue; larger ones give a stream closer to one queue's.
+  uint32_t leafVertices = 1024;
+};
+
+// The tree of regions (simplify.h): a perfect binary tree in heap numbering, the root node 1,
+// node n's children 2n and 2n + 1, leaf k node 2^depth + k.
+struct RegionTree {
+  uint32_t depth = 0;            // levels below the root (0: the root alone)
+  std::vector<uint32_t> leafOf;  // per input vertex: its leaf 0 .. 2^depth − 1 (empty at depth 0)
+  // The log in sections, each the collapses of one node: section s is
+  // [sectionEnd[s − 1] (0 for s = 0), sectionEnd[s]), made by node sectionNode[s]. Leaves
+  // first, the root last; nodes without collapses have no section.
+  std::vector<uint32_t> sectionNode, sectionEnd;
+
+  uint32_t nodes() const { return 2u << depth; }  // one past the largest node id
+  // The node at `level` (0: leaves) above input vertex v.
+  uint32_t nodeOf(uint32_t v, uint32_t level) const {
+    return depth == 0 ? 1u : (1u << (depth - level)) + (leafOf[v] >> level);
+  }
+  // The level of node n (0: leaves, depth: the root): n lies in [2^(depth − level), 2^(depth − level + 1)).
+  uint32_t levelOf(uint32_t node) const { return depth - uint32_t(std::bit_width(node) - 1); }
 };
 
 struct SimplifyResult {
@@ -113,8 +133,9 @@ struct SimplifyResult {
   uint32_t flatTetsLeft = 0;
   uint64_t costEvaluations = 0, rejectedByLink = 0;
   uint64_t queuePops = 0, requeued = 0;  // pops of current entries, and those pushed back costlier
-  uint32_t slabCollapses = 0;            // collapses made in the slabs at once (slabMinVertices)
-  std::string stopReason;                // "target reached", "no legal collapse left", "error bound"
+  uint32_t regionCollapses = 0;          // collapses made below the root, on two threads at once
+  RegionTree tree;
+  std::string stopReason;  // "target reached", "no legal collapse left", "error bound"
 };
 
 // Why a single collapse is or is not allowed (for tests and diagnostics).

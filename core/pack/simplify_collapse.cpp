@@ -29,9 +29,8 @@ void orientedOthers(const uint32_t* v, int si, int sj, uint32_t* out) {
 
 }  // namespace
 
-void Simplifier::collapse(Queue& Q, uint32_t i, uint32_t j, float fieldErr, float key) {
+void Simplifier::collapse(Queue& Q, uint32_t i, uint32_t j, float fieldErr) {
   CollapseLog& log = *Q.log;
-  if (Q.slab >= 0) Q.keys.push_back(key);
   log.i.push_back(i);
   log.j.push_back(j);
   log.iValue.push_back(vert_[i].fit);
@@ -103,7 +102,9 @@ void Simplifier::collapse(Queue& Q, uint32_t i, uint32_t j, float fieldErr, floa
   // the value before back. (The paper keeps the sample; fitting lowers the coarse levels' RMS
   // field error.)
   represented_[j] += represented_[i];
-  if (fitsRegion(represented_[j])) vert_[j].fit = float(fitted(fieldQuadric_[j], p(j), vert_[j].fit));
+  if (fitsRegion(represented_[j]))
+    vert_[j].fit = float(fitted(fieldQuadric_[j], p(j), vert_[j].fit, nodeLo(Q.node), nodeHi(Q.node)));
+  if (!lastNode_.empty()) lastNode_[j] = Q.node;
 
   // Everything around j changed. j and its neighbours are re-evaluated lazily, when they reach
   // the top: those already queued keep their entry; a blocked one (no legal collapse last
@@ -120,14 +121,14 @@ void Simplifier::collapse(Queue& Q, uint32_t i, uint32_t j, float fieldErr, floa
         Q.touched.push_back(w);
       }
     }
-  if (trackChanges_) {  // (random writes the slabs and a one-thread queue would make for nothing)
+  if (trackChanges_) {  // (random writes the regions and a one-thread queue would make for nothing)
     changed_[i] = roundStamp_;
     for (uint32_t v : Q.touched) changed_[v] = roundStamp_;
   }
   for (uint32_t v : Q.touched) {
     if (queued_[v]) continue;  // its entry stays: it is evaluated afresh when popped
     queued_[v] = 1;
-    if (Q.slab >= 0 && !inner_[v]) continue;  // left to the whole mesh's queue
+    if (Q.region && !inner_[v]) continue;  // left to the regions above
     Q.heap.push({queueKey(v), v});
   }
 }

@@ -123,7 +123,7 @@ Simplifier::Candidate Simplifier::boundTerms(Scratch& sc, uint32_t i, uint32_t j
   FieldQuadric fq = fieldQuadric_[i];
   fq.add(fieldQuadric_[j]);
   const uint32_t count = represented_[i] + represented_[j];
-  c.sj = fitsRegion(count) ? fitted(fq, P, vert_[j].fit) : vert_[j].fit;
+  c.sj = fitsRegion(count) ? fitted(fq, P, vert_[j].fit, sc.fitLo, sc.fitHi) : vert_[j].fit;
   // The field quadric over everything i and j stand for (our stand-in for eq. 5's sum over
   // the region).
   const double x5[5] = {P[0], P[1], P[2], c.sj, 1.0};

@@ -36,6 +36,9 @@ void Simplifier::refitValues() {
       if (col[w] != none) cols.push_back(col[w]);
     rowStart[r + 1] = uint32_t(cols.size());
   }
+  // Each value keeps to the range of the region that last collapsed onto it (lastNode_).
+  auto lo = [&](uint32_t r) { return nodeLo(lastNode_.empty() ? 1u : lastNode_[free[r]]); };
+  auto hi = [&](uint32_t r) { return nodeHi(lastNode_.empty() ? 1u : lastNode_[free[r]]); };
   std::vector<double> a(cols.size(), 0.0), rhs(n, 0.0);
   auto at = [&](uint32_t r, uint32_t c) -> double& {
     auto it = std::lower_bound(cols.begin() + rowStart[r], cols.begin() + rowStart[r + 1], c);
@@ -133,15 +136,15 @@ void Simplifier::refitValues() {
     }
     bool crossed = false;
     for (uint32_t r = 0; r < n; ++r) {
-      if (held[r] || (x[r] >= fieldMin_ && x[r] <= fieldMax_)) continue;
-      x[r] = std::clamp(x[r], fieldMin_, fieldMax_);
+      if (held[r] || (x[r] >= lo(r) && x[r] <= hi(r))) continue;
+      x[r] = std::clamp(x[r], lo(r), hi(r));
       held[r] = 1;
       crossed = true;
     }
     if (!crossed) break;
   }
   for (uint32_t r = 0; r < n; ++r)
-    if (held[r] != 2 && std::isfinite(x[r])) vert_[free[r]].fit = float(std::clamp(x[r], fieldMin_, fieldMax_));
+    if (held[r] != 2 && std::isfinite(x[r])) vert_[free[r]].fit = float(std::clamp(x[r], lo(r), hi(r)));
 }
 
 // The tet of the current mesh holding input vertex x, by walking from tet `t` across the face with the

@@ -125,6 +125,8 @@ void Simplifier::init() {
   // only read), then queued in vertex order so the result does not depend on the threads.
   main_.scratch = &mainScratch_;
   scratches_.resize(kRoundSize);
+  for (Scratch& sc : scratches_) sc.fitLo = fieldMin_, sc.fitHi = fieldMax_;
+  mainScratch_.fitLo = fieldMin_, mainScratch_.fitHi = fieldMax_;
   for (size_t k = 0; k < 2; ++k) scratches_[k].reset(V_);  // (the rest: readyScratches())
   auto work = [this](Scratch& sc, uint32_t begin, uint32_t end) {
     for (uint32_t v = begin; v < end; ++v)

@@ -8,6 +8,7 @@
 
 #include "pack/chunk_encode.h"
 #include "pack/level_error.h"
+#include "pack/region_stats.h"
 #include "pack/split_order.h"
 #include "progressive.h"
 #include "quantize.h"
@@ -37,10 +38,12 @@ class Encoder {
     // The estimate sums terms that can overshoot; no error exceeds the field's range.
     const int iso = m_.findField(m_.isoField);
     const float range = iso >= 0 ? m_.fields[size_t(iso)].range.max - m_.fields[size_t(iso)].range.min : 0.0f;
+    range_ = range;
     for (uint32_t c = 0; c < C; ++c)
       prefixMax_[c] = std::min(range, std::max(c ? prefixMax_[c - 1] : 0.0f, log.fieldError[c]));
     out_.baseFieldError = C ? prefixMax_[C - 1] : 0;
     startMeter(iso);
+    planNodes();
     // The base chunk compresses on another thread while the splits are encoded.
     std::future<Result> base = std::async(std::launch::async, [this] {
       out_.baseInfo.fieldError = out_.baseFieldError;
@@ -53,37 +56,111 @@ class Encoder {
       out_.baseInfo.fieldRms = e.rms;
       out_.baseInfo.fieldMax = e.max;
     }
+    if (r && metered_ && !out_.chunks.empty()) measure(out_.chunks.back());  // the full level
     return r ? b : r;
   }
 
  private:
-  // In cost order: each split encoded and applied, a chunk flushed once it holds its share.
+  // In cost order: each split encoded and applied, a chunk flushed once it holds its share or
+  // its node ends (a chunk holds the splits of one node: FORMAT.md §1.1).
   Result encodeSplits(uint32_t C) {
-    target_ = opt_.firstChunkBytes;
     startChunk();
     if (opt_.orderSplits && !s_.log.starBegin.empty()) return encodeOrderedSplits(C);
-    for (uint32_t c = C; c-- > 0;) {
+    for (uint32_t split = 0; split < C; ++split) {
+      const uint32_t c = C - 1 - split;
+      if (split == spans_[span_].first) beginNode();
       if (!splitFits(c)) {
         collect();
         return misfit();
       }
       encodeSplit(c);
       ++inChunk_;
-      if (opt_.progress && (c & 4095) == 0) opt_.progress(C - c, C);
-      if (recordBytes() >= target_ * ratio_ || c == 0 || tapers(C - c, c))
-        if (Result r = flushChunk(C - c); !r) {
+      if (opt_.progress && (c & 4095) == 0) opt_.progress(split + 1, C);
+      const uint32_t nodeEnd = spans_[span_].end;
+      if (recordBytes() >= target_ * ratio_ || split + 1 == nodeEnd ||
+          tapers(split + 1 - spans_[span_].first, nodeEnd - split - 1))
+        if (Result r = flushChunk(split + 1); !r) {
           collect();
           return r;
         }
+      if (split + 1 == nodeEnd) endNode();
     }
     return collect();
   }
 
-  // Towards the end chunks halve again (a chunk ends once it holds about as many bytes as the
-  // splits still to come would take, at the mean size so far), down to the first chunk's size:
-  // a viewer that keeps pace with the link then has a small last chunk to apply when the last
-  // byte arrives, instead of a whole large one. A rest smaller than that stays in the chunk.
+  // The nodes in stream order (FORMAT.md §1.1): the log's sections from the last (the root's)
+  // to the first, each a run of splits [first, end).
+  struct Span {
+    uint32_t node, first, end;
+  };
+  void planNodes() {
+    const RegionTree& tree = s_.tree;
+    const uint32_t C = s_.log.size();
+    for (size_t sec = tree.sectionNode.size(); sec-- > 0;) {
+      const uint32_t begin = sec ? tree.sectionEnd[sec - 1] : 0;
+      spans_.push_back({tree.sectionNode[sec], C - tree.sectionEnd[sec], C - begin});
+    }
+    span_ = 0;
+    if (C && (spans_.empty() || spans_.back().end != C))  // (a log in no section: one node, the root)
+      spans_.assign(1, Span{1, 0, C});
+    stats_ = regionStats(mesh_, s_, m_);
+    indexOf_.assign(std::max<uint32_t>(tree.nodes(), 2), -1);
+  }
+
+  // A node's first split is next: its manifest entry starts, and when it begins a level of the
+  // tree, the field error of the mesh now (the previous level's last chunk) is measured, by node.
+  void beginNode() {
+    const RegionTree& tree = s_.tree;
+    const uint32_t n = spans_[span_].node;
+    NodeInfo& info = node_;
+    info = NodeInfo{};
+    for (uint32_t up = n >> 1; up >= 1 && info.parent < 0; up >>= 1) info.parent = indexOf_[up];
+    info.firstChunk = uint32_t(jobs_.size()) + 1;
+    info.vertexBegin = pm_.vertexCount();
+    info.tetBegin = pm_.tetCount();
+    info.bounds = stats_.bounds[n];
+    info.ranges = stats_.ranges[n];
+    info.fieldError = std::min(range_, stats_.fieldError[n]);
+    const uint32_t level = tree.depth ? tree.levelOf(n) : 0;
+    if (metered_ && level != measuredLevel_) {
+      measuredLevel_ = level;
+      levelErrors_.assign(tree.nodes(), LevelError{});
+      if (n == 1) {
+        levelErrors_[1] = baseError();
+      } else {
+        if (!jobs_.empty()) measure(jobs_.back().info);
+        const bool tree = s_.tree.depth > 0;
+        meter_.totalByGroup(
+            [&](uint32_t v) { return tree && s_.tree.leafOf[v] != ~0u ? s_.tree.nodeOf(v, level) : ~0u; },
+            levelErrors_);
+      }
+    }
+    if (metered_) {
+      info.fieldRms = levelErrors_[n].rms;
+      info.fieldMax = levelErrors_[n].max;
+    }
+    // The root's first chunk is small, for the first refinements to come soon after the base;
+    // other nodes are fetched whole, chosen by what they show.
+    target_ = n == 1 ? opt_.firstChunkBytes : opt_.chunkBytes;
+  }
+
+  void endNode() {
+    NodeInfo& info = node_;
+    info.chunkCount = uint32_t(jobs_.size()) + 1 - info.firstChunk;
+    info.vertexEnd = pm_.vertexCount();
+    info.tetEnd = pm_.tetCount();
+    indexOf_[spans_[span_].node] = int32_t(out_.nodes.size());
+    out_.nodes.push_back(std::move(info));
+    ++span_;
+  }
+
+  // Towards the end of the root's splits chunks halve again (a chunk ends once it holds about as
+  // many bytes as the splits still to come would take, at the mean size so far), down to the
+  // first chunk's size: a viewer that keeps pace with the link then has a small last chunk to
+  // apply when the last byte arrives, instead of a whole large one. A rest smaller than that
+  // stays in the chunk.
   bool tapers(uint32_t done, uint32_t left) const {
+    if (spans_[span_].node != 1) return false;
     const double least = opt_.firstChunkBytes * ratio_;
     const double rest = double(left) * double(flushedRaw_ + recordBytes()) / double(done);
     return double(recordBytes()) >= std::max(least, rest) && rest >= least;
@@ -96,7 +173,8 @@ class Encoder {
     SplitOrder order(uint32_t(s_.tetAlive.size()));
     const CollapseLog& log = s_.log;
     for (uint32_t done = 0; done < C;) {
-      const uint32_t count = plannedSplits(done, C);
+      if (done == spans_[span_].first) beginNode();
+      const uint32_t count = std::min(plannedSplits(done, C), spans_[span_].end - done);
       order.plan(log, done, count);
       bool misfits = false;
       order.run([&](uint32_t s) { return out_.streamVertexOf[log.j[C - 1 - s]]; },
@@ -113,6 +191,7 @@ class Encoder {
         collect();
         return r;
       }
+      if (done == spans_[span_].end) endNode();
     }
     return collect();
   }
@@ -429,7 +508,6 @@ class Encoder {
     job.info.splits = inChunk_;
     const uint32_t C = s_.log.size();
     job.info.fieldError = splitsApplied < C ? prefixMax_[C - splitsApplied - 1] : 0.0;
-    measure(job.info);
     job.done = std::async(std::launch::async,
                           [&job, level = opt_.zstdLevel] { return finishChunk(job.raw, level, job.file, job.info); });
     if (jobs_.size() >= 2) {
@@ -496,7 +574,15 @@ class Encoder {
   std::vector<uint32_t> ring_;
   uint32_t prevJ_ = 0, inChunk_ = 0;
   uint64_t target_ = 0;
-  uint64_t flushedRaw_ = 0;  // record bytes of the chunks before the current one
+  std::vector<Span> spans_;
+  size_t span_ = 0;                      // the node being encoded
+  NodeInfo node_;                        // its manifest entry so far
+  RegionStats stats_;                    // per node of the tree
+  std::vector<int32_t> indexOf_;         // per node of the tree: its index in out_.nodes, -1 before
+  uint32_t measuredLevel_ = ~0u;         // the level of the tree the last measurement was for
+  std::vector<LevelError> levelErrors_;  // per node of that level
+  float range_ = 0;                      // the isoField's range (no estimate exceeds it)
+  uint64_t flushedRaw_ = 0;              // record bytes of the chunks before the current one
   double ratio_ = 2.5;
 };
 

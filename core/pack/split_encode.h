@@ -38,6 +38,7 @@ struct EncodedStream {
   std::vector<uint32_t> streamTetOf;        // original tet id -> id in the stream
   double baseFieldError = 0;                // estimated field error of the base mesh
   uint32_t movedMasks = 0;                  // splits whose T_moved does not follow from T_new (vertex_link.h)
+  std::vector<NodeInfo> nodes;              // the patch hierarchy's nodes, in stream order (FORMAT.md §1.1)
 };
 
 // `mesh` is the simplifier's input (values on the quantization grid of `m` unless lossless; its

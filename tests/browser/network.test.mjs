@@ -61,7 +61,9 @@ before(async () => {
   checkBuilds();
   await precompressDir(webDir); // nginx's gzip_static must not send an older build's .gz
   tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'tetstream-network-'));
-  ({ dir: pack } = makePack(tmp, 'h24', { n: 24, packArgs: ['--chunk-kb', '12', '--name', NAME] }));
+  // One node (--leaf-vertices 0): the chunks stream in manifest order, as these tests of the
+  // network expect (selective.test.mjs has a dataset of nodes).
+  ({ dir: pack } = makePack(tmp, 'h24', { n: 24, packArgs: ['--chunk-kb', '12', '--leaf-vertices', '0', '--name', NAME] }));
   manifest = readManifest(pack);
   assert.ok(manifest.chunks.length >= 8, `a stream of several chunks (${manifest.chunks.length})`);
 
@@ -226,7 +228,8 @@ test('over a slow link the chunks come one after another at the full rate, not a
   // chunks say so), so its lead is 150 KB/s × 30 ms × 1.25 = 5.6 KB whatever the speed of the
   // machine. The server holds the split chunks until the viewer runs (this server is fast: they
   // would all be in before it), and the last 16 KB of one chunk until the test releases them.
-  const { dir } = makePack(tmp, 'h40', { n: 40, packArgs: ['--chunk-kb', '64'] });
+  // (One node, the root: a sequence of chunks of 16 to 64 KB, as a stream of every node in order.)
+  const { dir } = makePack(tmp, 'h40', { n: 40, packArgs: ['--chunk-kb', '64', '--leaf-vertices', '0'] });
   const list = readManifest(dir).chunks;
   assert.ok(list.length >= 7, `a stream of several chunks (${list.length})`);
   const k = list.length - 2;

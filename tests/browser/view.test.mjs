@@ -108,7 +108,9 @@ before(async () => {
   const vtk = path.join(tmp, 'two.vtk');
   writeTwoFieldVtk(vtk);
   pack = path.join(tmp, 'two');
-  cli('pack', vtk, '-o', pack, '--chunk-kb', '8', '--lossless', '--field', 'radius', '--name', 'Two fields');
+  // One node (--leaf-vertices 0): every chunk streams, in manifest order (selective.test.mjs has a
+  // dataset of nodes).
+  cli('pack', vtk, '-o', pack, '--chunk-kb', '8', '--lossless', '--leaf-vertices', '0', '--field', 'radius', '--name', 'Two fields');
   const files = createServer({ mounts: [{ prefix: '/two', dir: pack }, { prefix: '/', dir: webDir }] });
   // /slow/... serves /two/... with every chunk 250 ms late (so a test can act mid-stream).
   ({ server, baseUrl } = await listenWithSlowRoute(files, { slowTo: '/two', delayMs: 250 }));

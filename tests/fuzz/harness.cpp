@@ -21,6 +21,7 @@
 #include "manifest.h"
 #include "pack/chunk_encode.h"
 #include "pack/packer.h"
+#include "partial.h"
 #include "validate.h"
 
 namespace tetstream::fuzz {
@@ -37,24 +38,31 @@ std::vector<uint8_t> readAll(const std::filesystem::path& p) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
+// `mesh` packed with `o` into a scratch folder, read back whole.
+Context packedContext(TetMesh mesh, PackOptions o, const char* tag) {
+  o.zstdLevel = 1;
+  o.chunkKb = 1;
+  const auto dir = std::filesystem::temp_directory_path() / (std::string(tag) + "-" + std::to_string(getpid()));
+  PackSummary summary;
+  if (!packMesh(std::move(mesh), dir.string(), o, summary))
+    fuzzCheckFailed("packing the fuzz dataset", __FILE__, __LINE__);
+  Context c;
+  std::vector<uint8_t> json = readAll(dir / "manifest.json");
+  c.manifestJson.assign(json.begin(), json.end());
+  for (const ChunkInfo& info : summary.manifest.chunks) c.files.push_back(readAll(dir / info.file));
+  std::filesystem::remove_all(dir);
+  return c;
+}
+
 const Context& context() {
   static const Context ctx = [] {
     TetMesh mesh = makeGridMesh(6);
     addHarmonicField(mesh);
     mesh.name = "fuzz";
     PackOptions o;
-    o.zstdLevel = 1;
     o.baseVertices = 24;
     o.minBaseVertices = 8;
-    o.chunkKb = 1;
-    const auto dir = std::filesystem::temp_directory_path() / ("tetstream-fuzz-" + std::to_string(getpid()));
-    PackSummary summary;
-    if (!packMesh(mesh, dir.string(), o, summary)) fuzzCheckFailed("packing the fuzz dataset", __FILE__, __LINE__);
-    Context c;
-    std::vector<uint8_t> json = readAll(dir / "manifest.json");
-    c.manifestJson.assign(json.begin(), json.end());
-    for (const ChunkInfo& info : summary.manifest.chunks) c.files.push_back(readAll(dir / info.file));
-    std::filesystem::remove_all(dir);
+    Context c = packedContext(std::move(mesh), o, "tetstream-fuzz");
     if (c.files.size() < 3) fuzzCheckFailed("the fuzz dataset needs two split chunks", __FILE__, __LINE__);
     return c;
   }();
@@ -68,9 +76,15 @@ void copyState(Dataset& to, const Dataset& from) {
   to.pm = from.pm;
   to.chunksReceived = from.chunksReceived;
   to.bytesReceived = from.bytesReceived;
+  to.received = from.received;
   to.payloads = from.payloads;
   to.chunkFirstSplit = from.chunkFirstSplit;
+  to.tetsAfter = from.tetsAfter;
+  to.nodeIds = from.nodeIds;
+  to.nodeChunksReceived = from.nodeChunksReceived;
+  to.inManifestOrder = from.inManifestOrder;
   to.recordStart = from.recordStart;
+  to.stableJ = from.stableJ;
   to.splitsDecoded = from.splitsDecoded;
   to.reader = from.reader;
 }
@@ -199,6 +213,73 @@ void splitChunk(const uint8_t* data, size_t size) {
   FUZZ_CHECK(ds.pm.mesh.tetCount() == tetsBefore && ds.pm.mesh.vertexCount() == verticesBefore);
 }
 
+// A small dataset with a hierarchy of nodes, packed once per process.
+const Context& nodeContext() {
+  static const Context ctx = [] {
+    TetMesh mesh = makeGridMesh(10);
+    addHarmonicField(mesh);
+    mesh.name = "fuzz-nodes";
+    PackOptions o;
+    o.leafVertices = 64;
+    Context c = packedContext(std::move(mesh), o, "tetstream-fuzz-nodes");
+    Manifest m;
+    if (!parseManifest(c.manifestJson, m) || m.nodes.size() < 4)
+      fuzzCheckFailed("the fuzz dataset needs a hierarchy", __FILE__, __LINE__);
+    return c;
+  }();
+  return ctx;
+}
+
+// The nodes below a root, which nodeChunk replaces.
+std::vector<uint32_t> innerNodes(const Manifest& m) {
+  std::vector<uint32_t> out;
+  for (uint32_t k = 0; k < m.nodes.size(); ++k)
+    if (m.nodes[k].parent >= 0) out.push_back(k);
+  return out;
+}
+
+void nodeChunk(const uint8_t* data, size_t size) {
+  if (size < 1) return;
+  const Context& ctx = nodeContext();
+  static std::string json;
+  static PartialDataset pd;
+  static std::vector<uint32_t> inner;
+  if (inner.empty()) {
+    Manifest m;
+    FUZZ_CHECK(parseManifest(ctx.manifestJson, m));
+    inner = innerNodes(m);
+    json = ctx.manifestJson;
+  }
+  const uint32_t k = inner[(data[0] >> 1) % inner.size()];
+  std::vector<uint8_t> replaced;
+  ChunkInfo* info = nullptr;
+  ChunkSource read = [&](uint32_t index, std::vector<uint8_t>& file) {
+    file = info && index == pd.manifest.nodes[k].firstChunk ? replaced : ctx.files[index];
+    return Result::success();
+  };
+  FUZZ_CHECK(openPartial(pd, json, read));
+  const std::vector<uint32_t> ancestors =
+      withAncestors(pd.manifest, std::vector<uint32_t>{uint32_t(pd.manifest.nodes[k].parent)});
+  for (uint32_t a : ancestors) FUZZ_CHECK(applyNode(pd, a, read));
+  const uint32_t first = pd.manifest.nodes[k].firstChunk;
+  info = &pd.manifest.chunks[first];
+  if (data[0] & 1) {
+    replaced.assign(data + 1, data + size);
+    matchFile(replaced, *info);
+  } else {
+    replaced = chunkFromPayload(ChunkKind::Splits, first, data + 1, size - 1, *info);
+  }
+  const std::vector<uint32_t> tetsBefore = pd.pm.mesh.tets;
+  const uint32_t verticesBefore = pd.pm.vertexCount();
+  if (!applyNode(pd, k, read)) {
+    FUZZ_CHECK(!pd.loaded(k) && pd.pm.vertexCount() == verticesBefore && pd.pm.mesh.tets == tetsBefore);
+    return;
+  }
+  checkStructure(pd.pm.mesh);
+  undoLastNode(pd);
+  FUZZ_CHECK(pd.pm.vertexCount() == verticesBefore && pd.pm.mesh.tets == tetsBefore);
+}
+
 void baseChunk(const uint8_t* data, size_t size) {
   const Context& ctx = context();
   static Dataset ds;  // the manifest parsed once (half of the time when parsed per input)
@@ -246,6 +327,8 @@ bool runTarget(const std::string& name, const uint8_t* data, size_t size) {
     manifest(data, size);
   else if (name == "split-chunk")
     splitChunk(data, size);
+  else if (name == "node-chunk")
+    nodeChunk(data, size);
   else if (name == "base-chunk")
     baseChunk(data, size);
   else if (name.starts_with("mesh-") && name.size() > 5)
@@ -265,6 +348,42 @@ std::vector<std::pair<std::string, std::vector<uint8_t>>> seeds(const std::strin
   ChunkDecoder dec;
   if (target == "manifest") {
     out.push_back({"packed", std::vector<uint8_t>(ctx.manifestJson.begin(), ctx.manifestJson.end())});
+    // The same chunks as a chain of two nodes (the first split chunk, then the rest), so fuzzing
+    // starts inside the node rules whatever hierarchy the packer wrote.
+    Manifest chain = m;
+    chain.nodes.clear();
+    for (uint32_t first : {1u, 2u}) {
+      NodeInfo n;
+      n.parent = int32_t(first) - 2;
+      n.firstChunk = first;
+      n.chunkCount = first == 1 ? 1 : uint32_t(m.chunks.size()) - 2;
+      n.vertexBegin = m.chunks[first - 1].vertices;
+      n.vertexEnd = m.chunks[first + n.chunkCount - 1].vertices;
+      n.tetBegin = m.chunks[first - 1].tets;
+      n.tetEnd = m.chunks[first + n.chunkCount - 1].tets;
+      n.bounds = m.bounds;
+      for (const FieldInfo& f : m.fields) n.ranges.push_back(f.range);
+      n.fieldError = m.chunks[first - 1].fieldError;
+      chain.nodes.push_back(n);
+    }
+    const std::string text = writeManifest(chain);
+    FUZZ_CHECK(parseManifest(text, chain));
+    out.push_back({"nodes", std::vector<uint8_t>(text.begin(), text.end())});
+  } else if (target == "node-chunk") {
+    const Context& nodes = nodeContext();
+    Manifest nm;
+    FUZZ_CHECK(parseManifest(nodes.manifestJson, nm));
+    const std::vector<uint32_t> inner = innerNodes(nm);
+    for (uint32_t pick = 0; pick < inner.size() && pick < 8; ++pick) {
+      const uint32_t c = nm.nodes[inner[pick]].firstChunk;
+      std::span<const uint8_t> p = payloadOf(dec, nm.chunks[c], c, nodes.files[c]);
+      std::vector<uint8_t> payload{uint8_t(pick << 1)};
+      payload.insert(payload.end(), p.begin(), p.end());
+      out.push_back({"node-" + std::to_string(pick), payload});
+      std::vector<uint8_t> file{uint8_t(pick << 1 | 1)};
+      file.insert(file.end(), nodes.files[c].begin(), nodes.files[c].end());
+      out.push_back({"node-file-" + std::to_string(pick), file});
+    }
   } else if (target == "base-chunk") {
     std::span<const uint8_t> p = payloadOf(dec, m.chunks[0], 0, ctx.files[0]);
     out.push_back({"base", std::vector<uint8_t>(p.begin(), p.end())});

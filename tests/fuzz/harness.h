@@ -24,6 +24,13 @@ void manifest(const uint8_t* data, size_t size);
 // exactly at the level before it; one that succeeds must leave a structurally valid mesh.
 void splitChunk(const uint8_t* data, size_t size);
 
+// The first chunk of a node of a patch hierarchy (FORMAT.md §1.1), applied to a partial dataset
+// that holds its ancestors (partial.h): data[0] picks the node (not a root) and, as for
+// splitChunk, whether the rest is the payload or the file. A chunk that fails must leave the
+// mesh exactly as it was; one that applies must leave a structurally valid mesh that undoing
+// the node takes back exactly.
+void nodeChunk(const uint8_t* data, size_t size);
+
 // The base-mesh chunk's payload (decompressed), with matching manifest counts where possible.
 void baseChunk(const uint8_t* data, size_t size);
 
@@ -31,7 +38,7 @@ void baseChunk(const uint8_t* data, size_t size);
 // must be a mesh whose tets reference existing vertices and whose fields have one value each.
 void meshFile(const char* extension, const uint8_t* data, size_t size);
 
-// Runs the target of that name ("manifest", "split-chunk", "base-chunk", "mesh-vtu" for
+// Runs the target of that name ("manifest", "split-chunk", "node-chunk", "base-chunk", "mesh-vtu" for
 // meshFile(".vtu"), ..., "pair-tetgen" for twoFiles("tetgen"), ...). False for an unknown name.
 bool runTarget(const std::string& name, const uint8_t* data, size_t size);
 

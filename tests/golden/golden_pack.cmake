@@ -4,7 +4,7 @@
 #   cmake -DTETSTREAM=build/native/tetstream -DWORK=DIR -P tests/golden/golden_pack.cmake
 # Add -DUPDATE=ON to rewrite the expected hashes (only when the bytes change on purpose).
 # Harmonic 28³ (21,952 vertices) is large enough for every size-dependent path of the packer:
-# slabs, two threads evaluating one queue, and two threads measuring each level.
+# a tree of regions (depth 4), two threads evaluating one queue, and two threads measuring each level.
 cmake_minimum_required(VERSION 3.20)
 foreach(var TETSTREAM WORK)
   if(NOT DEFINED ${var})

@@ -31,7 +31,8 @@ test('gen, pack, info and iso work together and report JSON', () => {
   const infoPack = cli('info', pack, '--json').json;
   assert.equal(infoPack.packed, true);
   assert.equal(infoPack.tets, infoMesh.tets);
-  assert.equal(infoPack.format.formatVersion, 1);
+  assert.equal(infoPack.format.formatVersion, 2);
+  assert.ok(Number.isInteger(infoPack.format.nodes) && infoPack.format.nodes < infoPack.format.chunks, 'at most one node a split chunk');
 
   // Lossless: every chunk applied gives the input's surface exactly.
   const a = cli('iso', vtu, '--value', '0.2', '--json').json;

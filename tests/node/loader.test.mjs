@@ -3,7 +3,7 @@
 // (tests/browser/network.test.mjs) run the same loader against real servers.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { ChunkLoader, LOG_LIMIT } from '../../web/loader.js';
+import { ChunkLoader, LOG_LIMIT, MAX_AHEAD } from '../../web/loader.js';
 import { FetchError } from '../../web/net.js';
 
 globalThis.navigator ??= { onLine: true }; // notice() reads it
@@ -218,4 +218,214 @@ test('the log keeps the newest entries only', () => {
   for (let k = 0; k < LOG_LIMIT + 10; k++) run.loader.note({ event: 'pause' });
   assert.equal(run.loader.log.length, LOG_LIMIT);
   assert.equal(run.loader.log[0].seq, 10);
+});
+
+// Plans: an order of chunk indices the page may change while streaming.
+
+const notFound = () => new FetchError('HTTP 404 (Not Found)', { kind: 'http', status: 404, transient: false });
+
+// Answers every open request but the ones `hold` names, in full, until none is left.
+async function answerAll(net, size, hold = () => false) {
+  for (let steps = 0; steps < 100; steps++) {
+    await settle();
+    const open = net.open().filter((r) => !hold(r.index));
+    if (!open.length) return;
+    for (const r of open) {
+      net.send(r, size);
+      net.finish(r);
+    }
+  }
+}
+
+test('chunks are requested and handed over in the order of the plan', async () => {
+  const order = [0, 5, 2, 7, 1, 3, 6, 4];
+  const run = makeLoader({ order });
+  await runLink(run);
+  assert.deepEqual(run.delivered, order);
+  assert.deepEqual(requests(run.loader).map((e) => e.index), order);
+  assert.equal(run.result.failed, null);
+});
+
+test('the loader fetches at most MAX_AHEAD plan places past the next chunk to hand over', async () => {
+  const order = [0, ...Array.from({ length: 19 }, (_, k) => 19 - k)]; // 0, 19, 18, ..., 1
+  const run = makeLoader({ chunks: 20, order });
+  run.loader.pump();
+  await answerAll(run.net, run.size, (i) => i === 0); // the base does not come yet
+  assert.deepEqual(requests(run.loader).map((e) => e.index), order.slice(0, MAX_AHEAD));
+  assert.deepEqual(run.delivered, []);
+  await answerAll(run.net, run.size);
+  assert.deepEqual(run.delivered, order);
+  assert.deepEqual(requests(run.loader).map((e) => e.index), order);
+  assert.ok(run.result.done);
+});
+
+test('a replan drops the requests for chunks it left, keeps the others, and wakes an idle loader', async () => {
+  let idle = 0;
+  const run = makeLoader({ order: [0, 1, 2, 3, 4, 5, 6, 7], onIdle: () => { idle++; } });
+  run.loader.pump();
+  await settle();
+  const open = () => run.net.open().map((r) => r.index);
+  assert.deepEqual(open(), [0, 1, 2, 3], 'the first lead worth of requests');
+  const [r0, , r2] = run.net.open();
+  run.net.send(r0, run.size);
+  run.net.finish(r0);
+  run.net.send(r2, run.size);
+  run.net.finish(r2);
+  await settle();
+  assert.deepEqual(run.delivered, [0]);
+  assert.deepEqual(open(), [1, 3, 4, 5], 'two more went out as the first two ended');
+  const sent = requests(run.loader).length;
+  run.loader.replan([3, 5, 6, 0]); // 0 was handed over already: ignored
+  const replan = run.loader.log.find((e) => e.event === 'replan');
+  assert.equal(replan.count, 3);
+  const after = run.loader.log.filter((e) => e.seq > replan.seq);
+  assert.deepEqual(after.filter((e) => e.event === 'drop').map((e) => [e.index, e.reason]), [[1, 'replan'], [4, 'replan']]);
+  assert.deepEqual(after.filter((e) => e.event === 'discard').map((e) => e.index), [2]);
+  assert.deepEqual(requests(run.loader).slice(sent).map((e) => e.index), [6], '3 and 5 are still under way');
+  assert.deepEqual(open(), [3, 5, 6]);
+  await answerAll(run.net, run.size);
+  assert.deepEqual(run.delivered, [0, 3, 5, 6]);
+  assert.equal(idle, 1, 'the end of the plan');
+  assert.equal(run.result.done, false, 'waiting for more');
+  assert.equal(run.loader.stopped, false);
+  run.loader.replan([]); // nothing new: still idle, not called again
+  assert.equal(idle, 1);
+  run.loader.replan([7, 1]);
+  assert.deepEqual(open(), [7, 1]);
+  await answerAll(run.net, run.size);
+  assert.deepEqual(run.delivered, [0, 3, 5, 6, 7, 1]);
+  assert.equal(idle, 2);
+  assert.deepEqual(requests(run.loader).map((e) => e.index), [0, 1, 2, 3, 4, 5, 6, 7, 1]);
+  run.loader.stop();
+});
+
+test('a replan from deliver() keeps the chunk being handed over', async () => {
+  const run = makeLoader({ chunks: 4, order: [0, 1, 2, 3], onIdle: () => {} });
+  run.loader.deliver = (i) => {
+    run.delivered.push(i);
+    if (i === 0) run.loader.replan([2, 1]);
+    return true;
+  };
+  run.loader.pump();
+  await answerAll(run.net, run.size);
+  assert.deepEqual(run.delivered, [0, 2, 1]);
+  assert.deepEqual(run.loader.plan, [0, 2, 1]);
+  run.loader.stop();
+});
+
+test('a replan cancels the backoff of a chunk it left', async () => {
+  const run = makeLoader({ chunks: 4, order: [0, 1, 2, 3], onIdle: () => {} });
+  run.loader.pump();
+  await settle();
+  const r1 = run.net.open().find((r) => r.index === 1);
+  run.net.fail(r1, new FetchError('HTTP 503', { kind: 'http', status: 503, transient: true }));
+  await settle();
+  assert.ok(run.loader.waiting.has(1));
+  run.loader.replan([0, 2, 3]); // 0 is not in yet: still in the plan
+  assert.equal(run.loader.waiting.size, 0);
+  run.clock.advance(60000);
+  assert.equal(requests(run.loader).filter((e) => e.index === 1).length, 1, 'not fetched again');
+  await answerAll(run.net, run.size);
+  assert.deepEqual(run.delivered, [0, 2, 3]);
+  assert.equal(run.loader.notice(), '', 'a chunk out of the plan is no news');
+  run.loader.stop();
+});
+
+test('with onChunkFailed a 404 skips its chunk once the chunks before it are in, and the rest goes on', async () => {
+  const skipped = [];
+  const delivered = [];
+  const run = makeLoader({
+    chunks: 5, order: [0, 3, 1, 4, 2], deliver: (i) => delivered.push(i) > 0,
+    onChunkFailed: (i, message) => skipped.push({ i, message, delivered: [...delivered] }),
+  });
+  run.loader.pump();
+  await settle();
+  run.net.fail(run.net.open().find((r) => r.index === 1), notFound());
+  await settle();
+  assert.deepEqual(skipped, [], 'chunks before it in the plan are still coming');
+  await answerAll(run.net, run.size);
+  assert.deepEqual(delivered, [0, 3, 4, 2]);
+  assert.deepEqual(skipped.map((s) => [s.i, s.delivered]), [[1, [0, 3]]]);
+  assert.match(skipped[0].message, /^Could not download part 2 of 5 of the dataset \(chunk-1\): HTTP 404 \(Not Found\)\.$/);
+  assert.deepEqual(run.loader.log.filter((e) => e.event === 'skip').map((e) => e.index), [1]);
+  assert.equal(run.result.failed, null);
+  assert.ok(run.result.done, 'the end of the plan');
+  assert.equal(requests(run.loader).filter((e) => e.index === 1).length, 1, 'never asked again');
+});
+
+test('with onChunkFailed the page can replan from the callback before anything after is handed over', async () => {
+  // Chunk 2 needs chunk 1 (a node's second chunk, or a child).
+  const run = makeLoader({ chunks: 5, order: [0, 1, 2, 3, 4], onChunkFailed: (i) => run.loader.replan(i === 1 ? [3, 4] : []) });
+  run.loader.pump();
+  await settle();
+  run.net.fail(run.net.open().find((r) => r.index === 1), notFound());
+  await answerAll(run.net, run.size);
+  assert.deepEqual(run.delivered, [0, 3, 4]);
+  assert.equal(run.result.failed, null);
+});
+
+test('a chunk damaged every time is skipped in plan mode with onChunkFailed', async () => {
+  const skipped = [];
+  const run = makeLoader({
+    chunks: 3, order: [0, 2, 1], check: (i) => (i === 2 ? 'not a part of this dataset' : null),
+    onChunkFailed: (i, message) => skipped.push([i, message]),
+  });
+  run.loader.pump();
+  for (let k = 0; k < 10 && !run.result.done; k++) {
+    await answerAll(run.net, run.size);
+    run.clock.advance(60000);
+  }
+  assert.deepEqual(run.delivered, [0, 1]);
+  assert.equal(skipped.length, 1);
+  assert.match(skipped[0][1], /^Part 3 of 3 of the dataset arrived damaged 4 times in a row/);
+  assert.equal(run.result.failed, null);
+});
+
+test('chunks that arrived before attach() are checked and handed over in plan order', async () => {
+  const checked = [];
+  const run = makeLoader({ chunks: 4, order: [0, 3, 1, 2], check: null, deliver: null });
+  run.loader.warm();
+  await answerAll(run.net, run.size);
+  assert.deepEqual(run.delivered, [], 'nothing before attach()');
+  run.loader.attach({
+    check: (i) => { checked.push(i); return null; },
+    deliver: (i) => run.delivered.push(i) > 0,
+  });
+  assert.deepEqual(checked, [0, 3, 1, 2]);
+  assert.deepEqual(run.delivered, [0, 3, 1, 2]);
+  assert.ok(run.result.done);
+});
+
+test('without onChunkFailed a 404 stops the stream after the chunks before it in the plan', async () => {
+  const run = makeLoader({ chunks: 5, order: [0, 3, 1, 4, 2] });
+  run.loader.pump();
+  await settle();
+  run.net.fail(run.net.open().find((r) => r.index === 1), notFound());
+  await settle();
+  assert.deepEqual(run.net.open().map((r) => r.index), [0, 3], 'the requests after it are dropped');
+  await answerAll(run.net, run.size);
+  assert.deepEqual(run.delivered, [0, 3]);
+  assert.match(run.result.failed, /^Could not download part 2 of 5 .*\. Showing the last complete level\.$/);
+  assert.ok(run.result.done);
+  assert.deepEqual(requests(run.loader).map((e) => e.index), [0, 3, 1, 4]);
+});
+
+test('a chunk that fails for a while before one that cannot be had is still fetched again', async () => {
+  const run = makeLoader({ chunks: 4 });
+  run.loader.pump();
+  await settle();
+  const [r0, r1, r2] = run.net.open();
+  run.net.fail(r2, notFound());
+  await settle();
+  run.net.fail(r1, new FetchError('connection lost', { kind: 'network', transient: true }));
+  await settle();
+  run.net.send(r0, run.size);
+  run.net.finish(r0);
+  await settle();
+  run.clock.advance(60000);
+  assert.deepEqual(requests(run.loader).map((e) => [e.index, e.reason]),
+    [[0, 'first'], [1, 'first'], [2, 'first'], [3, 'first'], [1, 'retry']]);
+  await answerAll(run.net, run.size);
+  assert.deepEqual(run.delivered, [0, 1]);
+  assert.match(run.result.failed, /^Could not download part 3 of 4 .* Showing the last complete level\.$/);
 });

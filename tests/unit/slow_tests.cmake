@@ -3,7 +3,7 @@
 # npm test runs them. A gtest filter: names joined by ':', '*' as a wildcard.
 set(TETSTREAM_SLOW_TESTS
   LevelError.MeasuredLevelErrorsMatchBruteForce
-  Simplify.SlabsGiveValidLevelsAndTheSameQuality
+  Simplify.RegionsGiveValidLevelsAndTheSameQuality
   Simplify.CostPerRemovedTetGivesALowerErrorAtTheSameTets
   Simplify.GradedMeshKeepsTheFarFieldWhereIsosurfacesAre
   SimplifyRefit.FittedValuesLowerTheFieldErrorOfCoarseLevels

@@ -10,6 +10,7 @@
 #include <set>
 
 #include "harness.h"
+#include "manifest.h"
 
 namespace fs = std::filesystem;
 
@@ -30,8 +31,21 @@ TEST(FuzzCorpus, EveryInputOfEveryTargetRunsClean) {
       ++inputs;
     }
   }
-  for (const char* t : {"manifest", "split-chunk", "base-chunk", "mesh-vtu", "mesh-vtk", "mesh-vts", "mesh-vti",
-                        "mesh-msh", "mesh-mesh", "mesh-xyz", "pair-tetgen", "pair-medit", "pair-plot3d"})
+  for (const char* t : {"manifest", "split-chunk", "node-chunk", "base-chunk", "mesh-vtu", "mesh-vtk", "mesh-vts",
+                        "mesh-vti", "mesh-msh", "mesh-mesh", "mesh-xyz", "pair-tetgen", "pair-medit", "pair-plot3d"})
     EXPECT_TRUE(targets.count(t)) << "no corpus for " << t;
   EXPECT_GT(inputs, 50u);
+}
+
+// The manifest seeds tests/fuzz/run.sh starts from are valid, one of them with nodes.
+TEST(FuzzCorpus, ManifestSeedsAreValid) {
+  size_t withNodes = 0;
+  for (const auto& [name, bytes] : tetstream::fuzz::seeds("manifest")) {
+    tetstream::Manifest m;
+    tetstream::Result r =
+        tetstream::parseManifest(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()), m);
+    EXPECT_TRUE(r) << name << ": " << r.message;
+    withNodes += !m.nodes.empty();
+  }
+  EXPECT_GE(withNodes, 1u);
 }

@@ -1,5 +1,5 @@
 // The simplifier (pack/simplify.h): legality of each collapse on tiny meshes, one thread and two
-// alike, slabs, the cost (scale free, per removed tet, weighted by volume), the boundary kept,
+// alike, regions, the cost (scale free, per removed tet, weighted by volume), the boundary kept,
 // the error bound.
 #include <gtest/gtest.h>
 
@@ -40,16 +40,16 @@ void expectSameOnOneThreadAndTwo(const TetMesh& m, SimplifyOptions o, SimplifyRe
   EXPECT_EQ(one.queuePops, two.queuePops);
 }
 
-// `m` simplified to `vertices` (or `tets`) with the parallel phase (forced, whatever the mesh's
-// size) and with one queue for the whole mesh.
-void simplifyInSlabsAndWhole(const TetMesh& m, uint32_t vertices, uint32_t tets, SimplifyResult& slabs,
-                             SimplifyResult& whole) {
+// `m` simplified to `vertices` (or `tets`) in a tree of regions of at most `leaf` vertices,
+// and with one queue for the whole mesh.
+void simplifyInRegionsAndWhole(const TetMesh& m, uint32_t vertices, uint32_t tets, SimplifyResult& regions,
+                               SimplifyResult& whole, uint32_t leaf = 256) {
   SimplifyOptions so;
   so.targetVertices = vertices;
   so.targetTets = tets;
-  so.slabMinVertices = 0;
-  ASSERT_TRUE(simplifyMesh(m, so, slabs));
-  so.slabMinVertices = ~0u;
+  so.leafVertices = leaf;
+  ASSERT_TRUE(simplifyMesh(m, so, regions));
+  so.leafVertices = 0;
   ASSERT_TRUE(simplifyMesh(m, so, whole));
 }
 
@@ -107,23 +107,26 @@ TEST(Simplify, TwoThreadsCollapseExactlyAsOne) {
   SimplifyOptions o;
   o.targetVertices = 40;
   o.parallelMinVertices = 0;
+  o.leafVertices = 0;  // (the one queue alone)
   expectSameOnOneThreadAndTwo(harmonic(14), o, one, two);
   EXPECT_GT(one.log.size(), 2500u);
-  EXPECT_EQ(one.slabCollapses, 0u);
+  EXPECT_EQ(one.regionCollapses, 0u);
 }
 
-// Large meshes are simplified in slabs for most of the way: each slab's collapses depend on
-// nothing another does, so one thread gives exactly the result of two.
-TEST(Simplify, SlabsCollapseTheSameOnOneThreadAndTwo) {
+// Large meshes are simplified in a tree of regions for most of the way: each region's
+// collapses depend on nothing another does, so one thread gives exactly the result of two.
+TEST(Simplify, RegionsCollapseTheSameOnOneThreadAndTwo) {
   SimplifyResult one, two;
   SimplifyOptions o;
   o.targetVertices = 100;
-  o.slabMinVertices = 0;
+  o.leafVertices = 256;
   SimplifyTuning tuning;
   tuning.verifyLinkCondition = true;  // (and the fast link check agrees with the reference throughout)
   expectSameOnOneThreadAndTwo(harmonic(20), o, one, two, tuning);
-  EXPECT_GT(one.slabCollapses, one.log.size() * 8 / 10);
-  EXPECT_EQ(one.slabCollapses, two.slabCollapses);
+  EXPECT_GT(one.regionCollapses, one.log.size() / 2);
+  EXPECT_EQ(one.regionCollapses, two.regionCollapses);
+  EXPECT_EQ(one.tree.sectionNode, two.tree.sectionNode);
+  EXPECT_EQ(one.tree.sectionEnd, two.tree.sectionEnd);
 }
 
 // Planar boundary faces and creases carry zero quadric error, so with the default weights the
@@ -145,20 +148,19 @@ TEST(Simplify, BoundaryIsPreserved) {
   }
 }
 
-// The slabs' logs are merged into one: every prefix must still be a valid mesh, the last level
-// the input, and the coarse field no worse than with one queue for the whole mesh, at 5% of the
-// tets as the benchmarks compare. (Coarser, at 2.5% of the tets, one queue is 9% better with
-// the cost per removed tet; both are better with that cost than without it at either level.)
-TEST(Simplify, SlabsGiveValidLevelsAndTheSameQuality) {
+// The regions' logs follow one another: every prefix must still be a valid mesh, the last level
+// the input, and the coarse field close to that of one queue for the whole mesh, at 5% of the
+// tets as the benchmarks compare.
+TEST(Simplify, RegionsGiveValidLevelsAndTheSameQuality) {
   TetMesh m = harmonic(20);
   PackOptions o;
-  o.slabMinVertices = 0;
-  roundTrip("slabs", m, o);
-  SimplifyResult slabs, whole;
-  simplifyInSlabsAndWhole(m, 0, m.tetCount() / 20, slabs, whole);
-  EXPECT_EQ(whole.slabCollapses, 0u);
-  const double a = fieldRms(m, coarseMesh(m, slabs), 0), b = fieldRms(m, coarseMesh(m, whole), 0);
-  std::printf("field RMS at 5%% of the tets: slabs %.6f, one queue %.6f\n", a, b);
+  o.leafVertices = 256;
+  roundTrip("regions", m, o);
+  SimplifyResult regions, whole;
+  simplifyInRegionsAndWhole(m, 0, m.tetCount() / 20, regions, whole);
+  EXPECT_EQ(whole.regionCollapses, 0u);
+  const double a = fieldRms(m, coarseMesh(m, regions), 0), b = fieldRms(m, coarseMesh(m, whole), 0);
+  std::printf("field RMS at 5%% of the tets: regions %.6f, one queue %.6f\n", a, b);
   EXPECT_LT(a, 1.05 * b);  // (measured: 0.01619 against 0.01593)
 }
 
@@ -211,6 +213,7 @@ TEST(Simplify, CostPerRemovedTetGivesALowerErrorAtTheSameTets) {
   for (uint32_t share : {5u, 10u, 20u}) {  // 1/share of the tets: 20%, 10%, 5%
     SimplifyOptions so;
     so.targetTets = m.tetCount() / share;
+    so.leafVertices = 0;  // (the costs compared in one queue)
     SimplifyResult perTet, alike;
     ASSERT_TRUE(simplifyMesh(m, so, perTet));
     SimplifyTuning tuning;
@@ -258,23 +261,20 @@ TEST(Simplify, CollapsesDoNotDependOnTheMeshScale) {
   EXPECT_EQ(a.log.j, b.log.j);
 }
 
-// The parallel phase must not leave the vertices along its cuts for the end: the stream gives
-// the last collapses back first, so such vertices showed up at the coarse levels as a finely
-// meshed slab (Harmonic 64³ at 12% of its vertices: 5,400 vertices in each of the two grid
-// layers along the cut against 1,500 in the others). Each level should spend its vertices as
-// one queue does.
-TEST(Simplify, LevelsOfTheParallelPhaseHaveNoSlabAlongACut) {
+// Each level of the tree leaves its cuts to the level above, and the root coarsens them with the
+// rest: no seam survives to the base, which spends its vertices as one queue's base does. (In
+// between, a node's splits refine its own cut at once: which nodes a viewer loads decides what
+// it sees; the stream order is no longer one level after another.)
+TEST(Simplify, TheBaseOfTheRegionsHasNoSlabAlongACut) {
   const uint32_t n = 20;
   TetMesh m = harmonic(n);
-  SimplifyResult slabs, whole;
-  simplifyInSlabsAndWhole(m, 100, 0, slabs, whole);
-  EXPECT_GT(slabs.slabCollapses, slabs.log.size() * 8 / 10);
-  for (double share : {0.08, 0.15, 0.3}) {
-    const uint32_t alive = uint32_t(share * m.vertexCount());
-    const double a = busiestLayerPair(n, slabs, alive), b = busiestLayerPair(n, whole, alive);
-    std::printf("%u vertices left: busiest pair of layers holds %.3f (one queue: %.3f)\n", alive, a, b);
-    EXPECT_LT(a, 1.3 * b) << alive << " vertices left";
-  }
+  SimplifyResult regions, whole;
+  simplifyInRegionsAndWhole(m, 400, 0, regions, whole);
+  EXPECT_GT(regions.regionCollapses, regions.log.size() / 2);
+  EXPECT_GT(regions.tree.depth, 3u);
+  const double a = busiestLayerPair(n, regions, 400), b = busiestLayerPair(n, whole, 400);
+  std::printf("base of 400 vertices: busiest pair of layers holds %.3f (one queue: %.3f)\n", a, b);
+  EXPECT_LT(a, 1.3 * b);
 }
 
 // --max-error E: every collapse made leaves a field error of at most E (relative to the range),
