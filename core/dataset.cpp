@@ -226,7 +226,7 @@ bool isPackedDir(const std::string& path) {
 
 Result loadPackedDir(const std::string& dir, Dataset& ds, int maxChunks, uint32_t maxVertices) {
   std::vector<uint8_t> bytes;
-  if (Result r = readFileBytes(dir + "/manifest.json", 16u << 20, bytes); !r) return r;
+  if (Result r = readFileBytes(dir + "/manifest.json", kManifestLimitBytes, bytes); !r) return r;
   if (Result r = openDataset(ds, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size())); !r)
     return r;
   size_t n = ds.manifest.chunks.size();

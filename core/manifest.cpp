@@ -1,7 +1,9 @@
 #include "manifest.h"
 
 #include <cassert>
+#include <charconv>
 #include <cmath>
+#include <cstdlib>
 #include <nlohmann/json.hpp>
 
 #include "hash.h"
@@ -11,7 +13,7 @@ namespace {
 
 using json = nlohmann::json;
 
-constexpr size_t kMaxManifestBytes = 16u << 20;
+constexpr size_t kMaxManifestBytes = kManifestLimitBytes;
 constexpr int kMaxDepth = 32;
 constexpr size_t kMaxChunks = 65536;
 constexpr size_t kMaxFields = 64;
@@ -272,7 +274,7 @@ int Manifest::findField(std::string_view fieldName) const {
 }
 
 Result parseManifest(std::string_view text, Manifest& m) {
-  if (text.size() > kMaxManifestBytes) return fail(Status::TooLarge, "manifest: larger than 16 MiB");
+  if (text.size() > kMaxManifestBytes) return fail(Status::TooLarge, "manifest: larger than 64 MiB");
   if (!nestingWithin(text, kMaxDepth)) return bad("nested deeper than 32 levels");
   json doc = json::parse(text.begin(), text.end(), nullptr, /*allow_exceptions=*/false);
   if (doc.is_discarded()) return bad("not valid JSON");
@@ -406,18 +408,84 @@ Result parseManifest(std::string_view text, Manifest& m) {
   return parseNodes(r, *nodes, m);
 }
 
+namespace {
+
+// The double nearest to the shortest decimal that gives back float x: the manifest's 32-bit
+// values (bounds, ranges, errors) written in 9 digits at most instead of a double's 17 (the
+// manifest of a large hierarchy holds hundreds of thousands of them; it is fetched first).
+double shortest(double x) {
+  char buf[32];
+  const auto end = std::to_chars(buf, buf + sizeof buf, float(x)).ptr;
+  return std::strtod(std::string(buf, end).c_str(), nullptr);
+}
+
+// Compact JSON laid out for people: a member of the object, or an element of an array in it (a
+// chunk, a node, a field), a line each; ": " and ", " elsewhere.
+std::string layOut(const std::string& compact) {
+  std::string out;
+  out.reserve(compact.size() + compact.size() / 8);
+  int depth = 0;
+  bool inString = false, escaped = false;
+  auto newline = [&] { out += '\n' + std::string(size_t(depth), ' '); };
+  for (size_t k = 0; k < compact.size(); ++k) {
+    const char c = compact[k];
+    if (inString) {
+      out += c;
+      if (escaped)
+        escaped = false;
+      else if (c == '\\')
+        escaped = true;
+      else if (c == '"')
+        inString = false;
+      continue;
+    }
+    switch (c) {
+      case '"': inString = true, out += c; break;
+      case ':': out += ": "; break;
+      case ',':
+        out += ',';
+        if (depth <= 2)
+          newline();
+        else
+          out += ' ';
+        break;
+      case '{':
+      case '[':
+        out += c;
+        if (k + 1 < compact.size() && (compact[k + 1] == '}' || compact[k + 1] == ']')) {  // empty
+          out += compact[++k];
+          break;
+        }
+        ++depth;
+        if (depth <= 2) newline();
+        break;
+      case '}':
+      case ']':
+        --depth;
+        if (depth <= 1) newline();
+        out += c;
+        break;
+      default: out += c;
+    }
+  }
+  return out + '\n';
+}
+
+}  // namespace
+
 std::string writeManifest(const Manifest& m) {
   json doc;
   doc["format"] = "tetstream";
   doc["formatVersion"] = m.formatVersion;
   doc["generator"] = m.generator.empty() ? std::string("tetstream ") + kLibraryVersion : m.generator;
   doc["name"] = m.name;
-  doc["bounds"] = {{"min", {m.bounds.min[0], m.bounds.min[1], m.bounds.min[2]}},
-                   {"max", {m.bounds.max[0], m.bounds.max[1], m.bounds.max[2]}}};
+  auto point = [](const float* p) { return json::array({shortest(p[0]), shortest(p[1]), shortest(p[2])}); };
+  doc["bounds"] = {{"min", point(m.bounds.min)}, {"max", point(m.bounds.max)}};
   doc["vertices"] = m.vertices;
   doc["tets"] = m.tets;
   json fields = json::array();
-  for (const FieldInfo& f : m.fields) fields.push_back({{"name", f.name}, {"min", f.range.min}, {"max", f.range.max}});
+  for (const FieldInfo& f : m.fields)
+    fields.push_back({{"name", f.name}, {"min", shortest(f.range.min)}, {"max", shortest(f.range.max)}});
   doc["fields"] = fields;
   doc["isoField"] = m.isoField;
   if (m.lossless)
@@ -434,9 +502,9 @@ std::string writeManifest(const Manifest& m) {
                       {"vertices", c.vertices},
                       {"tets", c.tets},
                       {"splits", c.splits},
-                      {"fieldError", c.fieldError}});
-    if (c.fieldRms >= 0) chunks.back()["fieldRms"] = c.fieldRms;
-    if (c.fieldMax >= 0) chunks.back()["fieldMax"] = c.fieldMax;
+                      {"fieldError", shortest(c.fieldError)}});
+    if (c.fieldRms >= 0) chunks.back()["fieldRms"] = shortest(c.fieldRms);
+    if (c.fieldMax >= 0) chunks.back()["fieldMax"] = shortest(c.fieldMax);
   }
   doc["chunks"] = chunks;
   assert(m.formatVersion >= 2 || m.nodes.empty());  // version 1 cannot hold nodes
@@ -444,22 +512,20 @@ std::string writeManifest(const Manifest& m) {
     json nodes = json::array();
     for (const NodeInfo& n : m.nodes) {
       json ranges = json::array();
-      for (const Range& r : n.ranges) ranges.push_back({r.min, r.max});
+      for (const Range& r : n.ranges) ranges.push_back({shortest(r.min), shortest(r.max)});
       nodes.push_back({{"parent", n.parent},
                        {"chunks", {n.firstChunk, n.chunkCount}},
                        {"vertices", {n.vertexBegin, n.vertexEnd}},
                        {"tets", {n.tetBegin, n.tetEnd}},
-                       {"bounds",
-                        {{"min", {n.bounds.min[0], n.bounds.min[1], n.bounds.min[2]}},
-                         {"max", {n.bounds.max[0], n.bounds.max[1], n.bounds.max[2]}}}},
+                       {"bounds", {{"min", point(n.bounds.min)}, {"max", point(n.bounds.max)}}},
                        {"ranges", ranges},
-                       {"fieldError", n.fieldError}});
-      if (n.fieldRms >= 0) nodes.back()["fieldRms"] = n.fieldRms;
-      if (n.fieldMax >= 0) nodes.back()["fieldMax"] = n.fieldMax;
+                       {"fieldError", shortest(n.fieldError)}});
+      if (n.fieldRms >= 0) nodes.back()["fieldRms"] = shortest(n.fieldRms);
+      if (n.fieldMax >= 0) nodes.back()["fieldMax"] = shortest(n.fieldMax);
     }
     doc["nodes"] = nodes;
   }
-  return doc.dump(1) + "\n";
+  return layOut(doc.dump());
 }
 
 }  // namespace tetstream

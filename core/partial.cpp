@@ -141,7 +141,7 @@ void undoLastNode(PartialDataset& pd, std::vector<uint32_t>* changedOut) {
 
 Result readManifestFile(const std::string& dir, std::string& json) {
   std::vector<uint8_t> bytes;
-  if (Result r = readFileBytes(dir + "/manifest.json", 16u << 20, bytes); !r) return r;
+  if (Result r = readFileBytes(dir + "/manifest.json", kManifestLimitBytes, bytes); !r) return r;
   json.assign(bytes.begin(), bytes.end());
   return Result::success();
 }

@@ -10,7 +10,7 @@ import { loadProgram, prepareWebGl, withRetries } from './program.js';
 import { RateMeter } from './rate.js';
 import { noticeText, showError, showStatus } from './status.js';
 
-const MANIFEST_LIMIT = 16 << 20; // FORMAT.md §1
+const MANIFEST_LIMIT = 64 << 20; // FORMAT.md §1
 const ERROR_STATE = 4;           // ts_load_state()
 
 // ------------------------------------------------------------------ the network, owned here
@@ -127,7 +127,7 @@ function loadManifest(manifestUrl) {
       response: early ? early.promise : null,
       abortResponse: early ? () => early.controller.abort() : null,
     });
-    if (bytes.length > MANIFEST_LIMIT) throw new LoadError(`The dataset description (manifest.json) at ${manifestUrl.href} is larger than 16 MB: not a tetstream manifest.`);
+    if (bytes.length > MANIFEST_LIMIT) throw new LoadError(`The dataset description (manifest.json) at ${manifestUrl.href} is larger than 64 MB: not a tetstream manifest.`);
     return bytes;
   });
 }

@@ -1,6 +1,7 @@
 #include "packer.h"
 
 #include <unistd.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <chrono>
@@ -25,6 +26,23 @@ Result writeFile(const fs::path& path, const void* data, size_t size) {
   FileWriter out(path.string());
   out.write(data, size);
   return out.commit();
+}
+
+// `text` as a gzip file (deflate at level 9 in a gzip wrapper).
+Result writeGzipped(const fs::path& path, const std::string& text) {
+  z_stream z{};
+  if (deflateInit2(&z, 9, Z_DEFLATED, 15 + 16, 9, Z_DEFAULT_STRATEGY) != Z_OK)
+    return fail(Status::IoError, path.string() + ": cannot start gzip");
+  std::vector<uint8_t> out(deflateBound(&z, uLong(text.size())) + 32);
+  z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(text.data()));
+  z.avail_in = uInt(text.size());
+  z.next_out = out.data();
+  z.avail_out = uInt(out.size());
+  const int done = deflate(&z, Z_FINISH);
+  out.resize(z.total_out);
+  deflateEnd(&z);
+  if (done != Z_STREAM_END) return fail(Status::IoError, path.string() + ": gzip failed");
+  return writeFile(path, out.data(), out.size());
 }
 
 std::string chunkFileName(uint32_t index, uint64_t hash) {
@@ -286,6 +304,11 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   }
   std::string json = writeManifest(m);
   Result r = writeFile(fs::path(outDir) / "manifest.json", json.data(), json.size());
+  // The manifest gzipped beside it, written after it (so it is never the older of the two, which
+  // servers take as stale): a large hierarchy's manifest is megabytes of JSON, fetched before
+  // anything else, and compresses about six times (server/README.md: precompressed siblings).
+  if (r) r = writeGzipped(fs::path(outDir) / "manifest.json.gz", json);
+  fs::remove(fs::path(outDir) / "manifest.json.br", ec);  // (one from an earlier pack would be stale)
   summary.writeMs = msSince(t0);
   return r;
 }

@@ -31,7 +31,7 @@ struct PackOptions {
   bool orderSplits = false;          // splits by kept vertex inside each chunk (pack --compact)
   double maxMemoryBytes = 0;         // refuse meshes that need more (0: 90% of physical memory)
   int threads = 2;                   // threads that evaluate collapse costs and measure levels (1 or 2; same output)
-  uint32_t leafVertices = 1024;      // largest region of the patch hierarchy (SimplifyOptions)
+  uint32_t leafVertices = 2048;      // largest region of the patch hierarchy (SimplifyOptions)
   uint32_t renumberMinTets = 50000;  // renumber scattered meshes from this size (pack/renumber.h)
   // Progress for displays: phase ("validate", "simplify", "encode", "write"), items done and
   // planned in that phase (collapses, splits; 0 planned when not countable).
