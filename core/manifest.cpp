@@ -1,8 +1,8 @@
 #include "manifest.h"
 
 #include <cassert>
-#include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <nlohmann/json.hpp>
 
@@ -414,9 +414,13 @@ namespace {
 // values (bounds, ranges, errors) written in 9 digits at most instead of a double's 17 (the
 // manifest of a large hierarchy holds hundreds of thousands of them; it is fetched first).
 double shortest(double x) {
+  const float f = float(x);
   char buf[32];
-  const auto end = std::to_chars(buf, buf + sizeof buf, float(x)).ptr;
-  return std::strtod(std::string(buf, end).c_str(), nullptr);
+  for (int digits = 6;; ++digits) {  // (9 always gives a float back; std::to_chars is not in every libc++)
+    std::snprintf(buf, sizeof buf, "%.*g", digits, double(f));
+    const double d = std::strtod(buf, nullptr);
+    if (float(d) == f || digits >= 9) return d;
+  }
 }
 
 // Compact JSON laid out for people: a member of the object, or an element of an array in it (a

@@ -150,4 +150,17 @@ uint64_t neededBytes(const ViewerState& s) {
   return bytes;
 }
 
+std::pair<uint32_t, uint32_t> neededCounts(const ViewerState& s) {
+  const Manifest& m = s.dataset.manifest;
+  if (m.chunks.empty()) return {0, 0};
+  uint64_t vertices = m.chunks[0].vertices, tets = m.chunks[0].tets;
+  const std::vector<uint8_t> broken = brokenBelow(s.fetch, m);
+  for (size_t k = 0; k < m.nodes.size(); ++k)
+    if (m.nodes.size() == s.fetch.needed.size() && s.fetch.needed[k] && !broken[k]) {
+      vertices += m.nodes[k].vertexEnd - m.nodes[k].vertexBegin;
+      tets += m.nodes[k].tetEnd - m.nodes[k].tetBegin;
+    }
+  return {uint32_t(std::min<uint64_t>(vertices, m.vertices)), uint32_t(std::min<uint64_t>(tets, m.tets))};
+}
+
 }  // namespace tetstream::viewer

@@ -8,6 +8,7 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <utility>
 #include <vector>
 
 #include "manifest.h"
@@ -50,5 +51,7 @@ bool exactSurface(const ViewerState& s);
 uint32_t nodesLoaded(const ViewerState& s);
 // Compressed bytes of the chunks the current view needs (received or not), base included.
 uint64_t neededBytes(const ViewerState& s);
+// Vertices and tets of the mesh once every node the view needs is applied.
+std::pair<uint32_t, uint32_t> neededCounts(const ViewerState& s);
 
 }  // namespace tetstream::viewer

@@ -68,23 +68,40 @@ void extractSlice(ViewerState& s) {
 
 // Growing the mesh arrays by doubling while streaming would copy tens of MB inside one frame
 // (~20 ms natively at 1 M tets): size them once for the last level that will be streamed (the
-// full mesh unless memory is limited), as the manifest announces it. The manifest is untrusted,
-// so only up to 4 M tets (~100 MB) without a memory limit; bigger meshes grow as usual.
+// full mesh unless memory is limited; with a patch hierarchy, what the view needs now:
+// neededCounts), as the manifest announces it. The manifest is untrusted, so only up to 4 M tets
+// (~100 MB) without a memory limit; bigger meshes grow as usual.
 void reserveLevel(ViewerState& s) {
   constexpr uint32_t kMaxReservedTets = 4u << 20;
   Dataset& ds = s.dataset;
   const Manifest& m = ds.manifest;
   if (s.memory.chunksAllowed == 0) return;
   const ChunkInfo& last = m.chunks[s.memory.chunksAllowed - 1];
-  if (!s.memory.limitBytes && (last.tets > kMaxReservedTets || last.vertices > kMaxReservedTets)) return;
+  uint32_t vertices = last.vertices, tets = last.tets;
+  if (!m.nodes.empty()) {
+    const std::pair<uint32_t, uint32_t> needed = neededCounts(s);
+    vertices = std::min(vertices, needed.first);
+    tets = std::min(tets, needed.second);
+  }
+  if (!s.memory.limitBytes && (tets > kMaxReservedTets || vertices > kMaxReservedTets)) return;
   ProgressiveMesh& pm = ds.pm;
-  pm.mesh.positions.reserve(3 * size_t(last.vertices));
-  pm.mesh.tets.reserve(4 * size_t(last.tets));
-  for (ScalarField& f : pm.mesh.fields) f.values.reserve(last.vertices);
-  pm.stars.reserve(last.vertices, 4 * size_t(last.tets));
-  pm.splitJ.reserve(last.vertices);
-  pm.splitTetsBefore.reserve(last.vertices);
-  s.surface.reserveTets(last.tets);
+  pm.mesh.positions.reserve(3 * size_t(vertices));
+  pm.mesh.tets.reserve(4 * size_t(tets));
+  for (ScalarField& f : pm.mesh.fields) f.values.reserve(vertices);
+  pm.stars.reserve(vertices, 4 * size_t(tets));
+  pm.splitJ.reserve(vertices);
+  pm.splitTetsBefore.reserve(vertices);
+  s.surface.reserveTets(tets);
+}
+
+// What the last level that will be streamed takes (estimateLevelBytes); with a patch hierarchy,
+// the share of it the view needs now, by tets.
+uint64_t plannedLevelBytes(const ViewerState& s) {
+  const Manifest& m = s.dataset.manifest;
+  const uint64_t all = estimateLevelBytes(m, s.memory.chunksAllowed);
+  if (m.nodes.empty() || s.memory.chunksAllowed == 0) return all;
+  const uint64_t tets = m.chunks[s.memory.chunksAllowed - 1].tets;
+  return tets ? uint64_t(double(all) * std::min(1.0, double(neededCounts(s).second) / double(tets))) : all;
 }
 
 // "part 12 of 30" as people count.
@@ -254,9 +271,7 @@ Result addChunk(ViewerState& s, uint32_t index, std::span<const uint8_t> bytes, 
   // for first; if the browser will not give it now, the arrays grow as levels come instead.
   const uint64_t need = s.memory.baseBytes + estimateLevelBytes(ds.manifest, ds.chunksReceived + 1);
   const bool reserveAll =
-      index == 0 &&
-      (!s.memory.reserveHeap ||
-       s.memory.reserveHeap(s.memory.baseBytes + estimateLevelBytes(ds.manifest, s.memory.chunksAllowed)));
+      index == 0 && (!s.memory.reserveHeap || s.memory.reserveHeap(s.memory.baseBytes + plannedLevelBytes(s)));
   if (s.memory.reserveHeap && !reserveAll && !s.memory.reserveHeap(need)) {
     s.memory.limited = true;
     Result r = fail(Status::TooLarge, "The browser did not give the viewer the " + formatBytes(need) +

@@ -91,7 +91,7 @@ struct SimplifyOptions {
   std::function<void(uint32_t done, uint32_t planned)> progress;  // called now and then
   // Keep in the log what each split reads (CollapseLog::star), for StreamOptions::orderSplits.
   bool recordReadSets = false;
-  // Threads (1 or 2; the result is the same either way): the slabs run on one each, and the
+  // Threads (1 or 2; the result is the same either way): the regions of a level share them, and the
   // one queue evaluates its next entries on both for meshes of at least parallelMinVertices
   // vertices (below that, starting rounds costs more than it saves).
   int threads = 2;

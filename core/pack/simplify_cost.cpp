@@ -242,7 +242,7 @@ bool Simplifier::finishCost(Scratch& sc, Candidate& c, CollapseVerdict* verdict)
 // What boundTerms() reads of a neighbour is scattered over large arrays (the loads of the field
 // quadrics were half of its time): it is asked for as soon as legal() passes the out-edge, and
 // only then. Asking for every neighbour's while legal() runs would fetch about four times what
-// is used (most out-edges are not legal), and the two threads of the slabs share the memory's
+// is used (most out-edges are not legal), and the two threads of the regions share the memory's
 // bandwidth.
 void Simplifier::gatherCandidates(Scratch& sc, uint32_t i) {
   sc.candidates.clear();
