@@ -53,6 +53,8 @@ struct FramePacing {
 struct App {
   ViewerState state;
   uint32_t planVersionSent = 0;  // the fetch plan's version the page was last told of (fetch_plan.h)
+  OrbitCamera plannedCamera;     // the camera when the plan last changed for it (replanForCamera)
+  double cameraReplanMs = -1e9;
   Renderer renderer;
   Canvas canvas;
   CameraControl view;

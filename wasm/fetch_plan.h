@@ -23,7 +23,8 @@ enum class FetchMode : uint8_t { Needed, Everything };
 struct FetchPlan {
   FetchMode mode = FetchMode::Needed;
   // Bumped whenever what is needed may have changed (isovalue, field, slice, mode, a node given
-  // up): the page asks for the plan again (docs/js-api.md).
+  // up) or, while streaming, its order (the camera: platform.cpp): the page asks for the plan
+  // again (docs/js-api.md).
   uint32_t version = 0;
   std::vector<uint8_t> needed;                  // per node: the view needs it (with its ancestors)
   std::vector<uint8_t> broken;                  // per node: one of its chunks could not be had (its subtree is skipped)

@@ -372,6 +372,20 @@ extern "C" EMSCRIPTEN_KEEPALIVE void ts_work() {
 namespace {
 
 // ---------------------------------------------------------------- frame
+// While a dataset of nodes streams in, turning the camera changes which regions come first
+// (fetch_plan.h: what a region covers on screen): the page is asked for a new plan, at most
+// twice a second (each is a pass over the nodes and a new order for the loader).
+void replanForCamera(App& a, double now) {
+  const ViewerState& s = a.state;
+  const OrbitCamera& c = a.view.camera;
+  const OrbitCamera& p = a.plannedCamera;
+  if (s.dataset.manifest.nodes.empty() || s.fetch.missing == 0 || now - a.cameraReplanMs < 500) return;
+  if (c.target == p.target && c.distance == p.distance && c.yaw == p.yaw && c.pitch == p.pitch) return;
+  a.plannedCamera = c;
+  a.cameraReplanMs = now;
+  ++a.state.fetch.version;
+}
+
 void frame() {
   App& a = g_app;
   ViewerState& s = a.state;
@@ -385,6 +399,7 @@ void frame() {
   a.pacing.lastFrameStart = start;
   syncCanvasSize();
   noteComplete(s);
+  replanForCamera(a, start);
   if (s.fetch.version != a.planVersionSent) {
     a.planVersionSent = s.fetch.version;
     tsjs_plan_changed();

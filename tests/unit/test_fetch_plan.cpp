@@ -1,0 +1,136 @@
+// The viewer's fetch plan (wasm/fetch_plan.h): which chunks of a dataset of nodes it asks for,
+// in what order, and when it is done.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "io/generators.h"
+#include "pack/packer.h"
+#include "test_helpers.h"
+#include "viewer_state.h"
+
+using namespace tetstream;
+using namespace tetstream::viewer;
+
+namespace {
+
+struct Packed {
+  std::string manifest;
+  std::vector<std::vector<uint8_t>> chunks;
+};
+
+// Harmonic 16³ in regions of at most 128 vertices.
+const Packed& packedNodes() {
+  static const Packed p = [] {
+    test::ScratchDir dir("fetch-plan");
+    TetMesh m = makeGridMesh(16);
+    addHarmonicField(m);
+    PackOptions o;
+    o.leafVertices = 128;
+    o.zstdLevel = 3;
+    PackSummary s;
+    EXPECT_TRUE(packMesh(m, dir.path, o, s));
+    Packed out;
+    out.manifest = test::loadFile(dir.path + "/manifest.json");
+    for (const ChunkInfo& c : s.manifest.chunks) out.chunks.push_back(test::loadBytes(dir.path + "/" + c.file));
+    return out;
+  }();
+  return p;
+}
+
+void offer(ViewerState& s, uint32_t index) {
+  const std::vector<uint8_t>& bytes = packedNodes().chunks[index];
+  auto* copy = static_cast<uint8_t*>(std::malloc(bytes.size()));
+  std::copy(bytes.begin(), bytes.end(), copy);
+  ASSERT_EQ(offerChunk(s, index, copy, bytes.size()), ChunkCheck::Ok) << "chunk " << index;
+}
+
+double g_ticks = 0;
+double fakeNow() { return g_ticks += 1; }
+
+// Nodes in the order the plan first asks for one of their chunks.
+std::vector<uint32_t> plannedNodes(const ViewerState& s) {
+  std::vector<uint32_t> nodes;
+  for (uint32_t c : plannedChunks(s, ~0u)) {
+    const int32_t k = s.dataset.nodeOfChunk(c);
+    if (k >= 0 && (nodes.empty() || nodes.back() != uint32_t(k))) nodes.push_back(uint32_t(k));
+  }
+  return nodes;
+}
+
+}  // namespace
+
+// The plan holds the base and the chunks of exactly the nodes whose range holds the isovalue
+// (with their ancestors), each node after its parent; following it ends exact and complete.
+TEST(FetchPlan, HoldsWhatTheIsovalueNeedsParentsFirst) {
+  ViewerState s;
+  ASSERT_TRUE(openManifest(s, packedNodes().manifest).ok());
+  const Manifest& m = s.dataset.manifest;
+  ASSERT_GE(m.nodes.size(), 16u);
+  setIsovalue(s, m.fields[0].range.min + 0.8f * (m.fields[0].range.max - m.fields[0].range.min));
+  const std::vector<uint32_t> plan = plannedChunks(s, ~0u);
+  ASSERT_FALSE(plan.empty());
+  EXPECT_EQ(plan[0], 0u) << "the base first";
+  std::vector<uint8_t> seen(m.nodes.size(), 0);
+  size_t chunks = 1;
+  for (uint32_t k : plannedNodes(s)) {
+    const NodeInfo& n = m.nodes[k];
+    EXPECT_TRUE(n.parent < 0 || seen[size_t(n.parent)]) << "node " << k << " before its parent";
+    seen[k] = 1;
+    chunks += n.chunkCount;
+  }
+  EXPECT_EQ(plan.size(), chunks);
+  for (uint32_t k = 0; k < m.nodes.size(); ++k) {
+    const Range r = m.nodes[k].ranges[0];
+    if (r.min <= s.isovalue && s.isovalue <= r.max) EXPECT_TRUE(seen[k]) << "node " << k << " is needed";
+  }
+  EXPECT_LT(plan.size(), m.chunks.size()) << "not everything";
+  EXPECT_EQ(s.fetch.missing, plan.size());
+  for (uint32_t c : plan) offer(s, c);
+  for (int k = 0; k < 100000 && refining(s); ++k) advance(s, g_ticks + 50, fakeNow);
+  EXPECT_EQ(s.state, LoadState::Complete);
+  EXPECT_TRUE(exactSurface(s));
+  EXPECT_TRUE(plannedChunks(s, ~0u).empty());
+
+  // Another isovalue needs more; everything needs every chunk.
+  const uint32_t version = s.fetch.version;
+  setIsovalue(s, m.fields[0].range.min + 0.4f * (m.fields[0].range.max - m.fields[0].range.min));
+  EXPECT_GT(s.fetch.version, version);
+  EXPECT_GT(s.fetch.missing, 0u);
+  EXPECT_EQ(s.state, LoadState::Streaming);
+  EXPECT_FALSE(exactSurface(s));
+  setFetchMode(s, FetchMode::Everything);
+  EXPECT_EQ(s.fetch.missing, m.chunks.size() - s.dataset.chunksReceived);
+}
+
+// Regions out of view come after every region in view whose ancestors are in view.
+TEST(FetchPlan, RegionsOutOfViewComeLast) {
+  ViewerState s;
+  ASSERT_TRUE(openManifest(s, packedNodes().manifest).ok());
+  const Manifest& m = s.dataset.manifest;
+  setFetchMode(s, FetchMode::Everything);
+  auto inView = [](const Bounds& b) { return b.min[0] < 0; };  // the half x < 0 is on screen
+  s.fetch.screenWeight = [&](const Bounds& b) { return inView(b) ? 1.0 : 0.0; };
+  const std::vector<uint32_t> order = plannedNodes(s);
+  ASSERT_EQ(order.size(), m.nodes.size());
+  auto ancestorOutOfView = [&](uint32_t k) {
+    for (int32_t a = m.nodes[k].parent; a >= 0; a = m.nodes[size_t(a)].parent)
+      if (!inView(m.nodes[size_t(a)].bounds)) return true;
+    return false;
+  };
+  bool outSeen = false;
+  size_t inViewFirst = 0;
+  for (uint32_t k : order) {
+    if (!inView(m.nodes[k].bounds)) {
+      outSeen = true;
+      continue;
+    }
+    if (outSeen)
+      EXPECT_TRUE(ancestorOutOfView(k)) << "node " << k << " in view waited behind one out of view";
+    else
+      ++inViewFirst;
+  }
+  EXPECT_GT(inViewFirst, order.size() / 4);
+}
