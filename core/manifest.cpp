@@ -21,23 +21,30 @@ constexpr uint64_t kMaxChunkBytes = 256ull << 20;
 constexpr uint64_t kMaxRawBytes = kMaxChunkRawBytes;
 constexpr uint64_t kMaxCount = (1ull << 31) - 1;
 
+// Where a character of JSON text stands: inside a string (its quotes included) or not. Both
+// scans of raw text below (nesting, layout) must skip what strings hold.
+struct StringTracker {
+  bool inString = false, escaped = false;
+  // True when c belongs to a string (an opening quote starts one).
+  bool inside(char c) {
+    if (!inString) return inString = c == '"';
+    if (escaped)
+      escaped = false;
+    else if (c == '\\')
+      escaped = true;
+    else if (c == '"')
+      inString = false;
+    return true;
+  }
+};
+
 // nlohmann's DOM destructor and our walk would recurse on absurd nesting; refuse it up front.
 bool nestingWithin(std::string_view s, int limit) {
   int depth = 0;
-  bool inString = false, escaped = false;
+  StringTracker text;
   for (char c : s) {
-    if (inString) {
-      if (escaped)
-        escaped = false;
-      else if (c == '\\')
-        escaped = true;
-      else if (c == '"')
-        inString = false;
-      continue;
-    }
-    if (c == '"')
-      inString = true;
-    else if (c == '{' || c == '[') {
+    if (text.inside(c)) continue;
+    if (c == '{' || c == '[') {
       if (++depth > limit) return false;
     } else if (c == '}' || c == ']')
       --depth;
@@ -429,22 +436,15 @@ std::string layOut(const std::string& compact) {
   std::string out;
   out.reserve(compact.size() + compact.size() / 8);
   int depth = 0;
-  bool inString = false, escaped = false;
+  StringTracker text;
   auto newline = [&] { out += '\n' + std::string(size_t(depth), ' '); };
   for (size_t k = 0; k < compact.size(); ++k) {
     const char c = compact[k];
-    if (inString) {
+    if (text.inside(c)) {
       out += c;
-      if (escaped)
-        escaped = false;
-      else if (c == '\\')
-        escaped = true;
-      else if (c == '"')
-        inString = false;
       continue;
     }
     switch (c) {
-      case '"': inString = true, out += c; break;
       case ':': out += ": "; break;
       case ',':
         out += ',';
