@@ -21,6 +21,9 @@ void addReadOptions(CLI::App* sub, ReadOptions& read) {
   sub->add_option("--q,--solution", read.solution,
                   "PLOT3D Q file for a grid (default: a sibling such as bluntfinq.bin for bluntfinxyz.bin), or a "
                   "Medit .sol (default: NAME.sol)");
+  auto* step = sub->add_option("--step", read.step, "files with time steps: read step K (0-based; default: the last)");
+  auto* time = sub->add_option("--time", read.time, "files with time steps: read the step nearest simulation time T");
+  step->excludes(time);
 }
 
 Result loadInput(const std::string& path, Input& in, const LevelOption& level, const ReadOptions& read) {
@@ -29,6 +32,8 @@ Result loadInput(const std::string& path, Input& in, const LevelOption& level, c
     if (!isPackedDir(path))
       return fail(Status::IoError, path + ": a folder without manifest.json is not a packed dataset");
     if (!read.solution.empty()) return fail(Status::BadArgument, "--q applies to mesh files, not to packed datasets");
+    if (read.step || read.time)
+      return fail(Status::BadArgument, "--step and --time apply to mesh files, not to packed datasets");
     Dataset ds;
     uint32_t maxVertices = ~0u;
     if (level.fraction >= 0) {
@@ -51,6 +56,8 @@ Result loadInput(const std::string& path, Input& in, const LevelOption& level, c
   Result r = readMesh(path, in.mesh, report, read);
   in.format = report.format;
   in.notes = report.notes;
+  in.steps = report.steps;
+  in.stepRead = report.stepRead;
   if (r && in.mesh.name.empty()) in.mesh.name = std::filesystem::path(path).stem().string();
   return r;
 }

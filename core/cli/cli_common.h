@@ -32,9 +32,12 @@ struct Input {
   uint32_t splitsApplied = 0;      // when packed: vertex splits applied
   std::vector<std::string> notes;  // what the reader did (converted fields, skipped cells)
   std::string format;              // mesh files: what the reader read (ReadReport::format)
+  std::vector<TimeStep> steps;     // mesh files with time steps: all of them
+  uint64_t stepRead = 0;           // ... and the one read
 };
 
-// --q FILE: the solution file of a PLOT3D grid (Q) or of a Medit mesh (.sol).
+// --q FILE: the solution file of a PLOT3D grid (Q) or of a Medit mesh (.sol); --step K or
+// --time T: the time step of a file with several.
 void addReadOptions(CLI::App* sub, ReadOptions& read);
 
 // A packed dataset folder (with manifest.json) or a mesh file (any format readMesh reads).

@@ -61,6 +61,12 @@ Runner addInfo(CLI::App& app) {
       if (!in.packed) {
         j["inputFormat"] = in.format;
         j["readMs"] = readMs;
+        if (!in.steps.empty()) {
+          json steps = json::array();
+          for (const TimeStep& s : in.steps) steps.push_back({{"index", s.index}, {"time", s.time}});
+          j["steps"] = steps;
+          j["stepRead"] = in.stepRead;
+        }
       }
       if (in.packed) {
         j["format"] = {{"formatVersion", in.manifest.formatVersion}, {"generator", in.manifest.generator},
@@ -75,6 +81,21 @@ Runner addInfo(CLI::App& app) {
     std::printf("%s%s\n", o->input.c_str(), in.packed ? " (packed dataset)" : "");
     std::printf("  name      %s\n", m.name.c_str());
     if (!in.packed) std::printf("  read      %s in %.0f ms\n", in.format.c_str(), readMs);
+    if (!in.steps.empty()) {
+      std::printf("  steps     %zu, read step %llu (t = %g)\n", in.steps.size(),
+                  static_cast<unsigned long long>(in.stepRead), in.steps[in.stepRead].time);
+      // A long run lists its first and last steps (--json has them all).
+      const size_t n = in.steps.size(), shown = 5;
+      for (size_t i = 0; i < n; ++i) {
+        if (n > 2 * shown + 2 && i == shown) {
+          std::printf("  step      ... %zu more\n", n - 2 * shown);
+          i = n - shown - 1;
+          continue;
+        }
+        std::printf("  step      %4llu  t = %g\n", static_cast<unsigned long long>(in.steps[i].index),
+                    in.steps[i].time);
+      }
+    }
     std::printf("  vertices  %u\n  tets      %u\n", m.vertexCount(), m.tetCount());
     std::printf("  bounds    [%g, %g, %g] .. [%g, %g, %g]\n", b.min[0], b.min[1], b.min[2], b.max[0], b.max[1],
                 b.max[2]);

@@ -52,10 +52,10 @@ std::string smallInputTunables(const char* userTunables) {
 // of a pack's time. glibc asks the kernel for huge pages (2 MB, one fault instead of 512) when
 // the tunable glibc.malloc.hugetlb=1 is set at start, and a running program cannot set it for
 // itself: so the program starts itself again, once, with it set. The output is the same; peak
-// memory grows by a few percent. The second start is cheap because the CLI is linked statically
-// (cmake/static_cli.cmake). A file's size does not tell a small mesh from a large one (a
-// structured grid's file is tiny), so every command that reads an input does it (all but gen).
-// Not done when the kernel gives huge pages to every program anyway ("always") or to none
+// memory grows by a few percent. The second start costs what the dynamic loader takes (a few
+// ms to about 20 with the HPC container libraries), nothing next to a pack it speeds up. A file's size does not tell a
+// small mesh from a large one (a structured grid's file is tiny), so every command that reads an input does it (all but
+// gen). Not done when the kernel gives huge pages to every program anyway ("always") or to none
 // ("never"), when the tunable is set already, under valgrind (its tools would lose the program)
 // or with TETSTREAM_HUGE_PAGES=0. Nor where a first touch is cheap (kCheapPageMicroseconds):
 // there fewer faults can gain little, and huge pages can cost (slower reading).

@@ -74,6 +74,13 @@ Format sniff(std::string_view head, const std::string& ext) {
   return Format::Unknown;
 }
 
+// The formats that can hold several time steps (and so take --step and --time).
+bool hasTimeSteps(Format f) {
+  switch (f) {
+    default: return false;
+  }
+}
+
 const char* formatName(Format f) {
   switch (f) {
     case Format::VtkXml: return "VTK XML";
@@ -205,6 +212,9 @@ Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const
       return fail(Status::Unsupported,
                   path + ": unsupported mesh format '" + ext + "' (content not recognized); " + kSupported);
   }
+  if ((options.step || options.time) && !hasTimeSteps(fmt))
+    return fail(Status::BadArgument, path + ": a " + formatName(fmt) +
+                                         " file holds one state; --step and --time apply to files with time steps");
   if (!options.solution.empty() && fmt != Format::Plot3d && fmt != Format::Medit)
     return fail(Status::BadArgument, path + ": a solution file (--q " + options.solution +
                                          ") goes with a PLOT3D grid or a Medit mesh, and this is " + formatName(fmt));

@@ -27,6 +27,7 @@
 // On failure `out` is left empty; notes gathered so far stay in the report.
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -42,10 +43,18 @@ struct SkippedCells {
   uint64_t count = 0;
 };
 
+// One state of a file that holds several (the time steps of a transient result).
+struct TimeStep {
+  uint64_t index = 0;  // 0-based, in the file's order
+  double time = 0;     // the simulation time the file gives it
+};
+
 struct ReadReport {
   std::string format;              // what was read, e.g. "VTK XML UnstructuredGrid (appended raw, zlib, UInt64 header)"
   std::vector<std::string> notes;  // human-readable, one line each, in the order they happened
   std::vector<SkippedCells> skippedCells;  // by VTK type, ascending
+  std::vector<TimeStep> steps;             // every time step of the file; empty for a single state
+  uint64_t stepRead = 0;                   // the index of the step that was read (when steps is not empty)
 };
 
 struct ReadOptions {
@@ -53,6 +62,11 @@ struct ReadOptions {
   // for a sibling ("bluntfinxyz.bin" -> "bluntfinq.bin", "wing.x" -> "wing.q"), a Medit mesh for
   // NAME.sol.
   std::string solution;
+  // Which time step of a file with several: by index, or the one nearest a simulation time. Neither:
+  // the last (the end state of a run, what a user usually looks at first). A file of one state
+  // refuses either with BadArgument.
+  std::optional<uint64_t> step;
+  std::optional<double> time;
 };
 
 // Reads a mesh file, choosing the reader by extension (case-insensitive): .vtu/.vts/.vti, .vtk,

@@ -200,6 +200,14 @@ void addField(TetMesh& mesh, ScalarField field, ReadReport& report);
 Result finishMesh(const std::string& label, TetMesh& mesh, CellSoup& soup, std::vector<CellArray> cellArrays,
                   ReadReport& report);
 
+// ------------------------------------------------------------------ time steps (time_steps.cpp)
+// Picks the step to read from a file's step times (in file order) by options.step, options.time
+// (the nearest step, with a note when not exact) or, by default, the last (with a note naming
+// how many there are). Fills report.steps and report.stepRead. Empty `times` (one state) is
+// index 0, and then --step or --time is a BadArgument, as is an index past the end.
+Result chooseTimeStep(std::span<const double> times, const ReadOptions& options, const std::string& label,
+                      ReadReport& report, size_t& index);
+
 // Whitespace-separated text with '#' comments (TetGen, Medit), with line numbers for messages.
 struct TextReader {
   std::string label;
