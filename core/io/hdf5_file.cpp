@@ -1,8 +1,8 @@
 #include "io/hdf5_file.h"
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
-#include <filesystem>
 
 namespace tetstream::hdf5 {
 namespace {
@@ -19,6 +19,7 @@ void silenceLibrary() {
 
 // Bounds on what a file may declare before it is believed.
 constexpr int kMaxRank = 32;
+constexpr size_t kMaxPath = 4096;  // characters of an object's path
 constexpr hsize_t kMaxMembers = 1u << 20;
 // Filters (deflate, szip, ...) shrink data; deflate tops out near 1032:1. A selection that needs
 // more than this many times the bytes stored for its dataset is refused before it is allocated.
@@ -92,9 +93,11 @@ std::string File::where(const std::string& object, const char* kind) const {
   return path_ + ": " + kind + " '" + object + "'";
 }
 
-bool File::exists(const std::string& object) const {
-  if (!file_.valid()) return false;
-  if (object.empty() || object == "/") return true;
+bool File::exists(const std::string& object) const { return find(object) == Found::Here; }
+
+File::Found File::find(const std::string& object) const {
+  if (!file_.valid() || object.size() > kMaxPath) return Found::Missing;
+  if (object.empty() || object == "/") return Found::Here;
   // H5Lexists fails (rather than says no) when an intermediate group is missing: walk the path.
   std::string prefix;
   size_t pos = object[0] == '/' ? 1 : 0;
@@ -108,19 +111,26 @@ bool File::exists(const std::string& object) const {
       const htri_t r = H5Lexists(file_.get(), prefix.c_str(), H5P_DEFAULT);
       if (r <= 0) {
         lastError();
-        return false;
+        return Found::Missing;
       }
+      // Links to other files are not followed: the data must be in this file.
+      H5L_info_t link;
+      if (H5Lget_info(file_.get(), prefix.c_str(), &link, H5P_DEFAULT) < 0) {
+        lastError();
+        return Found::Missing;
+      }
+      if (link.type == H5L_TYPE_EXTERNAL) return Found::OtherFile;
       // A link can dangle (soft or external links): the object must open too.
       const hid_t o = H5Oopen(file_.get(), prefix.c_str(), H5P_DEFAULT);
       if (o < 0) {
         lastError();
-        return false;
+        return Found::Missing;
       }
       H5Oclose(o);
     }
     pos = e + 1;
   }
-  return true;
+  return Found::Here;
 }
 
 bool File::isGroup(const std::string& object) const {
@@ -158,7 +168,11 @@ Result File::members(const std::string& group, std::vector<std::string>& names) 
 
 Result File::shape(const std::string& dataset, Shape& out) const {
   out = Shape{};
-  if (!exists(dataset)) return fail(Status::Corrupt, where(dataset) + " does not exist");
+  if (const Found f = find(dataset); f != Found::Here)
+    return fail(
+        f == Found::OtherFile ? Status::Unsupported : Status::Corrupt,
+        where(dataset) + (f == Found::OtherFile ? " is a link into another file, which tetstream does not follow"
+                                                : " does not exist"));
   Handle ds(H5Dopen2(file_.get(), dataset.c_str(), H5P_DEFAULT), H5Dclose);
   if (!ds.valid()) return fail(Status::Corrupt, withLibraryMessage(where(dataset) + " is not a dataset"));
   Handle space(H5Dget_space(ds.get()), H5Sclose);
@@ -221,10 +235,16 @@ Result File::select(const std::string& dataset, const Slab& slab, uint64_t expec
                                      " values where " + std::to_string(expect) + " are needed");
   if (count == 0) return Result::success();
 
-  // Storage against shape: a selection cannot need more bytes than the file keeps for the
-  // dataset (a few thousand times more when it is compressed).
+  // The data must be in this file: datasets stored in external raw files or mapped from other
+  // files (virtual datasets) could name any file on the machine.
   Handle type(H5Dget_type(ds.get()), H5Tclose);
   Handle dcpl(H5Dget_create_plist(ds.get()), H5Pclose);
+  if (dcpl.valid() && (H5Pget_external_count(dcpl.get()) > 0 || H5Pget_layout(dcpl.get()) == H5D_VIRTUAL))
+    return fail(Status::Unsupported, where(dataset) +
+                                         " keeps its data in other files (external storage or a "
+                                         "virtual dataset), which tetstream does not follow");
+  // Storage against shape: a selection cannot need more bytes than the file keeps for the
+  // dataset (a few thousand times more when it is compressed).
   const uint64_t elementBytes = type.valid() ? H5Tget_size(type.get()) : 0;
   const uint64_t stored = H5Dget_storage_size(ds.get());
   const int filters = dcpl.valid() ? H5Pget_nfilters(dcpl.get()) : 0;

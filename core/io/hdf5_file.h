@@ -72,7 +72,8 @@ class File {
   Result open(const std::string& path);
   const std::string& path() const { return path_; }
 
-  // Whether `object` (a path such as "/VTKHDF/PointData") names a group or a dataset.
+  // Whether `object` (a path such as "/VTKHDF/PointData") names a group or a dataset of this
+  // file (links into other files count as absent).
   bool exists(const std::string& object) const;
   bool isGroup(const std::string& object) const;
   // The names of a group's members, in name order.
@@ -97,6 +98,9 @@ class File {
   std::string where(const std::string& object, const char* kind = "dataset") const;
 
  private:
+  // Whether `object` is in this file, missing, or behind a link into another file.
+  enum class Found { Here, Missing, OtherFile };
+  Found find(const std::string& object) const;
   // Opens the dataset and selects `slab` in it, checked against its shape and storage.
   Result select(const std::string& dataset, const Slab& slab, uint64_t expect, Handle& ds, Handle& fileSpace,
                 Handle& memSpace) const;

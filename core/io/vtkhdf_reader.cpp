@@ -25,6 +25,7 @@ namespace {
 using namespace vtkio;
 
 const std::string kRoot = "/VTKHDF";
+constexpr int64_t kMaxPartitions = int64_t(1) << 24;  // far beyond any run's rank count
 
 std::string number(double v) {
   char buf[32];
@@ -133,6 +134,9 @@ Result readVtkHdf(const std::string& path, const ReadOptions& options, TetMesh& 
     parts = int64_t(shape.count());
   }
   if (parts <= 0) return fail(Status::NoTets, path + ": no partitions" + (temporal ? " in this step" : std::string()));
+  if (parts > kMaxPartitions)
+    return fail(Status::TooLarge, path + ": " + std::to_string(parts) + " partitions (at most " +
+                                      std::to_string(kMaxPartitions) + " are read)");
 
   // Partition sizes, then every array's rows for them.
   std::vector<int64_t> np, nc, nconn;

@@ -694,11 +694,15 @@ struct VtkHdfWriter {
     H5Dclose(d);
     H5Sclose(space);
   }
-  void points(const std::vector<double>& p) {
+  // Points in the file, or (`externalFile`) kept in a raw file elsewhere (HDF5 external storage).
+  void points(const std::vector<double>& p, const char* externalFile = nullptr) {
     const hsize_t dims[2] = {p.size() / 3, 3};
     hid_t space = H5Screate_simple(2, dims, nullptr);
-    hid_t d = H5Dcreate2(root, "Points", H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-    H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, p.data());
+    hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+    if (externalFile) H5Pset_external(dcpl, externalFile, 0, hsize_t(p.size() * 8));
+    hid_t d = H5Dcreate2(root, "Points", H5T_IEEE_F64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+    if (!externalFile) H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, p.data());
+    H5Pclose(dcpl);
     H5Dclose(d);
     H5Sclose(space);
   }
@@ -708,13 +712,19 @@ struct VtkHdfWriter {
   }
 };
 
+enum class PointsAt { Here, ExternalStorage, ExternalLink };
+
 void writeTwoTets(const std::string& path, std::vector<int64_t> counts, std::vector<int64_t> conn,
-                  const char* type = "UnstructuredGrid") {
+                  const char* type = "UnstructuredGrid", PointsAt at = PointsAt::Here) {
   VtkHdfWriter w(path, type);
   w.ints("NumberOfPoints", {counts[0]});
   w.ints("NumberOfCells", {counts[1]});
   w.ints("NumberOfConnectivityIds", {counts[2]});
-  w.points({0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1});
+  if (at == PointsAt::ExternalLink)
+    H5Lcreate_external("other.h5", "/VTKHDF/Points", w.root, "Points", H5P_DEFAULT, H5P_DEFAULT);
+  else
+    w.points({0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1},
+             at == PointsAt::ExternalStorage ? "/etc/hostname" : nullptr);
   w.ints("Types", {10, 10});
   w.ints("Offsets", {0, 4, 8});
   w.ints("Connectivity", conn);
@@ -749,6 +759,14 @@ TEST(VtkHdfDamaged, CountsIdsAndTypesAreChecked) {
   const std::string image = dir.path + "/image.vtkhdf";
   writeTwoTets(image, {5, 2, 8}, {0, 1, 2, 3, 4, 1, 3, 2}, "ImageData");
   EXPECT_FAILS(read(image, m, r), Status::Unsupported, "VTKHDF Type 'ImageData' is not read");
+
+  // Data in other files is not followed: an external link, raw external storage.
+  const std::string link = dir.path + "/link.vtkhdf";
+  writeTwoTets(link, {5, 2, 8}, {0, 1, 2, 3, 4, 1, 3, 2}, "UnstructuredGrid", PointsAt::ExternalLink);
+  EXPECT_FAILS(read(link, m, r), Status::Unsupported, "'/VTKHDF/Points' is a link into another file");
+  const std::string external = dir.path + "/external.vtkhdf";
+  writeTwoTets(external, {5, 2, 8}, {0, 1, 2, 3, 4, 1, 3, 2}, "UnstructuredGrid", PointsAt::ExternalStorage);
+  EXPECT_FAILS(read(external, m, r), Status::Unsupported, "keeps its data in other files");
 
   // Cut in half: the library refuses it, and the message says so and names the file.
   const std::string whole = loadFile(hpcPath("vtkhdf_parts.vtkhdf"));
