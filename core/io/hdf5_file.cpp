@@ -263,8 +263,13 @@ Result File::select(const std::string& dataset, const Slab& slab, uint64_t expec
     if (H5Sselect_hyperslab(fileSpace.get(), H5S_SELECT_SET, start.data(), stride.data(), cnt.data(), nullptr) < 0)
       return fail(Status::Corrupt, withLibraryMessage(where(dataset) + ": the selection is refused"));
   }
-  const hsize_t n = count;
-  memSpace = Handle(H5Screate_simple(1, &n, nullptr), H5Sclose);
+  // Memory laid out like the selection (same rank and counts): with a flat one, HDF5 maps a
+  // chunked dataset element by element (a 1M-tet topology in gzip chunks of one column: 2.9 s
+  // against 0.3 s).
+  std::vector<hsize_t> memDims = slab.all() ? std::vector<hsize_t>(sh.dims.begin(), sh.dims.end())
+                                            : std::vector<hsize_t>(slab.count.begin(), slab.count.end());
+  memSpace = memDims.empty() ? Handle(H5Screate(H5S_SCALAR), H5Sclose)
+                             : Handle(H5Screate_simple(int(memDims.size()), memDims.data(), nullptr), H5Sclose);
   if (!memSpace.valid()) return fail(Status::TooLarge, withLibraryMessage(where(dataset) + ": no memory space"));
   return Result::success();
 }
