@@ -19,10 +19,13 @@
 //     "Other") are read through their dofs (xdmf_function.h); vectors and tensors become their
 //     magnitude. An attribute survives only if every piece has it.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <map>
+#include <set>
 
 #include "io/readers.h"
 #include "io/xdmf_document.h"
@@ -148,14 +151,15 @@ class XdmfReader {
                    std::vector<double>& times);
   Result sameMesh(pugi::xml_node a, pugi::xml_node b, const std::string& what, bool& same);
   Result readPiece(pugi::xml_node grid, const std::vector<pugi::xml_node>& companions, const std::string& where,
-                   bool first, PieceArrays& arrays, bool& skipped);
+                   bool first, PieceArrays& arrays, bool& skipped, bool& sharedPoints);
+  void dropRepeatedCells(size_t firstNew, uint64_t vertexBase, uint64_t points, const std::string& where);
   Result readCells(pugi::xml_node topo, const TopologyKind* kind, const std::string& where, uint64_t points,
                    uint64_t vertexBase, std::vector<int64_t>& conn, int& nodes, uint64_t& cells);
   Result readMixed(const std::vector<int64_t>& values, const std::string& where, uint64_t points, uint64_t vertexBase,
                    uint64_t& cells);
   Result readPoints(pugi::xml_node geo, const std::string& where, uint64_t& points);
   Result readAttributes(const std::vector<pugi::xml_node>& attributes, const std::string& where,
-                        const xdmf::GridCells& grid, bool first, PieceArrays& arrays);
+                        const xdmf::GridCells& grid, bool first, bool sharedPoints, PieceArrays& arrays);
 
   Document& doc_;
   const ReadOptions& options_;
@@ -163,6 +167,9 @@ class XdmfReader {
   TetMesh mesh_;
   CellSoup soup_;
   std::vector<std::string> topologies_;  // read, in order, for ReadReport::format
+  // Geometry elements read so far (after references): their first vertex and point count. A
+  // grid on the points of an earlier one adds its cells to those points.
+  std::map<const void*, std::pair<uint64_t, uint64_t>> geometries_;
 };
 
 Result XdmfReader::flatten(pugi::xml_node grid, const std::string& what, int depth,
@@ -445,7 +452,7 @@ Result XdmfReader::readCells(pugi::xml_node topo, const TopologyKind* kind, cons
 }
 
 Result XdmfReader::readAttributes(const std::vector<pugi::xml_node>& attributes, const std::string& where,
-                                  const xdmf::GridCells& grid, bool first, PieceArrays& arrays) {
+                                  const xdmf::GridCells& grid, bool first, bool sharedPoints, PieceArrays& arrays) {
   ReadReport scratch;  // conversions are noted for the first piece only
   ReadReport& notes = first ? report_ : scratch;
   int index = 0;
@@ -467,6 +474,11 @@ Result XdmfReader::readAttributes(const std::vector<pugi::xml_node>& attributes,
       continue;
     }
     const bool node = iequals(center, "Node"), cell = iequals(center, "Cell");
+    if (node && sharedPoints) {
+      report_.notes.push_back(where + ": skipped point attribute '" + printable(name) +
+                              "' (the grid stands on the points of an earlier grid, whose point data is read)");
+      continue;
+    }
     if (!node && !cell) {
       notes.notes.push_back("skipped attribute '" + printable(name) + "' with Center=\"" + printable(center) +
                             "\" (tetstream reads Node and Cell data)");
@@ -493,9 +505,53 @@ Result XdmfReader::readAttributes(const std::vector<pugi::xml_node>& attributes,
   return Result::success();
 }
 
+// Cells of a grid that repeat cells already read on the same points (the same corners in any
+// order) are taken out again: DOLFINx writes its cell tags as a second grid of the mesh's cells.
+void XdmfReader::dropRepeatedCells(size_t firstNew, uint64_t vertexBase, uint64_t points, const std::string& where) {
+  using Key = std::array<uint32_t, 8>;
+  auto keyOf = [](const uint32_t* ids, int n) {
+    Key k;
+    k.fill(UINT32_MAX);
+    std::copy(ids, ids + n, k.begin());
+    std::sort(k.begin(), k.begin() + n);
+    return k;
+  };
+  std::set<Key> earlier;
+  size_t at = 0;
+  for (size_t c = 0; c < firstNew; ++c) {
+    const int n = kShapeCorners[soup_.shapes[c]];
+    if (soup_.corners[at] >= vertexBase && soup_.corners[at] < vertexBase + points)
+      earlier.insert(keyOf(&soup_.corners[at], n));
+    at += size_t(n);
+  }
+  size_t write = firstNew, writeAt = at;
+  uint64_t dropped = 0;
+  for (size_t c = firstNew; c < soup_.shapes.size(); ++c) {
+    const int n = kShapeCorners[soup_.shapes[c]];
+    if (earlier.count(keyOf(&soup_.corners[at], n))) {
+      ++dropped;
+    } else {
+      soup_.shapes[write] = soup_.shapes[c];
+      soup_.source[write] = soup_.source[c];
+      std::copy_n(&soup_.corners[at], n, &soup_.corners[writeAt]);
+      ++write;
+      writeAt += size_t(n);
+    }
+    at += size_t(n);
+  }
+  soup_.shapes.resize(write);
+  soup_.source.resize(write);
+  soup_.corners.resize(writeAt);
+  if (dropped)
+    report_.notes.push_back(where + ": " + std::to_string(dropped) +
+                            " cells repeat cells of an earlier grid on the same points (mesh tags?); not added again");
+}
+
 Result XdmfReader::readPiece(pugi::xml_node grid, const std::vector<pugi::xml_node>& companions,
-                             const std::string& where, bool first, PieceArrays& arrays, bool& skipped) {
+                             const std::string& where, bool first, PieceArrays& arrays, bool& skipped,
+                             bool& sharedPoints) {
   skipped = false;
+  sharedPoints = false;
   std::vector<pugi::xml_node> topos, geos;
   if (Result r = doc_.children(grid, "Topology", where, topos); !r) return r;
   if (topos.size() != 1)
@@ -538,12 +594,20 @@ Result XdmfReader::readPiece(pugi::xml_node grid, const std::vector<pugi::xml_no
   if (geos.size() != 1)
     return fail(Status::Corrupt, where + ": " + (geos.empty() ? "no <Geometry>" : "more than one <Geometry>"));
 
-  const uint64_t vertexBase = mesh_.positions.size() / 3;
-  uint64_t points = 0, cells = 0;
-  if (Result r = readPoints(geos[0], where, points); !r) return r;
+  uint64_t vertexBase = mesh_.positions.size() / 3, points = 0, cells = 0;
+  if (auto seen = geometries_.find(geos[0].internal_object()); seen != geometries_.end()) {
+    sharedPoints = true;
+    vertexBase = seen->second.first;
+    points = seen->second.second;
+  } else {
+    if (Result r = readPoints(geos[0], where, points); !r) return r;
+    geometries_[geos[0].internal_object()] = {vertexBase, points};
+  }
   std::vector<int64_t> conn;
   int nodes = 0;
+  const size_t firstNew = soup_.shapes.size();
   if (Result r = readCells(topo, kind, where, points, vertexBase, conn, nodes, cells); !r) return r;
+  if (sharedPoints) dropRepeatedCells(firstNew, vertexBase, points, where);
   const std::string name = mixed ? "Mixed" : kind->name;
   if (std::find(topologies_.begin(), topologies_.end(), name) == topologies_.end()) topologies_.push_back(name);
 
@@ -560,7 +624,7 @@ Result XdmfReader::readPiece(pugi::xml_node grid, const std::vector<pugi::xml_no
   gc.nodes = nodes;
   gc.corners = kind ? kShapeCorners[int(vtkCellInfo(kind->vtk).shape)] : 0;
   gc.points = points;
-  return readAttributes(attributes, where, gc, first, arrays);
+  return readAttributes(attributes, where, gc, first, sharedPoints, arrays);
 }
 
 Result XdmfReader::read(TetMesh& out) {
@@ -638,9 +702,9 @@ Result XdmfReader::read(TetMesh& out) {
     const std::string name = gridName(pieces[k]);
     std::string where = label + " Grid" + (name.empty() ? " " + std::to_string(k) : " '" + name + "'");
     PieceArrays pa;
-    bool skipped = false;
-    if (Result r =
-            readPiece(pieces[k], k == 0 ? companions : std::vector<pugi::xml_node>{}, where, read == 0, pa, skipped);
+    bool skipped = false, shared = false;
+    if (Result r = readPiece(pieces[k], k == 0 ? companions : std::vector<pugi::xml_node>{}, where, read == 0, pa,
+                             skipped, shared);
         !r)
       return r;
     if (skipped) continue;
@@ -663,7 +727,7 @@ Result XdmfReader::read(TetMesh& out) {
         }
       }
     };
-    join(merged.fields, pa.fields, keepField, "point");
+    if (!shared) join(merged.fields, pa.fields, keepField, "point");  // (its points are an earlier grid's)
     join(merged.cellArrays, pa.cellArrays, keepCell, "cell");
   }
   for (size_t i = 0; i < merged.fields.size(); ++i)

@@ -602,6 +602,51 @@ TEST(XdmfReader, DolfinxStyleFunctionsShareTheMesh) {
   EXPECT_TRUE(hasNote(r, "read the time series 'u' with 1 more")) << allNotes(r);
 }
 
+TEST(XdmfReader, GridsOnTheSamePoints) {
+  // DOLFINx's write_mesh + write_meshtags: the cell tags are a second grid of (some of) the
+  // mesh's cells on the mesh's Geometry, the facet tags a grid of triangles. Neither adds cells.
+  const std::string tags = R"x(<Xdmf Version="3.0" xmlns:xi="http://www.w3.org/2001/XInclude"><Domain>
+<Grid Name="mesh" GridType="Uniform">
+<Topology TopologyType="Tetrahedron" NumberOfElements="2" NodesPerElement="4"><DataItem Dimensions="2 4" NumberType="Int" Format="XML">0 1 2 3 4 1 3 2</DataItem></Topology>
+<Geometry GeometryType="XYZ"><DataItem Dimensions="5 3" Format="XML">0 0 0 1 0 0 0 1 0 0 0 1 1 1 1</DataItem></Geometry>
+<Attribute Name="f" Center="Node"><DataItem Dimensions="5" Format="XML">0 1 2 3 4</DataItem></Attribute></Grid>
+<Grid Name="cell_tags" GridType="Uniform"><xi:include xpointer="xpointer(/Xdmf/Domain/Grid/Geometry)"/>
+<Topology TopologyType="Tetrahedron" NumberOfElements="2" NodesPerElement="4"><DataItem Dimensions="2 4" NumberType="Int" Format="XML">3 2 1 0 2 3 1 4</DataItem></Topology>
+<Attribute Name="cell_tags" Center="Cell"><DataItem Dimensions="2" Format="XML">7 8</DataItem></Attribute></Grid>
+<Grid Name="facet_tags" GridType="Uniform"><xi:include xpointer="xpointer(/Xdmf/Domain/Grid/Geometry)"/>
+<Topology TopologyType="Triangle" NumberOfElements="1" NodesPerElement="3"><DataItem Dimensions="1 3" NumberType="Int" Format="XML">0 1 2</DataItem></Topology>
+<Attribute Name="facet_tags" Center="Cell"><DataItem Dimensions="1" Format="XML">3</DataItem></Attribute></Grid>
+</Domain></Xdmf>)x";
+  TetMesh m;
+  ReadReport r;
+  Result res = readText(tags, m, r);
+  ASSERT_TRUE(res) << res.message;
+  EXPECT_EQ(m.tetCount(), 2u) << allNotes(r);
+  EXPECT_EQ(m.vertexCount(), 5u);
+  EXPECT_GE(m.findField("f"), 0);
+  EXPECT_TRUE(hasNote(r, "Grid 'cell_tags': 2 cells repeat cells of an earlier grid")) << allNotes(r);
+  EXPECT_TRUE(hasNote(r, "Grid 'facet_tags': 1 Triangle cells")) << allNotes(r);
+  expectValid(m, "mesh with tags");
+
+  // Two blocks of different cells on one shared Geometry: both are read, on the same points.
+  const std::string blocks = R"x(<Xdmf Version="2.0"><Domain>
+<Geometry Name="points" GeometryType="XYZ"><DataItem Dimensions="5 3" Format="XML">0 0 0 1 0 0 0 1 0 0 0 1 1 1 1</DataItem></Geometry>
+<Grid Name="a"><Topology TopologyType="Tetrahedron"><DataItem Dimensions="1 4" Format="XML" NumberType="Int">0 1 2 3</DataItem></Topology>
+<Geometry Reference="/Xdmf/Domain/Geometry[1]"/><Attribute Name="mat" Center="Cell"><DataItem Dimensions="1" Format="XML">1</DataItem></Attribute></Grid>
+<Grid Name="b"><Topology TopologyType="Tetrahedron"><DataItem Dimensions="1 4" Format="XML" NumberType="Int">4 1 3 2</DataItem></Topology>
+<Geometry Reference="/Xdmf/Domain/Geometry[1]"/><Attribute Name="mat" Center="Cell"><DataItem Dimensions="1" Format="XML">2</DataItem></Attribute></Grid>
+</Domain></Xdmf>)x";
+  res = readText(blocks, m, r);
+  ASSERT_TRUE(res) << res.message;
+  EXPECT_EQ(m.tetCount(), 2u) << allNotes(r);
+  EXPECT_EQ(m.vertexCount(), 5u);
+  const int mat = m.findField("mat");
+  ASSERT_GE(mat, 0) << allNotes(r);
+  EXPECT_FLOAT_EQ(m.fields[size_t(mat)].values[size_t(findVertex(m, 0, 0, 0))], 1.0f);
+  EXPECT_FLOAT_EQ(m.fields[size_t(mat)].values[size_t(findVertex(m, 1, 1, 1))], 2.0f);
+  EXPECT_FALSE(hasNote(r, "merged")) << "the points are read once" << allNotes(r);
+}
+
 TEST(XdmfReader, LegacyDolfinFunctionThroughItsDofs) {
   // write_checkpoint's layout for two P1 tets (CG1) and for DG0: cell_dofs, vector, x_cell_dofs,
   // cells. The dofs are numbered apart from the vertices: dof of vertex v is 4 - v.
