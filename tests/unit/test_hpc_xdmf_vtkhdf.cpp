@@ -602,6 +602,41 @@ TEST(XdmfReader, DolfinxStyleFunctionsShareTheMesh) {
   EXPECT_TRUE(hasNote(r, "read the time series 'u' with 1 more")) << allNotes(r);
 }
 
+TEST(XdmfReader, BinaryDataWithEndianAndSeek) {
+  // Points as big-endian doubles after 16 bytes of something else, ids as little-endian Int32.
+  ScratchDir dir("xdmf-binary");
+  const double p[15] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1};
+  std::string points(16, 'x');
+  for (double v : p) {
+    uint64_t bits;
+    std::memcpy(&bits, &v, 8);
+    for (int b = 7; b >= 0; --b) points += char(bits >> (8 * b));
+  }
+  std::string ids;
+  for (int32_t v : {0, 1, 2, 3, 4, 1, 3, 2})
+    for (int b = 0; b < 4; ++b) ids += char(uint32_t(v) >> (8 * b));
+  ASSERT_TRUE(saveFile(dir.path + "/points.bin", points));
+  ASSERT_TRUE(saveFile(dir.path + "/ids.bin", ids));
+  auto xdmf = [&](const char* seek) {
+    return std::string(R"(<Xdmf Version="2.0"><Domain><Grid Name="g">
+<Topology TopologyType="Tetrahedron"><DataItem Dimensions="2 4" NumberType="Int" Precision="4" Endian="Little" Format="Binary">ids.bin</DataItem></Topology>
+<Geometry GeometryType="XYZ"><DataItem Dimensions="5 3" Precision="8" Endian="Big" Seek=")") +
+           seek + R"(" Format="Binary">points.bin</DataItem></Geometry></Grid></Domain></Xdmf>)";
+  };
+  ASSERT_TRUE(saveFile(dir.path + "/b.xmf", xdmf("16")));
+  TetMesh m;
+  ReadReport r;
+  Result res = read(dir.path + "/b.xmf", m, r);
+  ASSERT_TRUE(res) << res.message;
+  EXPECT_EQ(m.tetCount(), 2u);
+  ASSERT_EQ(m.positions.size(), 15u);
+  for (int i = 0; i < 15; ++i) EXPECT_EQ(m.positions[size_t(i)], float(p[i]));
+  EXPECT_NE(r.format.find("XDMF 2 (binary data)"), std::string::npos) << r.format;
+  ASSERT_TRUE(saveFile(dir.path + "/b.xmf", xdmf("40")));
+  EXPECT_FAILS(read(dir.path + "/b.xmf", m, r), Status::Truncated,
+               "(points.bin): needs 120 bytes from byte 40, the file has 136");
+}
+
 TEST(XdmfReader, GridsOnTheSamePoints) {
   // DOLFINx's write_mesh + write_meshtags: the cell tags are a second grid of (some of) the
   // mesh's cells on the mesh's Geometry, the facet tags a grid of triangles. Neither adds cells.
