@@ -17,6 +17,12 @@ namespace {
 using vtkio::ScalarType;
 
 constexpr int kMaxReferenceDepth = 8;
+// DataItems inside DataItems (HyperSlab, Function) nest at most this deep, a JOIN takes at most
+// kMaxJoin items, and one read reads at most kMaxItemReads items in all: nested JOINs that
+// point back at JOINs would otherwise multiply (kMaxJoin^depth reads from a few lines of XML).
+constexpr int kMaxItemDepth = 4;
+constexpr size_t kMaxJoin = 16;
+constexpr size_t kMaxItemReads = size_t(1) << 20;
 constexpr size_t kMaxRank = 8;
 constexpr uint64_t kMaxDimension = uint64_t(1) << 40;
 // Elements handed out by children() in one read: far above any real file's count (a time series
@@ -335,8 +341,11 @@ Result Document::integers(pugi::xml_node item, const std::string& what, Values<i
 template <class T>
 Result Document::read(pugi::xml_node item, const std::string& what, int depth, Values<T>& out) {
   out = Values<T>{};
-  if (depth > kMaxReferenceDepth)
-    return fail(Status::Corrupt, what + ": DataItems nest more than " + std::to_string(kMaxReferenceDepth) + " deep");
+  if (depth > kMaxItemDepth)
+    return fail(Status::Corrupt, what + ": DataItems nest more than " + std::to_string(kMaxItemDepth) + " deep");
+  if (++itemReads_ > kMaxItemReads)
+    return fail(Status::TooLarge,
+                what + ": more than " + std::to_string(kMaxItemReads) + " DataItems to read (Functions of Functions?)");
   pugi::xml_node node;
   if (Result r = follow(item, what, node); !r) return r;
   if (std::strcmp(node.name(), "DataItem") != 0)
@@ -396,7 +405,7 @@ Result Document::read(pugi::xml_node item, const std::string& what, int depth, V
         if (e == std::string_view::npos) e = args.size();
         std::string_view a = trim(args.substr(pos, e - pos));
         uint64_t k;
-        if (a.size() < 2 || a[0] != '$' || !vtkio::parseU64(a.substr(1), k) || k > 64) {
+        if (a.size() < 2 || a[0] != '$' || !vtkio::parseU64(a.substr(1), k) || k >= kMaxJoin) {
           order.clear();
           break;
         }
@@ -404,9 +413,10 @@ Result Document::read(pugi::xml_node item, const std::string& what, int depth, V
         pos = e + 1;
       }
     }
-    if (order.empty() || order.size() > 64)
-      return fail(Status::Unsupported,
-                  what + ": Function=\"" + vtkio::printable(f) + "\" (tetstream evaluates JOIN($0, $1, ...) only)");
+    if (order.empty() || order.size() > kMaxJoin)
+      return fail(Status::Unsupported, what + ": Function=\"" + vtkio::printable(f) +
+                                           "\" (tetstream evaluates JOIN($0, $1, ...) of up to " +
+                                           std::to_string(kMaxJoin) + " items only)");
     if (Result r = children(node, "DataItem", what, parts); !r) return r;
     std::vector<Values<T>> args(order.size());
     uint64_t n = 0;

@@ -90,7 +90,8 @@ class Document {
   std::map<std::string, std::vector<pugi::xml_node>, std::less<>> paths_;  // evaluated paths
   std::map<std::string, std::unique_ptr<hdf5::File>> files_;               // opened HDF5 files
   std::set<std::string> sources_;
-  size_t budget_ = 0;  // elements handed out by children(), against kElementBudget
+  size_t budget_ = 0;     // elements handed out by children(), against kElementBudget
+  size_t itemReads_ = 0;  // DataItems read, against kMaxItemReads
 };
 
 }  // namespace tetstream::xdmf

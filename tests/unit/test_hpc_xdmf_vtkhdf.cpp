@@ -496,6 +496,18 @@ TEST(XdmfHostile, HugeDimensionsCyclesAndUnknownPaths) {
   Result res = readText(selfInclude, m, r);
   EXPECT_FALSE(res);
   EXPECT_NE(res.message.find("t.xdmf"), std::string::npos) << res.message;
+  // JOINs of JOINs, each level by reference to the next: refused by depth, not read 16^6 times.
+  std::string nested;
+  for (int level = 0; level < 6; ++level) {
+    nested += "<DataItem Name=\"j" + std::to_string(level) + R"x(" ItemType="Function" Function="JOIN($0)">)x";
+    nested += level < 5 ? "<DataItem Reference=\"/Xdmf/Domain/DataItem[@Name='j" + std::to_string(level + 1) + "']\"/>"
+                        : std::string(R"(<DataItem Dimensions="5" Format="XML">1 2 3 4 5</DataItem>)");
+    nested += "</DataItem>";
+  }
+  std::string join =
+      twoTets(R"(<Attribute Name="f"><DataItem Reference="/Xdmf/Domain/DataItem[@Name='j0']"/></Attribute>)");
+  join.insert(join.find("<Grid"), nested);
+  EXPECT_FAILS(readText(join, m, r), Status::Corrupt, "DataItems nest more than 4 deep");
   // XPath outside the subset, another file, unknown formats.
   EXPECT_FAILS(
       readText(
