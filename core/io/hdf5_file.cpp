@@ -73,8 +73,14 @@ Result File::open(const std::string& path) {
   if (got < 8 || !hasSignature(std::string_view(head, got))) {
     if (H5Fis_hdf5(path.c_str()) <= 0) {
       lastError();
+      // .hdf is also HDF4's extension, a different format.
+      const bool hdf4 = got >= 4 && std::string_view(head, 4) == std::string_view("\x0e\x03\x13\x01", 4);
       return fail(got == 0 ? Status::Truncated : Status::BadMagic,
-                  path + ": not an HDF5 file (" + (got == 0 ? "empty" : "no HDF5 signature") + ")");
+                  path + ": not an HDF5 file (" +
+                      (got == 0 ? "empty"
+                       : hdf4   ? "it is HDF4, which tetstream does not read"
+                                : "no HDF5 signature") +
+                      ")");
     }
   }
   const hid_t id = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);

@@ -10,7 +10,9 @@
 //     times on the same mesh (DOLFINx writes one per function) add their attributes to it; the
 //     top-level grids outside the collections (DOLFINx's mesh grid) are what the steps refer to.
 //   - Without a temporal collection, every top-level grid is read; spatial collections and trees
-//     are flattened into pieces whose points are concatenated (coincident ones merged later).
+//     are flattened into pieces whose points are concatenated (coincident ones merged later). A
+//     grid whose Geometry is one already read (by reference or include) adds its cells to those
+//     points, less the cells it repeats (DOLFINx writes cell tags as such a grid).
 //   - Topology: Tetrahedron, Pyramid, Wedge, Hexahedron, their quadratic forms (corners kept) and
 //     Mixed; grids of surface, line or point cells (DOLFINx's facet tags) and cells of higher
 //     order than quadratic are counted and skipped without reading their data.
@@ -509,11 +511,14 @@ Result XdmfReader::readAttributes(const std::vector<pugi::xml_node>& attributes,
 // order) are taken out again: DOLFINx writes its cell tags as a second grid of the mesh's cells.
 void XdmfReader::dropRepeatedCells(size_t firstNew, uint64_t vertexBase, uint64_t points, const std::string& where) {
   using Key = std::array<uint32_t, 8>;
-  auto keyOf = [](const uint32_t* ids, int n) {
+  auto keyOf = [](const uint32_t* ids, int n) {  // the corners in increasing order
     Key k;
     k.fill(UINT32_MAX);
-    std::copy(ids, ids + n, k.begin());
-    std::sort(k.begin(), k.begin() + n);
+    for (size_t i = 0; i < size_t(n) && i < k.size(); ++i) {
+      size_t j = i;
+      for (; j > 0 && k[j - 1] > ids[i]; --j) k[j] = k[j - 1];
+      k[j] = ids[i];
+    }
     return k;
   };
   std::set<Key> earlier;
