@@ -12,6 +12,7 @@
 #include <limits>
 #include <new>
 
+#include "io/hdf5_file.h"
 #include "io/readers.h"
 
 namespace tetstream {
@@ -25,9 +26,10 @@ std::string lowerExtension(const std::string& path) {
 
 constexpr const char* kSupported =
     "supported: .vtu/.vts/.vti (VTK XML), .vtk (legacy VTK), .msh (Gmsh 2.2/4.1), .node/.ele (TetGen), "
-    ".mesh (Medit), PLOT3D grids (.xyz, .x, .g, .grd, .p3d, .bin; Q file with --q)";
+    ".mesh (Medit), PLOT3D grids (.xyz, .x, .g, .grd, .p3d, .bin; Q file with --q), .xdmf/.xmf (XDMF 2/3, "
+    "HDF5 or XML data), .vtkhdf/.hdf (VTKHDF; .h5/.hdf5 with a /VTKHDF group)";
 
-enum class Format { Unknown, VtkXml, LegacyVtk, Gmsh, Medit, Tetgen, Plot3d };
+enum class Format { Unknown, VtkXml, LegacyVtk, Gmsh, Medit, Tetgen, Plot3d, Xdmf, VtkHdf };
 
 // The extensions that name a format outright; anything else is sniffed from the content.
 Format byExtension(const std::string& ext) {
@@ -37,6 +39,8 @@ Format byExtension(const std::string& ext) {
   if (ext == ".mesh") return Format::Medit;
   if (ext == ".node" || ext == ".ele") return Format::Tetgen;
   if (ext == ".xyz") return Format::Plot3d;
+  if (ext == ".xdmf" || ext == ".xmf") return Format::Xdmf;
+  if (ext == ".vtkhdf" || ext == ".hdf") return Format::VtkHdf;
   return Format::Unknown;
 }
 
@@ -66,7 +70,9 @@ Format sniff(std::string_view head, const std::string& ext) {
     break;
   }
   std::string_view t = head.substr(std::min(p, head.size()));
-  if (t.starts_with("<")) return Format::VtkXml;
+  // An HDF5 file (.h5, .hdf5, ...) is taken as VTKHDF; its reader says so when /VTKHDF is missing.
+  if (hdf5::hasSignature(head)) return Format::VtkHdf;
+  if (t.starts_with("<")) return head.find("<Xdmf") != std::string_view::npos ? Format::Xdmf : Format::VtkXml;
   if (t.starts_with("# vtk DataFile")) return Format::LegacyVtk;
   if (t.starts_with("$MeshFormat")) return Format::Gmsh;
   if (t.starts_with("MeshVersionFormatted")) return Format::Medit;
@@ -77,6 +83,8 @@ Format sniff(std::string_view head, const std::string& ext) {
 // The formats that can hold several time steps (and so take --step and --time).
 bool hasTimeSteps(Format f) {
   switch (f) {
+    case Format::Xdmf:
+    case Format::VtkHdf: return true;
     default: return false;
   }
 }
@@ -89,6 +97,8 @@ const char* formatName(Format f) {
     case Format::Medit: return "Medit";
     case Format::Tetgen: return "TetGen";
     case Format::Plot3d: return "PLOT3D";
+    case Format::Xdmf: return "XDMF";
+    case Format::VtkHdf: return "VTKHDF";
     default: return "unknown";
   }
 }
@@ -159,6 +169,12 @@ Result readOneFile(Format fmt, std::string_view bytes, const std::string& name, 
     case Format::Tetgen:
       return fail(Status::Unsupported,
                   name + ": a TetGen mesh is two files (.node and .ele); read it by path, not from bytes");
+    // From bytes an XDMF file has no folder: only XML data items can be read.
+    case Format::Xdmf: return readXdmf(bytes, name, std::nullopt, {}, out, report);
+    case Format::VtkHdf:
+      return fail(Status::Unsupported, name +
+                                           ": a VTKHDF file is HDF5, which is read through the HDF5 library from "
+                                           "a file; read it by path, not from bytes");
     default: break;
   }
   return fail(Status::Unsupported, name + ": unsupported mesh format; " + kSupported);
@@ -219,6 +235,8 @@ Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const
     return fail(Status::BadArgument, path + ": a solution file (--q " + options.solution +
                                          ") goes with a PLOT3D grid or a Medit mesh, and this is " + formatName(fmt));
 
+  if (fmt == Format::VtkHdf) return guarded(path, out, [&] { return readVtkHdf(path, options, out, report); });
+
   std::string bytes, second;
   std::string secondPath;
   try {
@@ -258,6 +276,10 @@ Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const
     return guarded(path, out, [&] { return readMedit(bytes, path, second, secondPath, out, report); });
   if (fmt == Format::Plot3d)
     return guarded(path, out, [&] { return readPlot3d(bytes, path, second, secondPath, out, report); });
+  if (fmt == Format::Xdmf) {
+    const std::string folder = fs::path(path).parent_path().string();
+    return guarded(path, out, [&] { return readXdmf(bytes, path, folder, options, out, report); });
+  }
   return guarded(path, out, [&] { return readOneFile(fmt, bytes, path, out, report); });
 }
 

@@ -1,7 +1,9 @@
 // Mesh files in and out (pack side). Readers: VTK XML (.vtu UnstructuredGrid, .vts StructuredGrid,
 // .vti ImageData), legacy VTK (.vtk: UNSTRUCTURED_GRID, STRUCTURED_POINTS, STRUCTURED_GRID,
 // RECTILINEAR_GRID), Gmsh .msh 2.2/4.1 (ASCII and binary), TetGen .node/.ele, Medit .mesh (+ .sol),
-// PLOT3D grid + Q. Writer: .vtu.
+// PLOT3D grid + Q, XDMF 2/3 (.xdmf/.xmf; heavy data in HDF5, XML or raw binary; time steps) and
+// VTKHDF UnstructuredGrid (.vtkhdf/.hdf, or HDF5 with a /VTKHDF group; partitions, time steps).
+// HDF5 is read through the HDF5 library (hdf5_file.h). Writer: .vtu.
 //
 // The readers take bytes from strangers: every failure is a Result whose message names the file,
 // the array, section, line or cell, and what was expected vs. found. They never throw, never
@@ -70,13 +72,16 @@ struct ReadOptions {
 };
 
 // Reads a mesh file, choosing the reader by extension (case-insensitive): .vtu/.vts/.vti, .vtk,
-// .msh, .mesh, .node/.ele (reads both), .xyz; other extensions are recognized by their content
-// (PLOT3D for binary data under .x, .g, .grd, .p3d, .bin, .dat). out.name is the file's stem.
+// .msh, .mesh, .node/.ele (reads both), .xyz, .xdmf/.xmf (heavy data from the file's folder or
+// below it), .vtkhdf/.hdf; other extensions are recognized by their content (an HDF5 signature:
+// VTKHDF; XML with <Xdmf: XDMF; PLOT3D for binary data under .x, .g, .grd, .p3d, .bin, .dat).
+// out.name is the file's stem.
 Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const ReadOptions& options = {});
 
 // The same from bytes already in memory; `name` supplies the extension and the label in messages.
 // Formats of two files read only the first here (a PLOT3D grid without Q, a Medit mesh without
-// .sol); TetGen needs readTetgen (readers.h).
+// .sol); TetGen needs readTetgen (readers.h). XDMF reads only XML data items (HDF and Binary ones
+// are in other files: Unsupported); VTKHDF is Unsupported (read it by path).
 Result readMeshBytes(std::string_view bytes, const std::string& name, TetMesh& out, ReadReport& report);
 
 // Writes a .vtu (VTK XML, appended raw binary; see vtu_writer.cpp). Only .vtu is supported.

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -49,6 +50,23 @@ Result readMedit(std::string_view mesh, const std::string& label, std::string_vi
 // header, IBLANK) is found by trying every combination against the file size.
 Result readPlot3d(std::string_view grid, const std::string& gridLabel, std::string_view q, const std::string& qLabel,
                   TetMesh& out, ReadReport& report);
+
+// XDMF 2 and 3 (.xdmf, .xmf; xdmf_reader.cpp): unstructured grids (Tetrahedron, Pyramid, Wedge,
+// Hexahedron, their quadratic forms, Mixed), Geometry XYZ or X_Y_Z, Node and Cell attributes,
+// legacy DOLFIN finite element functions, spatial collections (merged) and temporal collections
+// (one step read: options.step / options.time, default the last). DataItems in XML, HDF5
+// ("FILE:/dataset") or raw binary, HyperSlab and JOIN functions; References and <xi:include>
+// within the document. Heavy-data files are looked up in `dataFolder` (the XDMF file's folder)
+// or below it; without a folder (nullopt: bytes in memory) HDF and Binary items are refused with
+// Unsupported. `xml` is the XDMF file's text; `label` names it in messages.
+Result readXdmf(std::string_view xml, const std::string& label, const std::optional<std::string>& dataFolder,
+                const ReadOptions& options, TetMesh& out, ReadReport& report);
+
+// VTKHDF (vtkhdf_reader.cpp): /VTKHDF of Type UnstructuredGrid, any number of partitions
+// (concatenated; their shared points merged by finishMesh), PointData and CellData, cell types as
+// in .vtu; a Steps group makes time steps (options.step / options.time, default the last) and
+// only the chosen step's rows are read. Read by path through the HDF5 library.
+Result readVtkHdf(const std::string& path, const ReadOptions& options, TetMesh& out, ReadReport& report);
 
 // VTK XML, appended raw binary: Float32 points, Int64 connectivity/offsets, UInt8 types, Float32
 // point data. One fwrite per array; writes PATH.tmp, then renames.

@@ -39,7 +39,9 @@ void baseChunk(const uint8_t* data, size_t size);
 void meshFile(const char* extension, const uint8_t* data, size_t size);
 
 // Runs the target of that name ("manifest", "split-chunk", "node-chunk", "base-chunk", "mesh-vtu" for
-// meshFile(".vtu"), ..., "pair-tetgen" for twoFiles("tetgen"), ...). False for an unknown name.
+// meshFile(".vtu"), ..., "mesh-xdmf" for meshFile(".xdmf": the XML and its XML data items; heavy
+// data in other files is refused from bytes), "pair-tetgen" for twoFiles("tetgen"), ...). False
+// for an unknown name.
 bool runTarget(const std::string& name, const uint8_t* data, size_t size);
 
 // The formats made of two files (TetGen .node + .ele, Medit .mesh + .sol, PLOT3D grid + Q):

@@ -19,7 +19,7 @@ cmake --preset fuzz >/dev/null
 cmake --build build/fuzz -j2 >/dev/null
 TARGETS=("$@")
 [ ${#TARGETS[@]} -gt 0 ] || TARGETS=(manifest split-chunk base-chunk mesh-vtu mesh-vtk mesh-vts mesh-vti mesh-msh
-  mesh-mesh mesh-xyz pair-tetgen pair-medit pair-plot3d)
+  mesh-mesh mesh-xyz mesh-xdmf pair-tetgen pair-medit pair-plot3d)
 # A two-file seed: 4-byte little-endian length of the first file, then both files.
 pair_seed() { python3 -c 'import sys,struct; a=open(sys.argv[1],"rb").read(); b=open(sys.argv[2],"rb").read(); sys.stdout.buffer.write(struct.pack("<I",len(a))+a+b)' "$1" "$2"; }
 
@@ -30,6 +30,9 @@ for t in "${TARGETS[@]}"; do
   F=tests/fixtures/formats
   case $t in
     mesh-xyz) cp $F/*.xyz $F/*.x $F/*.g "$seeds"/ ;;
+    # From bytes only XML data items are read (HDF and binary ones are refused): the XML-data file
+    # and the XML around the others.
+    mesh-xdmf) cp tests/fixtures/hpc/xdmf_*.x*mf "$seeds"/ ;;
     mesh-*) cp tests/fixtures/*."${t#mesh-}" $F/*."${t#mesh-}" "$seeds"/ 2>/dev/null || true ;;
     pair-tetgen) for n in $F/*.node; do pair_seed "$n" "${n%.node}.ele" > "$seeds/$(basename "${n%.node}")"; done ;;
     pair-medit) pair_seed $F/grid.mesh $F/grid.sol > "$seeds/grid"; pair_seed $F/mixed.mesh /dev/null > "$seeds/mixed" ;;

@@ -130,6 +130,46 @@ test('the other input formats: notes on stdout, --q names the PLOT3D solution', 
   assert.match(gmsh.stdout, /valid {5}no problems found/);
 });
 
+// XDMF and VTKHDF through the CLI (tests/fixtures/hpc, written by meshio and h5py): info lists the
+// time steps and which one was read, --step and --time pick another, pack and iso read them.
+test('XDMF and VTKHDF: info lists the steps, --step picks one, pack and iso read them', () => {
+  const fx = (name) => path.join(root, 'tests/fixtures/hpc', name);
+  const info = cli('info', fx('xdmf_series.xdmf'), '--json');
+  assert.equal(info.status, 0, info.stderr);
+  assert.deepEqual(info.json.steps, [0, 0.25, 0.5, 0.75].map((time, index) => ({ index, time })));
+  assert.equal(info.json.stepRead, 3);
+  assert.match(info.json.inputFormat, /^XDMF 3 \(HDF5 heavy data\), Tetrahedron, step 3 of 4/);
+  assert.equal(info.json.tets, 48);
+  const f = (json) => json.fields.find((x) => x.name === 'f');
+  assert.ok(Math.abs(f(info.json).min - 7.5) < 1e-5 && Math.abs(f(info.json).max - 13.5) < 1e-5, JSON.stringify(f(info.json)));
+
+  const first = cli('info', fx('xdmf_series.xdmf'), '--step', '0', '--json');
+  assert.equal(first.status, 0, first.stderr);
+  assert.equal(first.json.stepRead, 0);
+  assert.ok(Math.abs(f(first.json).max - 6) < 1e-5);
+  const near = cli('info', fx('vtkhdf_series.vtkhdf'), '--time', '0.6', '--json');
+  assert.equal(near.status, 0, near.stderr);
+  assert.equal(near.json.stepRead, 1);
+  assert.ok(near.json.notes.some((n) => /read the nearest, step 1/.test(n)), near.json.notes.join('\n'));
+  const past = cli('info', fx('xdmf_series.xdmf'), '--step', '9');
+  assert.equal(past.status, 1);
+  assert.match(past.stderr, /--step 9 does not exist; it has 4 time steps/);
+
+  const dir = tempDir('hpc');
+  const pack = cli('pack', fx('vtkhdf_parts.vtkhdf'), '-o', path.join(dir, 'p'), '--json');
+  assert.equal(pack.status, 0, pack.stderr);
+  assert.equal(pack.json.tets, 48);
+  const iso = cli('iso', fx('xdmf_mixed.xdmf'), '--value', '5', '--field', 'f', '--json');
+  assert.equal(iso.status, 0, iso.stderr);
+  assert.ok(iso.json.triangles > 0);
+
+  const escape = path.join(dir, 'escape.xdmf');
+  fs.writeFileSync(escape, fs.readFileSync(fx('xdmf_grid.xdmf'), 'utf8').replace('xdmf_grid.h5:/data0', '/etc/passwd:/x'));
+  const refused = cli('info', escape);
+  assert.equal(refused.status, 1);
+  assert.match(refused.stderr, /escape\.xdmf Grid 'Grid' Geometry .*'\/etc\/passwd' is an absolute path/);
+});
+
 // The commands that read an input start the program again with glibc's huge pages on
 // (core/cli/huge_pages.h): the pack must be the same byte for byte with them, without them
 // (TETSTREAM_HUGE_PAGES=0) and with a user's own GLIBC_TUNABLES kept (a small input also gets
