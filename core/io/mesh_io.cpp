@@ -25,9 +25,10 @@ std::string lowerExtension(const std::string& path) {
 
 constexpr const char* kSupported =
     "supported: .vtu/.vts/.vti (VTK XML), .vtk (legacy VTK), .msh (Gmsh 2.2/4.1), .node/.ele (TetGen), "
-    ".mesh (Medit), PLOT3D grids (.xyz, .x, .g, .grd, .p3d, .bin; Q file with --q)";
+    ".mesh (Medit), PLOT3D grids (.xyz, .x, .g, .grd, .p3d, .bin; Q file with --q), Exodus II (.exo, .e, .ex2, "
+    ".exii, .g), CGNS (.cgns)";
 
-enum class Format { Unknown, VtkXml, LegacyVtk, Gmsh, Medit, Tetgen, Plot3d };
+enum class Format { Unknown, VtkXml, LegacyVtk, Gmsh, Medit, Tetgen, Plot3d, Exodus, Cgns };
 
 // The extensions that name a format outright; anything else is sniffed from the content.
 Format byExtension(const std::string& ext) {
@@ -37,6 +38,9 @@ Format byExtension(const std::string& ext) {
   if (ext == ".mesh") return Format::Medit;
   if (ext == ".node" || ext == ".ele") return Format::Tetgen;
   if (ext == ".xyz") return Format::Plot3d;
+  // ".g" (a Genesis mesh, or a PLOT3D grid) is told by content.
+  if (ext == ".exo" || ext == ".e" || ext == ".ex2" || ext == ".exii") return Format::Exodus;
+  if (ext == ".cgns") return Format::Cgns;
   return Format::Unknown;
 }
 
@@ -77,6 +81,8 @@ Format sniff(std::string_view head, const std::string& ext) {
 // The formats that can hold several time steps (and so take --step and --time).
 bool hasTimeSteps(Format f) {
   switch (f) {
+    case Format::Exodus:
+    case Format::Cgns: return true;
     default: return false;
   }
 }
@@ -89,6 +95,8 @@ const char* formatName(Format f) {
     case Format::Medit: return "Medit";
     case Format::Tetgen: return "TetGen";
     case Format::Plot3d: return "PLOT3D";
+    case Format::Exodus: return "Exodus II";
+    case Format::Cgns: return "CGNS";
     default: return "unknown";
   }
 }
@@ -159,6 +167,10 @@ Result readOneFile(Format fmt, std::string_view bytes, const std::string& name, 
     case Format::Tetgen:
       return fail(Status::Unsupported,
                   name + ": a TetGen mesh is two files (.node and .ele); read it by path, not from bytes");
+    case Format::Exodus:
+    case Format::Cgns:
+      return fail(Status::Unsupported, name + ": " + formatName(fmt) +
+                                           " files are read by their library from disk; read it by path, not from bytes");
     default: break;
   }
   return fail(Status::Unsupported, name + ": unsupported mesh format; " + kSupported);
@@ -193,6 +205,9 @@ Result readMeshBytes(std::string_view bytes, const std::string& name, TetMesh& o
   std::string ext = lowerExtension(name);
   Format fmt = byExtension(ext);
   if (fmt == Format::Unknown) fmt = sniff(bytes.substr(0, 4096), ext);
+  if (const vtkio::Container c = vtkio::containerSignature(bytes); fmt == Format::Unknown && c != vtkio::Container::None)
+    return fail(Status::Unsupported, name + ": a " + vtkio::containerName(c) +
+                                         " file (Exodus II or CGNS?); these are read by path, not from bytes");
   if (fmt == Format::Unknown)
     return fail(Status::Unsupported, name + ": unsupported mesh format '" + ext + "'; " + kSupported);
   return guarded(name, out, [&] { return readOneFile(fmt, bytes, name, out, report); });
@@ -207,7 +222,8 @@ Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const
     // Sniff the first bytes before reading a possibly large file we cannot read anyway.
     std::string head;
     if (Result r = readHead(path, head); !r) return r;
-    fmt = sniff(head, ext);
+    const vtkio::HpcFormat hpc = vtkio::hpcFormatByContent(path, head);
+    fmt = hpc == vtkio::HpcFormat::Exodus ? Format::Exodus : hpc == vtkio::HpcFormat::Cgns ? Format::Cgns : sniff(head, ext);
     if (fmt == Format::Unknown)
       return fail(Status::Unsupported,
                   path + ": unsupported mesh format '" + ext + "' (content not recognized); " + kSupported);
@@ -218,6 +234,10 @@ Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const
   if (!options.solution.empty() && fmt != Format::Plot3d && fmt != Format::Medit)
     return fail(Status::BadArgument, path + ": a solution file (--q " + options.solution +
                                          ") goes with a PLOT3D grid or a Medit mesh, and this is " + formatName(fmt));
+
+  // The Exodus II and CGNS libraries read the file themselves.
+  if (fmt == Format::Exodus) return guarded(path, out, [&] { return readExodus(path, options, out, report); });
+  if (fmt == Format::Cgns) return guarded(path, out, [&] { return readCgns(path, options, out, report); });
 
   std::string bytes, second;
   std::string secondPath;

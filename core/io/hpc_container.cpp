@@ -1,0 +1,116 @@
+// What lies under an Exodus II or CGNS file, found before any reader is chosen: the container's
+// signature (netCDF classic, HDF5, ADF) and, for a file whose extension names no format, whether
+// its content is Exodus II or CGNS (asked of netCDF and HDF5 themselves, so that another HDF5
+// file, such as VTKHDF or XDMF's heavy data, is not taken for either).
+#include <hdf5.h>
+#include <netcdf.h>
+
+#include <cstring>
+#include <filesystem>
+#include <mutex>
+
+#include "io/readers.h"
+
+namespace tetstream::vtkio {
+
+namespace {
+
+constexpr char kHdf5Signature[8] = {'\x89', 'H', 'D', 'F', '\r', '\n', '\x1a', '\n'};
+
+// HDF5 turns its error stack printing back on for nothing; while we probe or read, a damaged
+// file must not print to stderr. Restores the previous setting on scope exit.
+class QuietHdf5 {
+ public:
+  QuietHdf5() {
+    H5Eget_auto2(H5E_DEFAULT, &func_, &data_);
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  }
+  ~QuietHdf5() { H5Eset_auto2(H5E_DEFAULT, func_, data_); }
+  QuietHdf5(const QuietHdf5&) = delete;
+  QuietHdf5& operator=(const QuietHdf5&) = delete;
+
+ private:
+  H5E_auto2_t func_ = nullptr;
+  void* data_ = nullptr;
+};
+
+bool hdf5LinkExists(hid_t group, const char* name) { return H5Lexists(group, name, H5P_DEFAULT) > 0; }
+
+// The HDF5 root of a CGNS file holds CGNSLibraryVersion; netCDF-4 keeps global attributes on the
+// root group, and every Exodus II writer (the SEACAS library, meshio) sets api_version and
+// stores coordinates as coordx/coordy/coordz or one coord variable.
+HpcFormat hdf5Content(const std::string& path) {
+  QuietHdf5 quiet;
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (file < 0) return HpcFormat::None;
+  HpcFormat found = HpcFormat::None;
+  const hid_t root = H5Gopen2(file, "/", H5P_DEFAULT);
+  if (root >= 0) {
+    if (hdf5LinkExists(root, "CGNSLibraryVersion"))
+      found = HpcFormat::Cgns;
+    else if (H5Aexists(root, "api_version") > 0 || hdf5LinkExists(root, "coordx") || hdf5LinkExists(root, "coord"))
+      found = HpcFormat::Exodus;
+    H5Gclose(root);
+  }
+  H5Fclose(file);
+  return found;
+}
+
+HpcFormat netcdfContent(const std::string& path) {
+  int ncid = -1;
+  if (nc_open(path.c_str(), NC_NOWRITE, &ncid) != NC_NOERR) return HpcFormat::None;
+  int id = -1;
+  const bool exodus = nc_inq_attid(ncid, NC_GLOBAL, "api_version", &id) == NC_NOERR ||
+                      nc_inq_dimid(ncid, "num_nodes", &id) == NC_NOERR;
+  nc_close(ncid);
+  return exodus ? HpcFormat::Exodus : HpcFormat::None;
+}
+
+}  // namespace
+
+std::mutex& hpcLibraryMutex() {
+  static std::mutex m;
+  return m;
+}
+
+Container containerSignature(std::string_view head) {
+  if (head.size() >= 4 && head.substr(0, 3) == "CDF") {
+    if (head[3] == '\x01') return Container::NetcdfClassic;
+    if (head[3] == '\x02') return Container::Netcdf64BitOffset;
+    if (head[3] == '\x05') return Container::Netcdf64BitData;
+  }
+  // HDF5 looks for its superblock at 0, 512, 1024, 2048, ... (a user block may come first).
+  for (size_t at = 0; at + sizeof kHdf5Signature <= head.size(); at = at ? 2 * at : 512)
+    if (std::memcmp(head.data() + at, kHdf5Signature, sizeof kHdf5Signature) == 0) return Container::Hdf5;
+  // ADF: "@(#)" with the high bits set, then the version text.
+  if (head.size() >= 24 && head.substr(4, 20) == "ADF Database Version") return Container::Adf;
+  return Container::None;
+}
+
+const char* containerName(Container c) {
+  switch (c) {
+    case Container::NetcdfClassic: return "netCDF classic";
+    case Container::Netcdf64BitOffset: return "netCDF 64-bit offset";
+    case Container::Netcdf64BitData: return "netCDF 64-bit data";
+    case Container::Hdf5: return "HDF5";
+    case Container::Adf: return "ADF";
+    default: return "unknown container";
+  }
+}
+
+HpcFormat hpcFormatByContent(const std::string& path, std::string_view head) {
+  const Container c = containerSignature(head);
+  if (c == Container::None) return HpcFormat::None;
+  if (c == Container::Adf) return HpcFormat::Cgns;  // ADF is CGNS's own container
+  std::lock_guard<std::mutex> lock(hpcLibraryMutex());
+  return c == Container::Hdf5 ? hdf5Content(path) : netcdfContent(path);
+}
+
+uint64_t maxDecodedBytes(uint64_t fileBytes, Container c) {
+  // netCDF classic and ADF store arrays as they are. netCDF-4 and CGNS over HDF5 may compress
+  // them, deflate by at most about 1032:1; with some slack for the smallest files.
+  if (c == Container::Hdf5) return fileBytes * 1100 + (1u << 20);
+  return fileBytes;
+}
+
+}  // namespace tetstream::vtkio
