@@ -49,10 +49,14 @@ void onCgnsMessage(int kind, char* message) {
   if (kind == 0 && gWarnings && gWarnings->size() < 4 && message) gWarnings->push_back(message);
 }
 
+// Closes the file however the read ends, and whatever the library left of it in HDF5.
 struct CgnsFile {
   int fn = -1;
+  std::string path;
+  bool hdf5 = false;
   ~CgnsFile() {
     if (fn >= 0) cg_close(fn);
+    if (hdf5) closeHdf5Leftovers(path);
   }
 };
 
@@ -125,6 +129,8 @@ class CgnsReader {
 
  private:
   Result readOpen(TetMesh& out) {
+    file_.path = path_;
+    file_.hdf5 = container_ == Container::Hdf5;
     if (cg_open(path_.c_str(), CG_MODE_READ, &file_.fn) != CG_OK) {
       file_.fn = -1;
       return fail(Status::Corrupt, path_ + ": not a readable CGNS file: " + lastCgnsError());

@@ -15,6 +15,7 @@
 //     under its own name, and NAME_magnitude is added (the readers' name for a vector's norm).
 // Not read: global, node set and side set variables, sets, attributes.
 #include <exodusII.h>
+#include <netcdf.h>
 
 #include <cmath>
 #include <cstdio>
@@ -27,6 +28,10 @@ namespace tetstream {
 namespace {
 
 using namespace vtkio;
+
+// The library's return codes (exodusII_int.h, not a public header): 0 success, 1 a warning
+// (something not found: no data was read), negative an error.
+constexpr int kExodusOk = 0;
 
 std::string lastExodusError() {
   const char* msg = nullptr;
@@ -98,12 +103,11 @@ class ExodusReader {
 
   Result read(TetMesh& out) {
     std::error_code ec;
-    const uint64_t fileBytes = std::filesystem::file_size(path_, ec);
+    const uint64_t fileBytes = fileBytes_ = std::filesystem::file_size(path_, ec);
     if (ec) return fail(Status::IoError, path_ + ": cannot open (" + ec.message() + ")");
-    if (Result r = checkSignature(fileBytes); !r) return r;
-    limit_ = maxDecodedBytes(fileBytes, container_);
-
     std::lock_guard<std::mutex> lock(hpcLibraryMutex());
+    if (Result r = checkContainer(fileBytes); !r) return r;
+    limit_ = maxDecodedBytes(fileBytes, container_);
     ex_opts(0);  // no messages on stderr, never abort: failures come back as return codes
     int cpuWordSize = 8, ioWordSize = 0;
     float version = 0;
@@ -112,7 +116,7 @@ class ExodusReader {
     ioWordSize_ = ioWordSize == 4 ? 4 : 8;
 
     ex_init_params init{};
-    if (ex_get_init_ext(file_.id, &init) < 0)
+    if (ex_get_init_ext(file_.id, &init) != kExodusOk)
       return fail(Status::Corrupt, path_ + ": cannot read the Exodus II header: " + lastExodusError());
     if (Result r = checkInit(init); !r) return r;
     // Names longer than the default 32 characters (the file says how long its longest is).
@@ -136,19 +140,40 @@ class ExodusReader {
   }
 
  private:
-  Result checkSignature(uint64_t fileBytes) {
-    std::string head(4096, '\0');
+  // What the libraries are given is checked first: the container's signature; for netCDF classic
+  // the whole header (checkNetcdfClassicHeader: netCDF believes its counts and allocates by them,
+  // so a damaged header could exhaust memory); and that netCDF itself opens the file (ex_open
+  // prints to stderr whatever ex_opts says when netCDF refuses an HDF5 file).
+  Result checkContainer(uint64_t fileBytes) {
+    std::string head;
+    for (size_t want = 1 << 16;; want *= 4) {
+      if (Result r = readHead(want, head); !r) return r;
+      if (want == 1 << 16) {
+        container_ = containerSignature(head);
+        if (container_ == Container::None || container_ == Container::Adf)
+          return fail(Status::BadMagic, path_ + ": not an Exodus II file: it starts with neither the netCDF (CDF) " +
+                                            "nor the HDF5 signature" + (head.empty() ? " (the file is empty)" : ""));
+        if (container_ == Container::Hdf5) break;
+      }
+      const NetcdfHeaderResult h = checkNetcdfClassicHeader(head, fileBytes, path_);
+      if (!h.needMore) {
+        if (!h.result) return h.result;
+        break;
+      }
+    }
+    int ncid = -1;
+    if (const int status = nc_open(path_.c_str(), NC_NOWRITE, &ncid); status != NC_NOERR)
+      return fail(Status::Corrupt, path_ + ": netCDF cannot open it (" + nc_strerror(status) + ")");
+    nc_close(ncid);
+    return Result::success();
+  }
+
+  Result readHead(size_t bytes, std::string& head) const {
     std::FILE* f = std::fopen(path_.c_str(), "rb");
     if (!f) return fail(Status::IoError, path_ + ": cannot open");
+    head.assign(bytes, '\0');
     head.resize(std::fread(head.data(), 1, head.size(), f));
     std::fclose(f);
-    container_ = containerSignature(head);
-    if (container_ == Container::None || container_ == Container::Adf)
-      return fail(Status::BadMagic, path_ + ": not an Exodus II file: it starts with neither the netCDF (CDF) nor " +
-                                        "the HDF5 signature" + (head.empty() ? " (the file is empty)" : ""));
-    // A netCDF classic header alone is at least 32 bytes; the library reads past a shorter file.
-    if (fileBytes < 32)
-      return fail(Status::Truncated, path_ + ": " + std::to_string(fileBytes) + " bytes, too short for an Exodus II file");
     return Result::success();
   }
 
@@ -157,12 +182,8 @@ class ExodusReader {
     if (count < 0) return fail(Status::Corrupt, path_ + ": " + what + " is negative (" + std::to_string(count) + ")");
     if (uint64_t(count) > limit_ / std::max<uint64_t>(bytesEach, 1))
       return fail(Status::Truncated, path_ + ": " + what + " is " + std::to_string(count) + ", more than a file of " +
-                                         std::to_string(fileBytesForMessage()) + " bytes can hold");
+                                         std::to_string(fileBytes_) + " bytes can hold");
     return Result::success();
-  }
-  uint64_t fileBytesForMessage() const {
-    std::error_code ec;
-    return std::filesystem::file_size(path_, ec);
   }
 
   Result checkInit(const ex_init_params& init) {
@@ -212,7 +233,7 @@ class ExodusReader {
     numNodes_ = init.num_nodes;
     const size_t n = size_t(numNodes_);
     std::vector<double> x(n), y(n), z(n);
-    if (n && ex_get_coord(file_.id, x.data(), y.data(), z.data()) < 0)
+    if (n && ex_get_coord(file_.id, x.data(), y.data(), z.data()) != kExodusOk)
       return fail(Status::Corrupt, path_ + ": cannot read the node coordinates: " + lastExodusError());
     mesh.positions.resize(3 * n);
     for (size_t v = 0; v < n; ++v) {
@@ -232,7 +253,7 @@ class ExodusReader {
   Result readBlocks(const ex_init_params& init, CellSoup& soup) {
     numElements_ = init.num_elem;
     std::vector<int64_t> ids(size_t(init.num_elem_blk));
-    if (!ids.empty() && ex_get_ids(file_.id, EX_ELEM_BLOCK, ids.data()) < 0)
+    if (!ids.empty() && ex_get_ids(file_.id, EX_ELEM_BLOCK, ids.data()) != kExodusOk)
       return fail(Status::Corrupt, path_ + ": cannot read the element block ids: " + lastExodusError());
     uint64_t first = 0;
     for (int64_t id : ids) {
@@ -281,7 +302,7 @@ class ExodusReader {
       return fail(Status::Corrupt, path_ + ": " + where + " has " + std::to_string(b.nodesPer) +
                                        " nodes per element; the shape needs at least " + std::to_string(corners));
     std::vector<int64_t> conn(size_t(b.count * b.nodesPer));
-    if (ex_get_conn(file_.id, EX_ELEM_BLOCK, b.id, conn.data(), nullptr, nullptr) < 0)
+    if (ex_get_conn(file_.id, EX_ELEM_BLOCK, b.id, conn.data(), nullptr, nullptr) != kExodusOk)
       return fail(Status::Corrupt, path_ + ": " + where + ": cannot read its connectivity: " + lastExodusError());
     if (soup.referenced.size() < size_t(numNodes_)) soup.referenced.resize(size_t(numNodes_), 0);
     if (!b.kind.volume) {
@@ -320,7 +341,7 @@ class ExodusReader {
     if (n < 0) return fail(Status::Corrupt, path_ + ": cannot read the number of time steps: " + lastExodusError());
     if (Result r = checkCount("the number of time steps", n, ioWordSize_); !r) return r;
     times_.assign(size_t(n), 0.0);
-    if (n > 0 && ex_get_all_times(file_.id, times_.data()) < 0)
+    if (n > 0 && ex_get_all_times(file_.id, times_.data()) != kExodusOk)
       return fail(Status::Corrupt, path_ + ": cannot read the time steps' times: " + lastExodusError());
     if (n > std::numeric_limits<int>::max())
       return fail(Status::TooLarge, path_ + ": " + std::to_string(n) + " time steps");
@@ -338,7 +359,7 @@ class ExodusReader {
     std::vector<std::vector<char>> buffers(size_t(n), std::vector<char>(size_t(nameLength_) + 1, '\0'));
     std::vector<char*> pointers;
     for (auto& b : buffers) pointers.push_back(b.data());
-    if (ex_get_variable_names(file_.id, type, n, pointers.data()) < 0)
+    if (ex_get_variable_names(file_.id, type, n, pointers.data()) != kExodusOk)
       return fail(Status::Corrupt, path_ + ": cannot read the " + kind + " variable names: " + lastExodusError());
     for (auto& b : buffers) {
       b.back() = '\0';
@@ -366,7 +387,8 @@ class ExodusReader {
     std::vector<double> values(n);
     const size_t firstField = mesh.fields.size();
     for (size_t k = 0; k < names.size(); ++k) {
-      if (n && ex_get_var(file_.id, int(step + 1), EX_NODAL, int(k + 1), 1, numNodes_, values.data()) < 0)
+      if (n && ex_get_var(file_.id, int(step + 1), EX_NODAL, int(k + 1), 1, numNodes_, values.data()) != kExodusOk &&
+          !readNodalVariableDirectly(step, k, values))
         return fail(Status::Corrupt, path_ + ": nodal variable '" + names[k] + "' at step " + std::to_string(step) +
                                          ": " + lastExodusError());
       ScalarField f;
@@ -376,6 +398,33 @@ class ExodusReader {
     }
     addComponentMagnitudes(mesh, firstField, report_);
     return Result::success();
+  }
+
+  // The library looks for nodal variables where the file's model size says: one variable each
+  // (vals_nod_varK) in a "large model", all in vals_nod_var otherwise. meshio writes them one
+  // each without saying the model is large, so the library finds none; they are read from
+  // vals_nod_varK through netCDF (the Exodus file id is the netCDF id) when it has the layout
+  // (time_step, num_nodes).
+  bool readNodalVariableDirectly(size_t step, size_t k, std::vector<double>& values) {
+    const std::string name = "vals_nod_var" + std::to_string(k + 1);
+    int var = -1, ndims = 0;
+    int dims[NC_MAX_VAR_DIMS];
+    size_t length[2] = {0, 0};
+    if (nc_inq_varid(file_.id, name.c_str(), &var) != NC_NOERR || nc_inq_varndims(file_.id, var, &ndims) != NC_NOERR ||
+        ndims != 2 || nc_inq_vardimid(file_.id, var, dims) != NC_NOERR ||
+        nc_inq_dimlen(file_.id, dims[0], &length[0]) != NC_NOERR ||
+        nc_inq_dimlen(file_.id, dims[1], &length[1]) != NC_NOERR || length[0] <= step ||
+        length[1] != uint64_t(numNodes_))
+      return false;
+    const size_t start[2] = {step, 0}, count[2] = {1, length[1]};
+    if (nc_get_vara_double(file_.id, var, start, count, values.data()) != NC_NOERR) return false;
+    if (!directNoted_) {
+      directNoted_ = true;
+      report_.notes.push_back("read the nodal variables from vals_nod_var1.. through netCDF: the file stores them "
+                              "one per variable without marking itself a large model, where the Exodus library "
+                              "finds none");
+    }
+    return true;
   }
 
   Result readElementVariables(size_t step, std::vector<CellArray>& arrays) {
@@ -388,8 +437,11 @@ class ExodusReader {
                                         " blocks");
     // Which variable each block has (1 everywhere when the file has no truth table).
     std::vector<int> truth(nb * nv, 1);
-    if (nb && ex_get_truth_table(file_.id, EX_ELEM_BLOCK, int(nb), int(nv), truth.data()) < 0)
+    if (const int status = nb ? ex_get_truth_table(file_.id, EX_ELEM_BLOCK, int(nb), int(nv), truth.data()) : 0;
+        status < 0)
       return fail(Status::Corrupt, path_ + ": cannot read the element variable truth table: " + lastExodusError());
+    else if (status > 0)
+      std::fill(truth.begin(), truth.end(), 1);
     const uint64_t cells = blocks_.empty() ? 0 : blocks_.back().firstElement + uint64_t(blocks_.back().count);
     std::vector<double> values;
     for (size_t k = 0; k < nv; ++k) {
@@ -400,7 +452,7 @@ class ExodusReader {
         const Block& b = blocks_[bi];
         if (!b.kind.volume || b.count == 0 || !truth[bi * nv + k]) continue;
         values.resize(size_t(b.count));
-        if (ex_get_var(file_.id, int(step + 1), EX_ELEM_BLOCK, int(k + 1), b.id, b.count, values.data()) < 0)
+        if (ex_get_var(file_.id, int(step + 1), EX_ELEM_BLOCK, int(k + 1), b.id, b.count, values.data()) != kExodusOk)
           return fail(Status::Corrupt, path_ + ": element variable '" + names[k] + "' on element block " +
                                            std::to_string(b.id) + " at step " + std::to_string(step) + ": " +
                                            lastExodusError());
@@ -432,13 +484,13 @@ class ExodusReader {
   ReadReport& report_;
   ExodusFile file_;
   Container container_ = Container::None;
-  uint64_t limit_ = 0;
+  uint64_t fileBytes_ = 0, limit_ = 0;
   uint64_t ioWordSize_ = 8;
   int nameLength_ = 32;
   int64_t numNodes_ = 0, numElements_ = 0;
   std::vector<Block> blocks_;
   std::vector<double> times_;
-  bool nodeMapRead_ = false, elemMapRead_ = false;
+  bool nodeMapRead_ = false, elemMapRead_ = false, directNoted_ = false;
   std::vector<int64_t> nodeMap_, elemMap_;
 };
 

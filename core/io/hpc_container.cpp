@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <mutex>
+#include <vector>
 
 #include "io/readers.h"
 
@@ -66,6 +67,13 @@ HpcFormat netcdfContent(const std::string& path) {
   return exodus ? HpcFormat::Exodus : HpcFormat::None;
 }
 
+// HDF5 closes whatever is still open when the program exits, and when a library left ids behind
+// (the CGNS library does after failing on a damaged file: a property list it never closes) it
+// prints "HDF5: infinite loop closing library" to stderr. Nothing here writes HDF5, so the exit
+// handler has nothing to flush: it is not installed. This must run before any other HDF5 call,
+// hence at static initialization.
+const bool kNoHdf5ExitHandler = [] { return H5dont_atexit() >= 0; }();
+
 }  // namespace
 
 std::mutex& hpcLibraryMutex() {
@@ -104,6 +112,27 @@ HpcFormat hpcFormatByContent(const std::string& path, std::string_view head) {
   if (c == Container::Adf) return HpcFormat::Cgns;  // ADF is CGNS's own container
   std::lock_guard<std::mutex> lock(hpcLibraryMutex());
   return c == Container::Hdf5 ? hdf5Content(path) : netcdfContent(path);
+}
+
+void closeHdf5Leftovers(const std::string& path) {
+  QuietHdf5 quiet;
+  const ssize_t n = H5Fget_obj_count(H5F_OBJ_ALL, H5F_OBJ_ALL);
+  if (n <= 0) return;
+  std::vector<hid_t> ids(static_cast<size_t>(n));
+  const ssize_t got = H5Fget_obj_ids(H5F_OBJ_ALL, H5F_OBJ_ALL, size_t(n), ids.data());
+  ids.resize(size_t(std::max<ssize_t>(got, 0)));
+  std::vector<hid_t> mine, files;
+  for (hid_t id : ids) {
+    char name[4096];
+    const ssize_t len = H5Fget_name(id, name, sizeof name);
+    if (len <= 0 || size_t(len) >= sizeof name || path != name) continue;
+    (H5Iget_type(id) == H5I_FILE ? files : mine).push_back(id);
+  }
+  // Objects before their files; every reference the library left is dropped.
+  for (const std::vector<hid_t>* group : {&mine, &files})
+    for (hid_t id : *group)
+      while (H5Iis_valid(id) > 0 && H5Idec_ref(id) > 0) {
+      }
 }
 
 uint64_t maxDecodedBytes(uint64_t fileBytes, Container c) {

@@ -241,6 +241,20 @@ HpcFormat hpcFormatByContent(const std::string& path, std::string_view head);
 // every call into them holds this lock.
 std::mutex& hpcLibraryMutex();
 
+// Checks a netCDF classic header (CDF-1/2/5; `head` is the file's first bytes) before the netCDF
+// library reads it: every count must fit in the file's bytes, every variable's data in the file
+// (else Truncated, or Corrupt), as the library believes the counts and allocates by them.
+// needMore: the header goes on past `head` (give more of the file and check again).
+struct NetcdfHeaderResult {
+  Result result;
+  bool needMore = false;
+};
+NetcdfHeaderResult checkNetcdfClassicHeader(std::string_view head, uint64_t fileSize, const std::string& label);
+
+// Closes what HDF5 still holds of the file at `path` (the CGNS library leaves groups of a file it
+// failed to open behind; HDF5 would report them on stderr at exit).
+void closeHdf5Leftovers(const std::string& path);
+
 // The most bytes a container of fileBytes can decode to: what it stores, or for HDF5 (which may
 // compress) the deflate limit. Counts a file declares are checked against this before allocating.
 uint64_t maxDecodedBytes(uint64_t fileBytes, Container c);
