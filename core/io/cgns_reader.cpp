@@ -165,14 +165,15 @@ class CgnsReader {
     if (container_ != Container::Adf && container_ != Container::Hdf5)
       return fail(Status::BadMagic, path_ + ": not a CGNS file: it starts with neither the ADF nor the HDF5 signature" +
                                         (head.empty() ? " (the file is empty)" : ""));
-    if (container_ == Container::Adf && fileBytes < kAdfHeaderBytes)
-      return fail(Status::Truncated, path_ + ": " + std::to_string(fileBytes) +
-                                         " bytes, shorter than an ADF file's header and root node");
+    // ADF reads past a file's end unchecked: the header says where the data ends.
+    uint64_t end = 0;
+    if (container_ == Container::Adf && !adfDataEnd(head, end))
+      return fail(Status::Corrupt, path_ + ": the ADF file header is damaged (no end-of-file pointer)");
+    if (container_ == Container::Adf && fileBytes < end)
+      return fail(Status::Truncated, path_ + ": " + std::to_string(fileBytes) + " bytes, but its ADF header says the data "
+                                         "runs to byte " + std::to_string(end) + " (truncated?)");
     return Result::success();
   }
-  // ADF's file header (186 bytes) and free-chunk table are followed by the root node: a file
-  // that ends before it is not one the library can open (and ADF reads past it unchecked).
-  static constexpr uint64_t kAdfHeaderBytes = 1024;
 
   Result checkCount(const std::string& what, uint64_t count, uint64_t bytesEach) const {
     if (count > limit_ / std::max<uint64_t>(bytesEach, 1))

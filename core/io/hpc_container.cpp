@@ -114,6 +114,22 @@ HpcFormat hpcFormatByContent(const std::string& path, std::string_view head) {
   return c == Container::Hdf5 ? hdf5Content(path) : netcdfContent(path);
 }
 
+bool adfDataEnd(std::string_view head, uint64_t& end) {
+  // The ADF file header (ADF_internals.c): tags "AdF4" at byte 130 and "AdF5" at 182 around four
+  // disk pointers of 12 hex digits each (8 for the 4096-byte block, 4 for the offset in it):
+  // the root node, the end of file, the free-chunk table, reserved.
+  if (head.size() < 186 || head.substr(130, 4) != "AdF4" || head.substr(182, 4) != "AdF5") return false;
+  uint64_t block = 0, offset = 0;
+  for (size_t i = 0; i < 12; ++i) {
+    const char c = head[146 + i];
+    const int digit = c >= '0' && c <= '9' ? c - '0' : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1;
+    if (digit < 0) return false;
+    (i < 8 ? block : offset) = (i < 8 ? block : offset) * 16 + uint64_t(digit);
+  }
+  end = block * 4096 + offset;
+  return true;
+}
+
 void closeHdf5Leftovers(const std::string& path) {
   QuietHdf5 quiet;
   const ssize_t n = H5Fget_obj_count(H5F_OBJ_ALL, H5F_OBJ_ALL);

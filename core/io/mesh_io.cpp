@@ -204,10 +204,14 @@ Result readMeshBytes(std::string_view bytes, const std::string& name, TetMesh& o
   out = TetMesh{};
   std::string ext = lowerExtension(name);
   Format fmt = byExtension(ext);
-  if (fmt == Format::Unknown) fmt = sniff(bytes.substr(0, 4096), ext);
-  if (const vtkio::Container c = vtkio::containerSignature(bytes); fmt == Format::Unknown && c != vtkio::Container::None)
-    return fail(Status::Unsupported, name + ": a " + vtkio::containerName(c) +
-                                         " file (Exodus II or CGNS?); these are read by path, not from bytes");
+  if (fmt == Format::Unknown) {
+    // netCDF and ADF hold Exodus II and CGNS (HDF5 may hold other formats: left to sniff()).
+    const vtkio::Container c = vtkio::containerSignature(bytes);
+    if (c != vtkio::Container::None && c != vtkio::Container::Hdf5)
+      return fail(Status::Unsupported, name + ": " + vtkio::containerName(c) +
+                                           " container (an Exodus II or CGNS file?); these are read by path, not from bytes");
+    fmt = sniff(bytes.substr(0, 4096), ext);
+  }
   if (fmt == Format::Unknown)
     return fail(Status::Unsupported, name + ": unsupported mesh format '" + ext + "'; " + kSupported);
   return guarded(name, out, [&] { return readOneFile(fmt, bytes, name, out, report); });

@@ -160,8 +160,9 @@ class HeaderCheck {
       return bad(Status::Corrupt, std::string("the netCDF header's list of ") + what + " has tag " + std::to_string(t) +
                                       ", expected " + std::to_string(tag));
     if (count > left() / minBytes)
-      return bad(Status::Corrupt, std::string("the netCDF header lists ") + std::to_string(count) + " " + what +
-                                      ", more than the file's " + std::to_string(fileSize_) + " bytes can hold");
+      return bad(Status::Truncated, std::string("the netCDF header lists ") + std::to_string(count) + " " + what +
+                                        ", more than the rest of the file (" + std::to_string(left()) +
+                                        " bytes) can hold (truncated or damaged?)");
     return true;
   }
 
@@ -191,9 +192,9 @@ class HeaderCheck {
       if (!size || (!cdf5_ && type > 6))
         return bad(Status::Corrupt, "attribute '" + nm + "' of " + owner + " has netCDF type " + std::to_string(type));
       if (count > left() / size)
-        return bad(Status::Corrupt, "attribute '" + nm + "' of " + owner + " declares " + std::to_string(count) +
-                                        " values, more than the file's " + std::to_string(fileSize_) +
-                                        " bytes can hold");
+        return bad(Status::Truncated, "attribute '" + nm + "' of " + owner + " declares " + std::to_string(count) +
+                                          " values, more than the rest of the file (" + std::to_string(left()) +
+                                          " bytes) can hold (truncated or damaged?)");
       if (!c_.skip(padded4(count * size))) return ranOut("attribute '" + nm + "' of " + owner);
     }
     return true;
@@ -253,23 +254,21 @@ class HeaderCheck {
       bool over = false;
       const uint64_t bytes = product(v, over);
       const bool record = !v.dims.empty() && v.dims[0] == 0;
-      if (over || bytes > fileSize_)
-        return bad(Status::Corrupt, "variable '" + v.name + "' is larger than the file (" + std::to_string(fileSize_) +
-                                        " bytes)");
-      if (v.begin < headerEnd || v.begin > fileSize_)
+      if (over)
+        return bad(Status::Corrupt, "variable '" + v.name + "' has dimensions whose product overflows 64 bits");
+      if (v.begin < headerEnd)
         return bad(Status::Corrupt, "variable '" + v.name + "' starts at byte " + std::to_string(v.begin) +
-                                        ", outside the data part of the file (" + std::to_string(headerEnd) + ".." +
-                                        std::to_string(fileSize_) + ")");
-      if (record) {
+                                        ", inside the header (which ends at " + std::to_string(headerEnd) + ")");
+      if (record) {  // checked below, with the number of records
         recsize += padded4(bytes);
         lastRecord = bytes;
         ++recordVars;
         continue;
       }
-      if (bytes > fileSize_ - v.begin)
-        return bad(Status::Truncated, "variable '" + v.name + "' needs the bytes up to " +
-                                          std::to_string(v.begin + bytes) + ", but the file has " +
-                                          std::to_string(fileSize_) + " (truncated?)");
+      if (v.begin > fileSize_ || bytes > fileSize_ - v.begin)
+        return bad(Status::Truncated, "variable '" + v.name + "' needs the bytes " + std::to_string(v.begin) + ".." +
+                                          std::to_string(v.begin) + "+" + std::to_string(bytes) +
+                                          ", but the file has " + std::to_string(fileSize_) + " (truncated?)");
     }
     // One record variable is stored unpadded (the netCDF library's rule).
     if (recordVars == 1) recsize = lastRecord;

@@ -251,6 +251,10 @@ struct NetcdfHeaderResult {
 };
 NetcdfHeaderResult checkNetcdfClassicHeader(std::string_view head, uint64_t fileSize, const std::string& label);
 
+// Where an ADF file's data ends (its header's end-of-file pointer, a byte offset); false when
+// `head` (the first bytes) has no ADF header. The ADF library reads past a file's end unchecked.
+bool adfDataEnd(std::string_view head, uint64_t& end);
+
 // Closes what HDF5 still holds of the file at `path` (the CGNS library leaves groups of a file it
 // failed to open behind; HDF5 would report them on stderr at exit).
 void closeHdf5Leftovers(const std::string& path);
