@@ -133,6 +133,7 @@ class ExodusReader {
     std::vector<CellArray> cellArrays;
     if (Result r = readNodalVariables(step, mesh); !r) return r;
     if (Result r = readElementVariables(step, cellArrays); !r) return r;
+    noteUnreadVariables();
     report_.format = formatText();
     if (Result r = finishMesh(path_, mesh, soup, std::move(cellArrays), report_); !r) return r;
     out = std::move(mesh);
@@ -462,6 +463,24 @@ class ExodusReader {
     }
     addComponentMagnitudes(arrays, 0, report_);
     return Result::success();
+  }
+
+  // Variables on other entities than nodes and element blocks are not read; a note says so.
+  void noteUnreadVariables() {
+    struct Kind {
+      ex_entity_type type;
+      const char* name;
+    };
+    std::string unread;
+    for (const Kind& k : {Kind{EX_GLOBAL, "global"}, Kind{EX_NODE_SET, "node set"}, Kind{EX_SIDE_SET, "side set"},
+                          Kind{EX_ELEM_SET, "element set"}, Kind{EX_EDGE_BLOCK, "edge block"},
+                          Kind{EX_FACE_BLOCK, "face block"}}) {
+      int n = 0;
+      if (ex_get_variable_param(file_.id, k.type, &n) == kExodusOk && n > 0)
+        unread += (unread.empty() ? "" : ", ") + std::to_string(n) + " " + k.name;
+    }
+    if (!unread.empty())
+      report_.notes.push_back("not read: the variables of other entities than nodes and element blocks (" + unread + ")");
   }
 
   std::string formatText() const {
