@@ -106,7 +106,7 @@ class ExodusReader {
     const uint64_t fileBytes = fileBytes_ = std::filesystem::file_size(path_, ec);
     if (ec) return fail(Status::IoError, path_ + ": cannot open (" + ec.message() + ")");
     std::lock_guard<std::mutex> lock(hpcLibraryMutex());
-    if (Result r = checkContainer(fileBytes); !r) return r;
+    if (Result r = checkExodusFile(path_, fileBytes, container_); !r) return r;
     limit_ = maxDecodedBytes(fileBytes, container_);
     ex_opts(0);  // no messages on stderr, never abort: failures come back as return codes
     int cpuWordSize = 8, ioWordSize = 0;
@@ -141,43 +141,6 @@ class ExodusReader {
   }
 
  private:
-  // What the libraries are given is checked first: the container's signature; for netCDF classic
-  // the whole header (checkNetcdfClassicHeader: netCDF believes its counts and allocates by them,
-  // so a damaged header could exhaust memory); and that netCDF itself opens the file (ex_open
-  // prints to stderr whatever ex_opts says when netCDF refuses an HDF5 file).
-  Result checkContainer(uint64_t fileBytes) {
-    std::string head;
-    for (size_t want = 1 << 16;; want *= 4) {
-      if (Result r = readHead(want, head); !r) return r;
-      if (want == 1 << 16) {
-        container_ = containerSignature(head);
-        if (container_ == Container::None || container_ == Container::Adf)
-          return fail(Status::BadMagic, path_ + ": not an Exodus II file: it starts with neither the netCDF (CDF) " +
-                                            "nor the HDF5 signature" + (head.empty() ? " (the file is empty)" : ""));
-        if (container_ == Container::Hdf5) break;
-      }
-      const NetcdfHeaderResult h = checkNetcdfClassicHeader(head, fileBytes, path_);
-      if (!h.needMore) {
-        if (!h.result) return h.result;
-        break;
-      }
-    }
-    int ncid = -1;
-    if (const int status = nc_open(path_.c_str(), NC_NOWRITE, &ncid); status != NC_NOERR)
-      return fail(Status::Corrupt, path_ + ": netCDF cannot open it (" + nc_strerror(status) + ")");
-    nc_close(ncid);
-    return Result::success();
-  }
-
-  Result readHead(size_t bytes, std::string& head) const {
-    std::FILE* f = std::fopen(path_.c_str(), "rb");
-    if (!f) return fail(Status::IoError, path_ + ": cannot open");
-    head.assign(bytes, '\0');
-    head.resize(std::fread(head.data(), 1, head.size(), f));
-    std::fclose(f);
-    return Result::success();
-  }
-
   // A count the file declares, of `bytesEach` stored bytes each, must fit in what the file holds.
   Result checkCount(const std::string& what, int64_t count, uint64_t bytesEach) const {
     if (count < 0) return fail(Status::Corrupt, path_ + ": " + what + " is negative (" + std::to_string(count) + ")");

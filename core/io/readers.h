@@ -259,6 +259,11 @@ bool adfDataEnd(std::string_view head, uint64_t& end);
 // failed to open behind; HDF5 would report them on stderr at exit).
 void closeHdf5Leftovers(const std::string& path);
 
+// An Exodus II file as the Exodus library may be given it (exodus_checks.cpp): a netCDF classic
+// header that checks out, a file netCDF opens, and variables and attributes that hold what the
+// library's buffers expect. `container` is set from the signature.
+Result checkExodusFile(const std::string& path, uint64_t fileBytes, Container& container);
+
 // The most bytes a container of fileBytes can decode to: what it stores, or for HDF5 (which may
 // compress) the deflate limit. Counts a file declares are checked against this before allocating.
 uint64_t maxDecodedBytes(uint64_t fileBytes, Container c);

@@ -5,8 +5,9 @@
 // counts, volume, boundary area (a seam between blocks or zones leaves inner faces on the
 // boundary and adds area), field values, the point values of converted cell data, time steps;
 // then damaged copies (truncated, bytes changed) must give a Result naming the file.
-#include <hdf5.h>
 #include <gtest/gtest.h>
+#include <hdf5.h>
+#include <netcdf.h>
 
 #include <cmath>
 #include <filesystem>
@@ -278,6 +279,34 @@ TEST(ExodusErrors, TruncatedOrChangedCopiesGiveResults) {
   damagedCopies("exo_blocks.exo", "exo", failed);  // netCDF classic
   damagedCopies("exo_meshio.exo", "e", failed);    // netCDF-4 (HDF5)
   EXPECT_TRUE(failed);
+}
+
+// Attributes the Exodus library copies into fixed fields without a bound (an element type name
+// into 33 bytes, api_version into one float) are checked through netCDF before it reads them.
+TEST(ExodusErrors, AttributesTooLongForTheLibraryAreRefused) {
+  ScratchDir dir("exodus-attributes");
+  const std::string copy = dir.path + "/long.exo";
+  auto edit = [&](auto&& change) {
+    ASSERT_TRUE(saveFile(copy, loadFile(hpcPath("exo_blocks.exo"))));
+    int nc = -1, var = -1;
+    ASSERT_EQ(nc_open(copy.c_str(), NC_WRITE, &nc), NC_NOERR);
+    ASSERT_EQ(nc_redef(nc), NC_NOERR);
+    ASSERT_EQ(nc_inq_varid(nc, "connect2", &var), NC_NOERR);
+    change(nc, var);
+    ASSERT_EQ(nc_close(nc), NC_NOERR);
+  };
+  TetMesh m;
+  ReadReport r;
+  edit([](int nc, int var) {
+    const std::string name = "WEDGE" + std::string(195, 'X');
+    ASSERT_EQ(nc_put_att_text(nc, var, "elem_type", name.size(), name.data()), NC_NOERR);
+  });
+  EXPECT_FAILS(readMesh(copy, m, r), Status::Corrupt, "element block 2 (connect2) has an element type name of 200");
+  edit([](int nc, int) {
+    const float versions[4] = {7, 7, 7, 7};
+    ASSERT_EQ(nc_put_att_float(nc, NC_GLOBAL, "api_version", NC_FLOAT, 4, versions), NC_NOERR);
+  });
+  EXPECT_FAILS(readMesh(copy, m, r), Status::Corrupt, "the global attribute api_version holds 4 values");
 }
 
 TEST(ExodusNetcdfHeader, CountsAreCheckedAgainstTheFile) {
