@@ -170,15 +170,16 @@ class CgnsReader {
     if (container_ == Container::Adf && !adfDataEnd(head, end))
       return fail(Status::Corrupt, path_ + ": the ADF file header is damaged (no end-of-file pointer)");
     if (container_ == Container::Adf && fileBytes < end)
-      return fail(Status::Truncated, path_ + ": " + std::to_string(fileBytes) + " bytes, but its ADF header says the data "
-                                         "runs to byte " + std::to_string(end) + " (truncated?)");
+      return fail(Status::Truncated, path_ + ": " + std::to_string(fileBytes) +
+                                         " bytes, but its ADF header says the data runs to byte " +
+                                         std::to_string(end) + " (truncated?)");
     return Result::success();
   }
 
   Result checkCount(const std::string& what, uint64_t count, uint64_t bytesEach) const {
     if (count > limit_ / std::max<uint64_t>(bytesEach, 1))
-      return fail(Status::Truncated, path_ + ": " + what + " is " + std::to_string(count) +
-                                         ", more than the file can hold");
+      return fail(Status::Truncated,
+                  path_ + ": " + what + " is " + std::to_string(count) + ", more than the file can hold");
     return Result::success();
   }
 
@@ -290,7 +291,8 @@ class CgnsReader {
       std::vector<std::string> pointers;
       if (Result r = readSolutionPointers(z, size_t(nsteps), pointers); !r) return r;
       if (pointers.empty()) {
-        report_.notes.push_back(zoneLabel(z) + " has no FlowSolutionPointers: its solutions are the same at every step");
+        report_.notes.push_back(zoneLabel(z) +
+                                " has no FlowSolutionPointers: its solutions are the same at every step");
         continue;
       }
       z.stepSolution = true;
@@ -303,8 +305,7 @@ class CgnsReader {
     if (cg_goto(file_.fn, base_, "BaseIterativeData_t", 1, "end") != CG_OK)
       return fail(Status::Corrupt, path_ + ": BaseIterativeData: " + lastCgnsError());
     int narrays = 0;
-    if (cg_narrays(&narrays) != CG_OK)
-      return fail(Status::Corrupt, path_ + ": BaseIterativeData: " + lastCgnsError());
+    if (cg_narrays(&narrays) != CG_OK) return fail(Status::Corrupt, path_ + ": BaseIterativeData: " + lastCgnsError());
     int timeArray = 0, iterationArray = 0;
     for (int a = 1; a <= narrays; ++a) {
       char aname[64] = {};
@@ -343,11 +344,10 @@ class CgnsReader {
       int ndim = 0;
       cgsize_t dims[12] = {};
       if (cg_array_info(a, aname, &type, &ndim, dims) != CG_OK)
-        return fail(Status::Corrupt, zoneLabel(z) + ": ZoneIterativeData array " + std::to_string(a) + ": " +
-                                         lastCgnsError());
+        return fail(Status::Corrupt,
+                    zoneLabel(z) + ": ZoneIterativeData array " + std::to_string(a) + ": " + lastCgnsError());
       if (std::string(aname) != "FlowSolutionPointers") continue;
-      if (type != CGNS_ENUMV(Character) || ndim != 2 || dims[0] < 1 || dims[0] > 256 ||
-          uint64_t(dims[1]) != nsteps)
+      if (type != CGNS_ENUMV(Character) || ndim != 2 || dims[0] < 1 || dims[0] > 256 || uint64_t(dims[1]) != nsteps)
         return fail(Status::Corrupt, zoneLabel(z) + ": FlowSolutionPointers is not " + std::to_string(nsteps) +
                                          " names (one per step of BaseIterativeData)");
       std::vector<char> text(size_t(dims[0]) * nsteps);
@@ -405,14 +405,14 @@ class CgnsReader {
     if (Result r = readCoordinate(z, "CoordinateZ", c); !r) return r;
     if (cyl && !cylindricalNoted_) {
       cylindricalNoted_ = true;
-      report_.notes.push_back("converted cylindrical coordinates (CoordinateR, CoordinateTheta, CoordinateZ) to "
-                              "Cartesian");
+      report_.notes.push_back("converted cylindrical coordinates (R, Theta, Z) to Cartesian");
     }
     for (uint64_t v = 0; v < z.vertices; ++v) {
       double x = a[v], y = b[v];
       if (cyl) x = a[v] * std::cos(b[v]), y = a[v] * std::sin(b[v]);
       if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(c[v]))
-        return fail(Status::NonFinite, zoneLabel(z) + ": vertex " + std::to_string(v + 1) + " has a non-finite coordinate");
+        return fail(Status::NonFinite,
+                    zoneLabel(z) + ": vertex " + std::to_string(v + 1) + " has a non-finite coordinate");
       float* p = &mesh.positions[3 * (z.vertexBase + v)];
       p[0] = float(x), p[1] = float(y), p[2] = float(c[v]);
     }
@@ -431,13 +431,14 @@ class CgnsReader {
     if (!kind.volume) {
       ++soup.skipped[{kind.vtkType, "CGNS " + type}];
       for (int q = 0; q < count; ++q)
-        if (nodes[q] >= 1 && uint64_t(nodes[q]) <= z.vertices) soup.referenced[z.vertexBase + uint64_t(nodes[q] - 1)] = 1;
+        if (nodes[q] >= 1 && uint64_t(nodes[q]) <= z.vertices)
+          soup.referenced[z.vertexBase + uint64_t(nodes[q] - 1)] = 1;
       return Result::success();
     }
     const int corners = kShapeCorners[int(kind.shape)];
     if (count < corners)
-      return fail(Status::Corrupt, where + ": element " + std::to_string(e) + " (" + type + ") has " +
-                                       std::to_string(count) + " nodes");
+      return fail(Status::Corrupt,
+                  where + ": element " + std::to_string(e) + " (" + type + ") has " + std::to_string(count) + " nodes");
     uint32_t ids[8];
     for (int q = 0; q < count; ++q) {
       const cgsize_t v = nodes[q];
@@ -498,8 +499,8 @@ class CgnsReader {
       const CgnsType kind = cgnsType(type);
       int npe = 0;
       if (type.empty() || cg_npe(etype, &npe) != CG_OK || npe < 1)
-        return fail(Status::Unsupported, where + ": element type " + (type.empty() ? std::to_string(int(etype)) : type) +
-                                             " is not read");
+        return fail(Status::Unsupported,
+                    where + ": element type " + (type.empty() ? std::to_string(int(etype)) : type) + " is not read");
       if (uint64_t(dataSize) != count * uint64_t(npe))
         return fail(Status::Corrupt, where + ": " + std::to_string(count) + " " + type + " elements need " +
                                          std::to_string(count * uint64_t(npe)) + " node ids, the section has " +
@@ -507,7 +508,9 @@ class CgnsReader {
       if (!conn.empty() && cg_elements_read(file_.fn, base_, z.index, s, conn.data(), nullptr) != CG_OK)
         return fail(Status::Corrupt, where + ": " + lastCgnsError());
       for (uint64_t k = 0; k < count; ++k)
-        if (Result r = addElement(z, where, type, kind, &conn[size_t(k) * size_t(npe)], npe, int64_t(start) + int64_t(k), soup); !r)
+        if (Result r = addElement(z, where, type, kind, &conn[size_t(k) * size_t(npe)], npe,
+                                  int64_t(start) + int64_t(k), soup);
+            !r)
           return r;
     }
     return Result::success();
@@ -527,8 +530,9 @@ class CgnsReader {
     for (uint64_t k = 0; k < count; ++k) {
       const int64_t element = int64_t(start) + int64_t(k);
       if (at >= size)
-        return fail(Status::Corrupt, where + ": the connectivity (" + std::to_string(size) + " entries) ends at element " +
-                                         std::to_string(element) + " of " + std::to_string(start) + ".." +
+        return fail(Status::Corrupt, where + ": the connectivity (" + std::to_string(size) +
+                                         " entries) ends at element " + std::to_string(element) + " of " +
+                                         std::to_string(start) + ".." +
                                          std::to_string(int64_t(start) + int64_t(count) - 1));
       offsetsDiffer += uint64_t(offsets[k]) != at;
       const cgsize_t code = conn[size_t(at)];
@@ -599,9 +603,8 @@ class CgnsReader {
         }
         const bool vertex = location == CGNS_ENUMV(Vertex), cell = location == CGNS_ENUMV(CellCenter);
         if (!vertex && !cell) {
-          const char* ln = int(location) >= 0 && int(location) < NofValidGridLocation
-                               ? cg_GridLocationName(location)
-                               : "an unknown location";
+          const char* ln = int(location) >= 0 && int(location) < NofValidGridLocation ? cg_GridLocationName(location)
+                                                                                      : "an unknown location";
           report_.notes.push_back("skipped " + where + ": values at " + ln + " (Vertex and CellCenter are read)");
           continue;
         }
@@ -647,7 +650,8 @@ class CgnsReader {
         report_.notes.push_back("skipped " + where + " field '" + field + "': an earlier solution of the zone has it");
         continue;
       }
-      if (n && cg_field_read(file_.fn, base_, z.index, s, fname, CGNS_ENUMV(RealDouble), lo, hi, values.data()) != CG_OK)
+      if (n &&
+          cg_field_read(file_.fn, base_, z.index, s, fname, CGNS_ENUMV(RealDouble), lo, hi, values.data()) != CG_OK)
         return fail(Status::Corrupt, where + " field '" + field + "': " + lastCgnsError());
       std::vector<double>& dst = into.get(field, size_t(vertex ? totalVertices_ : totalSlots_));
       std::copy(values.begin(), values.end(), dst.begin() + std::ptrdiff_t(vertex ? z.vertexBase : z.slotBase));

@@ -36,8 +36,8 @@ class SchemaCheck {
   SchemaCheck(int ncid, const std::string& path) : nc_(ncid), path_(path) {}
 
   Result run() {
-    for (const char* a : {"api_version", "version", "floating_point_word_size", "file_size", "int64_status",
-                          "maximum_name_length"}) {
+    for (const char* a :
+         {"api_version", "version", "floating_point_word_size", "file_size", "int64_status", "maximum_name_length"}) {
       size_t length = 0;
       if (nc_inq_attlen(nc_, NC_GLOBAL, a, &length) == NC_NOERR && length != 1)
         return fail(Status::Corrupt, path_ + ": the global attribute " + a + " holds " + std::to_string(length) +
@@ -58,8 +58,7 @@ class SchemaCheck {
       if (Result r = expectSize(var, want); !r) return r;
     for (uint64_t k = 1; k <= blocks; ++k) {
       const std::string n = std::to_string(k), conn = "connect" + n;
-      if (Result r = expectSize(conn, dim(("num_el_in_blk" + n).c_str()) * dim(("num_nod_per_el" + n).c_str()));
-          !r)
+      if (Result r = expectSize(conn, dim(("num_el_in_blk" + n).c_str()) * dim(("num_nod_per_el" + n).c_str())); !r)
         return r;
       int var = -1;
       size_t length = 0;

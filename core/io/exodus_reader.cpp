@@ -153,15 +153,14 @@ class ExodusReader {
   Result checkInit(const ex_init_params& init) {
     if (init.num_dim != 3) {
       if (init.num_dim == 1 || init.num_dim == 2)
-        return fail(Status::NoTets, path_ + ": a " + std::to_string(init.num_dim) +
-                                        "D Exodus II mesh (num_dim " + std::to_string(init.num_dim) +
-                                        "): no volume cells");
+        return fail(Status::NoTets, path_ + ": a " + std::to_string(init.num_dim) + "D Exodus II mesh (num_dim " +
+                                        std::to_string(init.num_dim) + "): no volume cells");
       return fail(Status::Corrupt, path_ + ": num_dim is " + std::to_string(init.num_dim) + ", expected 3");
     }
     if (Result r = checkCount("the number of nodes", init.num_nodes, 3 * ioWordSize_); !r) return r;
     if (uint64_t(init.num_nodes) > kMaxVertices)
-      return fail(Status::TooLarge, path_ + ": " + std::to_string(init.num_nodes) +
-                                        " nodes; tetstream indexes vertices with 32 bits");
+      return fail(Status::TooLarge,
+                  path_ + ": " + std::to_string(init.num_nodes) + " nodes; tetstream indexes vertices with 32 bits");
     if (Result r = checkCount("the number of elements", init.num_elem, 4); !r) return r;
     if (Result r = checkCount("the number of element blocks", init.num_elem_blk, 4); !r) return r;
     return Result::success();
@@ -204,8 +203,7 @@ class ExodusReader {
       if (!std::isfinite(x[v]) || !std::isfinite(y[v]) || !std::isfinite(z[v])) {
         char buf[128];
         std::snprintf(buf, sizeof buf, "(%g, %g, %g)", x[v], y[v], z[v]);
-        return fail(Status::NonFinite,
-                    path_ + ": " + nodeName(int64_t(v) + 1) + " has a non-finite coordinate " + buf);
+        return fail(Status::NonFinite, path_ + ": " + nodeName(int64_t(v) + 1) + " has a non-finite coordinate " + buf);
       }
       mesh.positions[3 * v] = float(x[v]);
       mesh.positions[3 * v + 1] = float(y[v]);
@@ -238,8 +236,8 @@ class ExodusReader {
       if (Result r = checkCount(where + ": its number of elements", b.count, 1); !r) return r;
       if (b.count > 0 && !b.kind.special) {
         if (b.nodesPer < 1 || b.nodesPer > 1000)
-          return fail(Status::Corrupt, path_ + ": " + where + " has " + std::to_string(b.nodesPer) +
-                                           " nodes per element");
+          return fail(Status::Corrupt,
+                      path_ + ": " + where + " has " + std::to_string(b.nodesPer) + " nodes per element");
         if (Result r = checkCount(where + ": its connectivity size", b.count * b.nodesPer, 4); !r) return r;
       }
       first += uint64_t(b.count);
@@ -316,8 +314,7 @@ class ExodusReader {
     int n = 0;
     if (ex_get_variable_param(file_.id, type, &n) < 0)
       return fail(Status::Corrupt, path_ + ": cannot read the number of " + kind + " variables: " + lastExodusError());
-    if (n < 0 || n > 100000)
-      return fail(Status::Corrupt, path_ + ": " + std::to_string(n) + " " + kind + " variables");
+    if (n < 0 || n > 100000) return fail(Status::Corrupt, path_ + ": " + std::to_string(n) + " " + kind + " variables");
     names.clear();
     if (n == 0) return Result::success();
     std::vector<std::vector<char>> buffers(size_t(n), std::vector<char>(size_t(nameLength_) + 1, '\0'));
@@ -384,9 +381,10 @@ class ExodusReader {
     if (nc_get_vara_double(file_.id, var, start, count, values.data()) != NC_NOERR) return false;
     if (!directNoted_) {
       directNoted_ = true;
-      report_.notes.push_back("read the nodal variables from vals_nod_var1.. through netCDF: the file stores them "
-                              "one per variable without marking itself a large model, where the Exodus library "
-                              "finds none");
+      report_.notes.push_back(
+          "read the nodal variables from vals_nod_var1.. through netCDF: the file stores them "
+          "one per variable without marking itself a large model, where the Exodus library "
+          "finds none");
     }
     return true;
   }
@@ -397,8 +395,8 @@ class ExodusReader {
     if (names.empty() || noValues(names.size(), "element")) return Result::success();
     const size_t nb = blocks_.size(), nv = names.size();
     if (nb * nv > (size_t(1) << 26))
-      return fail(Status::TooLarge, path_ + ": " + std::to_string(nv) + " element variables on " + std::to_string(nb) +
-                                        " blocks");
+      return fail(Status::TooLarge,
+                  path_ + ": " + std::to_string(nv) + " element variables on " + std::to_string(nb) + " blocks");
     // Which variable each block has (1 everywhere when the file has no truth table).
     std::vector<int> truth(nb * nv, 1);
     if (const int status = nb ? ex_get_truth_table(file_.id, EX_ELEM_BLOCK, int(nb), int(nv), truth.data()) : 0;
@@ -435,22 +433,24 @@ class ExodusReader {
       const char* name;
     };
     std::string unread;
-    for (const Kind& k : {Kind{EX_GLOBAL, "global"}, Kind{EX_NODE_SET, "node set"}, Kind{EX_SIDE_SET, "side set"},
-                          Kind{EX_ELEM_SET, "element set"}, Kind{EX_EDGE_BLOCK, "edge block"},
-                          Kind{EX_FACE_BLOCK, "face block"}}) {
+    for (const Kind& k :
+         {Kind{EX_GLOBAL, "global"}, Kind{EX_NODE_SET, "node set"}, Kind{EX_SIDE_SET, "side set"},
+          Kind{EX_ELEM_SET, "element set"}, Kind{EX_EDGE_BLOCK, "edge block"}, Kind{EX_FACE_BLOCK, "face block"}}) {
       int n = 0;
       if (ex_get_variable_param(file_.id, k.type, &n) == kExodusOk && n > 0)
         unread += (unread.empty() ? "" : ", ") + std::to_string(n) + " " + k.name;
     }
     if (!unread.empty())
-      report_.notes.push_back("not read: the variables of other entities than nodes and element blocks (" + unread + ")");
+      report_.notes.push_back("not read: the variables of other entities than nodes and element blocks (" + unread +
+                              ")");
   }
 
   std::string formatText() const {
     size_t volume = 0;
     for (const Block& b : blocks_) volume += b.kind.volume;
-    std::string s = std::string("Exodus II (") + (container_ == Container::Hdf5 ? "netCDF-4" : containerName(container_)) +
-                    "), " + std::to_string(blocks_.size()) + (blocks_.size() == 1 ? " element block" : " element blocks");
+    std::string s = std::string("Exodus II (") +
+                    (container_ == Container::Hdf5 ? "netCDF-4" : containerName(container_)) + "), " +
+                    std::to_string(blocks_.size()) + (blocks_.size() == 1 ? " element block" : " element blocks");
     if (volume != blocks_.size()) s += " (" + std::to_string(volume) + " of volume cells)";
     if (!report_.steps.empty()) {
       char t[64];

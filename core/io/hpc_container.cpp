@@ -61,8 +61,8 @@ HpcFormat netcdfContent(const std::string& path) {
   int ncid = -1;
   if (nc_open(path.c_str(), NC_NOWRITE, &ncid) != NC_NOERR) return HpcFormat::None;
   int id = -1;
-  const bool exodus = nc_inq_attid(ncid, NC_GLOBAL, "api_version", &id) == NC_NOERR ||
-                      nc_inq_dimid(ncid, "num_nodes", &id) == NC_NOERR;
+  const bool exodus =
+      nc_inq_attid(ncid, NC_GLOBAL, "api_version", &id) == NC_NOERR || nc_inq_dimid(ncid, "num_nodes", &id) == NC_NOERR;
   nc_close(ncid);
   return exodus ? HpcFormat::Exodus : HpcFormat::None;
 }

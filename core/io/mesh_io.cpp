@@ -169,8 +169,9 @@ Result readOneFile(Format fmt, std::string_view bytes, const std::string& name, 
                   name + ": a TetGen mesh is two files (.node and .ele); read it by path, not from bytes");
     case Format::Exodus:
     case Format::Cgns:
-      return fail(Status::Unsupported, name + ": " + formatName(fmt) +
-                                           " files are read by their library from disk; read it by path, not from bytes");
+      return fail(Status::Unsupported,
+                  name + ": " + formatName(fmt) +
+                      " files are read by their library from disk; read it by path, not from bytes");
     default: break;
   }
   return fail(Status::Unsupported, name + ": unsupported mesh format; " + kSupported);
@@ -208,8 +209,9 @@ Result readMeshBytes(std::string_view bytes, const std::string& name, TetMesh& o
     // netCDF and ADF hold Exodus II and CGNS (HDF5 may hold other formats: left to sniff()).
     const vtkio::Container c = vtkio::containerSignature(bytes);
     if (c != vtkio::Container::None && c != vtkio::Container::Hdf5)
-      return fail(Status::Unsupported, name + ": " + vtkio::containerName(c) +
-                                           " container (an Exodus II or CGNS file?); these are read by path, not from bytes");
+      return fail(Status::Unsupported,
+                  name + ": " + vtkio::containerName(c) +
+                      " container (an Exodus II or CGNS file?); these are read by path, not from bytes");
     fmt = sniff(bytes.substr(0, 4096), ext);
   }
   if (fmt == Format::Unknown)
@@ -227,7 +229,9 @@ Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const
     std::string head;
     if (Result r = readHead(path, head); !r) return r;
     const vtkio::HpcFormat hpc = vtkio::hpcFormatByContent(path, head);
-    fmt = hpc == vtkio::HpcFormat::Exodus ? Format::Exodus : hpc == vtkio::HpcFormat::Cgns ? Format::Cgns : sniff(head, ext);
+    fmt = hpc == vtkio::HpcFormat::Exodus ? Format::Exodus
+          : hpc == vtkio::HpcFormat::Cgns ? Format::Cgns
+                                          : sniff(head, ext);
     if (fmt == Format::Unknown)
       return fail(Status::Unsupported,
                   path + ": unsupported mesh format '" + ext + "' (content not recognized); " + kSupported);

@@ -30,16 +30,16 @@ constexpr uint64_t kMaxVarDims = 1024;
 
 uint64_t typeSize(uint32_t type) {
   switch (type) {
-    case 1:  // byte
-    case 2:  // char
-    case 7: return 1;  // ubyte
-    case 3:  // short
-    case 8: return 2;  // ushort
-    case 4:  // int
-    case 5:  // float
-    case 9: return 4;  // uint
-    case 6:  // double
-    case 10:  // int64
+    case 1:             // byte
+    case 2:             // char
+    case 7: return 1;   // ubyte
+    case 3:             // short
+    case 8: return 2;   // ushort
+    case 4:             // int
+    case 5:             // float
+    case 9: return 4;   // uint
+    case 6:             // double
+    case 10:            // int64
     case 11: return 8;  // uint64
     default: return 0;
   }
@@ -215,8 +215,8 @@ class HeaderCheck {
         uint64_t id;
         if (!c_.sized(cdf5_, id)) return ranOut(what);
         if (id >= dimLength_.size())
-          return bad(Status::Corrupt, what + " uses dimension " + std::to_string(id) + " of " +
-                                          std::to_string(dimLength_.size()));
+          return bad(Status::Corrupt,
+                     what + " uses dimension " + std::to_string(id) + " of " + std::to_string(dimLength_.size()));
         if (dimLength_[id] == 0 && d != 0)
           return bad(Status::Corrupt, what + " uses the record dimension other than first");
         v.dims.push_back(dimLength_[id]);
@@ -254,8 +254,7 @@ class HeaderCheck {
       bool over = false;
       const uint64_t bytes = product(v, over);
       const bool record = !v.dims.empty() && v.dims[0] == 0;
-      if (over)
-        return bad(Status::Corrupt, "variable '" + v.name + "' has dimensions whose product overflows 64 bits");
+      if (over) return bad(Status::Corrupt, "variable '" + v.name + "' has dimensions whose product overflows 64 bits");
       if (v.begin < headerEnd)
         return bad(Status::Corrupt, "variable '" + v.name + "' starts at byte " + std::to_string(v.begin) +
                                         ", inside the header (which ends at " + std::to_string(headerEnd) + ")");

@@ -33,8 +33,7 @@ using test::totalVolume;
 std::string hpcPath(const std::string& name) { return fixturePath("hpc/" + name); }
 
 const nlohmann::json& expected() {
-  static const nlohmann::json j =
-      nlohmann::json::parse(loadFile(hpcPath("expected_exodus_cgns.json")), nullptr, false);
+  static const nlohmann::json j = nlohmann::json::parse(loadFile(hpcPath("expected_exodus_cgns.json")), nullptr, false);
   return j;
 }
 
@@ -59,8 +58,8 @@ void expectFieldIs(const TetMesh& m, const std::string& name, F&& fn, double tol
   ASSERT_EQ(values.size(), m.vertexCount()) << what << " " << name;
   for (uint32_t v = 0; v < m.vertexCount(); ++v) {
     const double x = m.positions[3 * v], y = m.positions[3 * v + 1], z = m.positions[3 * v + 2];
-    ASSERT_NEAR(values[v], fn(x, y, z), tolerance) << what << " " << name << " at (" << x << ", " << y << ", " << z
-                                                   << ")";
+    ASSERT_NEAR(values[v], fn(x, y, z), tolerance)
+        << what << " " << name << " at (" << x << ", " << y << ", " << z << ")";
   }
 }
 
@@ -166,12 +165,15 @@ TEST(ExodusBlocks, NodalAndElementVariablesOfEachStep) {
     const double t = e["times"][step].get<double>();
     EXPECT_EQ(r.stepRead, step);
     const std::string what = "step " + std::to_string(step);
-    expectFieldIs(m, "temperature", [&](double x, double y, double z) { return x + 2 * y + 3 * z + 10 * t; }, 1e-5,
-                  what);
+    expectFieldIs(
+        m, "temperature", [&](double x, double y, double z) { return x + 2 * y + 3 * z + 10 * t; }, 1e-5, what);
     // Components stay fields under their own names; the vector also gives its magnitude.
-    expectFieldIs(m, "velocityX", [&](double, double y, double) { return y * (1 + t); }, 1e-6, what);
-    expectFieldIs(m, "velocityY", [&](double x, double, double) { return -x * (1 + t); }, 1e-6, what);
-    expectFieldIs(m, "velocityZ", [&](double, double, double z) { return z * (1 + t); }, 1e-6, what);
+    expectFieldIs(
+        m, "velocityX", [&](double, double y, double) { return y * (1 + t); }, 1e-6, what);
+    expectFieldIs(
+        m, "velocityY", [&](double x, double, double) { return -x * (1 + t); }, 1e-6, what);
+    expectFieldIs(
+        m, "velocityZ", [&](double, double, double z) { return z * (1 + t); }, 1e-6, what);
     expectFieldIs(
         m, "velocity_magnitude",
         [&](double x, double y, double z) { return std::sqrt(x * x + y * y + z * z) * (1 + t); }, 1e-5, what);
@@ -188,7 +190,8 @@ TEST(ExodusBlocks, TimePicksTheNearestStep) {
   ASSERT_TRUE(read("exo_blocks.exo", m, r, o));
   EXPECT_EQ(r.stepRead, 1u);
   EXPECT_TRUE(hasNote(r, "no step at t = 0.4; read the nearest, step 1 (t = 0.5)")) << allNotes(r);
-  expectFieldIs(m, "temperature", [](double x, double y, double z) { return x + 2 * y + 3 * z + 5; }, 1e-5, "t=0.4");
+  expectFieldIs(
+      m, "temperature", [](double x, double y, double z) { return x + 2 * y + 3 * z + 5; }, 1e-5, "t=0.4");
 
   EXPECT_FAILS(read("exo_blocks.exo", m, r, atStep(3)), Status::BadArgument, "--step 3 does not exist");
   EXPECT_EQ(m.vertexCount(), 0u);
@@ -199,7 +202,8 @@ TEST(ExodusMeshio, NetcdfFourFileWithItsNodalVariable) {
   ReadReport r;
   ASSERT_TRUE(read("exo_meshio.exo", m, r));
   EXPECT_NE(r.format.find("Exodus II (netCDF-4), 5 element blocks (4 of volume cells)"), std::string::npos) << r.format;
-  expectFieldIs(m, "f", [](double x, double y, double z) { return x + 2 * y + 3 * z; }, 1e-6, "meshio");
+  expectFieldIs(
+      m, "f", [](double x, double y, double z) { return x + 2 * y + 3 * z; }, 1e-6, "meshio");
   EXPECT_TRUE(hasNote(r, "through netCDF")) << allNotes(r);
   EXPECT_TRUE(hasNote(r, "skipped 2 cells of unsupported type Exodus TRI3")) << allNotes(r);
   // One step (t = 0): listed, and --step 0 is that state.
@@ -340,7 +344,8 @@ TEST_P(CgnsContainers, UnstructuredZonesTetraAndMixed) {
   ReadReport r;
   ASSERT_TRUE(read(file, m, r));
   EXPECT_NE(r.format.find("2 unstructured zones"), std::string::npos) << r.format;
-  expectFieldIs(m, "T", [](double x, double y, double z) { return x + 2 * y + 3 * z; }, 1e-5, file);
+  expectFieldIs(
+      m, "T", [](double x, double y, double z) { return x + 2 * y + 3 * z; }, 1e-5, file);
   // CellCenter values (named T_cell beside the Vertex T) become volume-weighted point data.
   expectRows(m, "T_cell", expected()[file]["T_cell"], file);
   EXPECT_TRUE(hasNote(r, "merged 9 duplicate vertices")) << allNotes(r);
@@ -355,12 +360,13 @@ TEST_P(CgnsContainers, StructuredZonesVertexAndCellCenter) {
   ReadReport r;
   ASSERT_TRUE(read(file, m, r));
   EXPECT_NE(r.format.find("2 structured zones"), std::string::npos) << r.format;
-  expectFieldIs(m, "Density", [](double x, double, double) { return 1 + 0.1 * x; }, 1e-5, file);
-  expectFieldIs(m, "MomentumY", [](double, double y, double) { return 0.25 * y; }, 1e-6, file);
+  expectFieldIs(
+      m, "Density", [](double x, double, double) { return 1 + 0.1 * x; }, 1e-5, file);
+  expectFieldIs(
+      m, "MomentumY", [](double, double y, double) { return 0.25 * y; }, 1e-6, file);
   expectFieldIs(
       m, "Momentum_magnitude",
-      [](double x, double y, double z) { return std::sqrt(0.25 * x * x + 0.0625 * y * y + 0.25 * z * z); }, 1e-5,
-      file);
+      [](double x, double y, double z) { return std::sqrt(0.25 * x * x + 0.0625 * y * y + 0.25 * z * z); }, 1e-5, file);
   expectRows(m, "Density_cell", expected()[file]["Density_cell"], file);
   EXPECT_TRUE(hasNote(r, "merged 12 duplicate vertices")) << allNotes(r);
   // One state: no steps to choose from.
@@ -379,8 +385,9 @@ TEST(CgnsSteps, EachStepReadsTheSolutionItsPointerNames) {
     ReadReport r;
     ASSERT_TRUE(read("cgns_steps.cgns", m, r, atStep(step)));
     const double t = 0.5 * double(step);
-    expectFieldIs(m, "T", [&](double x, double y, double z) { return x + 2 * y + 3 * z + 10 * t; }, 1e-5,
-                  "step " + std::to_string(step));
+    expectFieldIs(
+        m, "T", [&](double x, double y, double z) { return x + 2 * y + 3 * z + 10 * t; }, 1e-5,
+        "step " + std::to_string(step));
     ASSERT_EQ(r.steps.size(), 3u);
     EXPECT_EQ(r.steps[step].time, t);
     EXPECT_TRUE(hasNote(r, "read base 'Volume'; not read: 'Surface' (2D cells)")) << allNotes(r);
@@ -405,7 +412,7 @@ TEST(CgnsErrors, PolyhedraAreRefusedByName) {
 
 TEST(CgnsErrors, TruncatedOrChangedCopiesGiveResults) {
   bool failed = false;
-  damagedCopies("cgns_structured.adf.cgns", "cgns", failed);  // ADF
+  damagedCopies("cgns_structured.adf.cgns", "cgns", failed);    // ADF
   damagedCopies("cgns_unstructured.cgns", "hdf.cgns", failed);  // HDF5
   EXPECT_TRUE(failed);
 }
@@ -466,8 +473,8 @@ TEST(CgnsSniff, OtherHdf5FilesAreNeitherFormat) {
 
 TEST(ExodusComponents, TriplesNeedOneSpellingInOrder) {
   using vtkio::componentTriples;
-  const auto t = componentTriples({"T", "vel_x", "vel_y", "vel_z", "MomentumX", "MomentumY", "MomentumZ", "ax", "by",
-                                   "cz", "u_X", "u_y", "u_Z"});
+  const auto t = componentTriples(
+      {"T", "vel_x", "vel_y", "vel_z", "MomentumX", "MomentumY", "MomentumZ", "ax", "by", "cz", "u_X", "u_y", "u_Z"});
   ASSERT_EQ(t.size(), 2u);
   EXPECT_EQ(t[0].stem, "vel");
   EXPECT_EQ(t[0].first, 1u);
