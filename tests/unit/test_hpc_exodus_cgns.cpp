@@ -5,6 +5,7 @@
 // counts, volume, boundary area (a seam between blocks or zones leaves inner faces on the
 // boundary and adds area), field values, the point values of converted cell data, time steps;
 // then damaged copies (truncated, bytes changed) must give a Result naming the file.
+#include <exodusII.h>
 #include <gtest/gtest.h>
 #include <hdf5.h>
 #include <netcdf.h>
@@ -311,6 +312,25 @@ TEST(ExodusErrors, AttributesTooLongForTheLibraryAreRefused) {
     ASSERT_EQ(nc_put_att_float(nc, NC_GLOBAL, "api_version", NC_FLOAT, 4, versions), NC_NOERR);
   });
   EXPECT_FAILS(readMesh(copy, m, r), Status::Corrupt, "the global attribute api_version holds 4 values");
+}
+
+// A 2D mesh (num_dim 2: a block of quadrilaterals, as 2D solvers write) has no volume cells.
+TEST(ExodusErrors, TwoDimensionalMeshIsSaidSo) {
+  ScratchDir dir("exodus-2d");
+  const std::string file = dir.path + "/plate.exo";
+  int cpu = 8, io = 8;
+  const int id = ex_create(file.c_str(), EX_CLOBBER, &cpu, &io);
+  ASSERT_GE(id, 0);
+  const double x[4] = {0, 1, 1, 0}, y[4] = {0, 0, 1, 1};
+  const int conn[4] = {1, 2, 3, 4};
+  ASSERT_EQ(ex_put_init(id, "plate", 2, 4, 1, 1, 0, 0), 0);
+  ASSERT_EQ(ex_put_coord(id, x, y, nullptr), 0);
+  ASSERT_EQ(ex_put_block(id, EX_ELEM_BLOCK, 1, "QUAD4", 1, 4, 0, 0, 0), 0);
+  ASSERT_EQ(ex_put_conn(id, EX_ELEM_BLOCK, 1, conn, nullptr, nullptr), 0);
+  ASSERT_EQ(ex_close(id), 0);
+  TetMesh m;
+  ReadReport r;
+  EXPECT_FAILS(readMesh(file, m, r), Status::NoTets, "plate.exo: a 2D Exodus II mesh (num_dim 2): no volume cells");
 }
 
 TEST(ExodusNetcdfHeader, CountsAreCheckedAgainstTheFile) {
