@@ -314,6 +314,28 @@ TEST(ExodusErrors, AttributesTooLongForTheLibraryAreRefused) {
   EXPECT_FAILS(readMesh(copy, m, r), Status::Corrupt, "the global attribute api_version holds 4 values");
 }
 
+// Exodus numbers nodes and elements 1.. inside the file; users know them by the number maps' ids,
+// which the messages give too (exo_blocks.exo: node k has id 999 + 2k, element k 4998 + 3k).
+TEST(ExodusErrors, MessagesNameNodesAndElementsByTheirIds) {
+  ScratchDir dir("exodus-ids");
+  const std::string copy = dir.path + "/ids.exo";
+  auto edit = [&](const char* var, std::vector<size_t> index, double value) {
+    ASSERT_TRUE(saveFile(copy, loadFile(hpcPath("exo_blocks.exo"))));
+    int nc = -1, id = -1;
+    ASSERT_EQ(nc_open(copy.c_str(), NC_WRITE, &nc), NC_NOERR);
+    ASSERT_EQ(nc_inq_varid(nc, var, &id), NC_NOERR);
+    ASSERT_EQ(nc_put_var1_double(nc, id, index.data(), &value), NC_NOERR);
+    ASSERT_EQ(nc_close(nc), NC_NOERR);
+  };
+  TetMesh m;
+  ReadReport r;
+  edit("connect2", {1, 1}, 9999);  // block 20 (WEDGE): element 2's second node
+  EXPECT_FAILS(readMesh(copy, m, r), Status::OutOfRange,
+               "element block 20 (wedge) element 2 (id 5100) uses node 9999, but the nodes are numbered 1..450");
+  edit("coordy", {4}, std::nan(""));
+  EXPECT_FAILS(readMesh(copy, m, r), Status::NonFinite, "node 5 (id 1009) has a non-finite coordinate");
+}
+
 // A 2D mesh (num_dim 2: a block of quadrilaterals, as 2D solvers write) has no volume cells.
 TEST(ExodusErrors, TwoDimensionalMeshIsSaidSo) {
   ScratchDir dir("exodus-2d");
