@@ -26,10 +26,11 @@ std::string lowerExtension(const std::string& path) {
 
 constexpr const char* kSupported =
     "supported: .vtu/.vts/.vti (VTK XML), .vtk (legacy VTK), .msh (Gmsh 2.2/4.1), .node/.ele (TetGen), "
-    ".mesh (Medit), PLOT3D grids (.xyz, .x, .g, .grd, .p3d, .bin; Q file with --q), .xdmf/.xmf (XDMF 2/3, "
-    "HDF5 or XML data), .vtkhdf/.hdf (VTKHDF; .h5/.hdf5 with a /VTKHDF group)";
+    ".mesh (Medit), PLOT3D grids (.xyz, .x, .g, .grd, .p3d, .bin; Q file with --q), Exodus II (.exo, .e, .ex2, "
+    ".exii, .g), CGNS (.cgns), .xdmf/.xmf (XDMF 2/3, HDF5 or XML data), .vtkhdf/.hdf (VTKHDF; .h5/.hdf5 with a "
+    "/VTKHDF group)";
 
-enum class Format { Unknown, VtkXml, LegacyVtk, Gmsh, Medit, Tetgen, Plot3d, Xdmf, VtkHdf };
+enum class Format { Unknown, VtkXml, LegacyVtk, Gmsh, Medit, Tetgen, Plot3d, Exodus, Cgns, Xdmf, VtkHdf };
 
 // The extensions that name a format outright; anything else is sniffed from the content.
 Format byExtension(const std::string& ext) {
@@ -41,6 +42,9 @@ Format byExtension(const std::string& ext) {
   if (ext == ".xyz") return Format::Plot3d;
   if (ext == ".xdmf" || ext == ".xmf") return Format::Xdmf;
   if (ext == ".vtkhdf" || ext == ".hdf") return Format::VtkHdf;
+  // ".g" (a Genesis mesh, or a PLOT3D grid) is told by content.
+  if (ext == ".exo" || ext == ".e" || ext == ".ex2" || ext == ".exii") return Format::Exodus;
+  if (ext == ".cgns") return Format::Cgns;
   return Format::Unknown;
 }
 
@@ -70,7 +74,8 @@ Format sniff(std::string_view head, const std::string& ext) {
     break;
   }
   std::string_view t = head.substr(std::min(p, head.size()));
-  // An HDF5 file (.h5, .hdf5, ...) is taken as VTKHDF; its reader says so when /VTKHDF is missing.
+  // An HDF5 file (.h5, .hdf5, ...) that is not Exodus II or CGNS (hpcFormatByContent, before this)
+  // is taken as VTKHDF; its reader says so when /VTKHDF is missing.
   if (hdf5::hasSignature(head)) return Format::VtkHdf;
   if (t.starts_with("<")) return head.find("<Xdmf") != std::string_view::npos ? Format::Xdmf : Format::VtkXml;
   if (t.starts_with("# vtk DataFile")) return Format::LegacyVtk;
@@ -83,6 +88,8 @@ Format sniff(std::string_view head, const std::string& ext) {
 // The formats that can hold several time steps (and so take --step and --time).
 bool hasTimeSteps(Format f) {
   switch (f) {
+    case Format::Exodus:
+    case Format::Cgns:
     case Format::Xdmf:
     case Format::VtkHdf: return true;
     default: return false;
@@ -99,6 +106,8 @@ const char* formatName(Format f) {
     case Format::Plot3d: return "PLOT3D";
     case Format::Xdmf: return "XDMF";
     case Format::VtkHdf: return "VTKHDF";
+    case Format::Exodus: return "Exodus II";
+    case Format::Cgns: return "CGNS";
     default: return "unknown";
   }
 }
@@ -175,6 +184,11 @@ Result readOneFile(Format fmt, std::string_view bytes, const std::string& name, 
       return fail(Status::Unsupported, name +
                                            ": a VTKHDF file is HDF5, which is read through the HDF5 library from "
                                            "a file; read it by path, not from bytes");
+    case Format::Exodus:
+    case Format::Cgns:
+      return fail(Status::Unsupported,
+                  name + ": " + formatName(fmt) +
+                      " files are read by their library from disk; read it by path, not from bytes");
     default: break;
   }
   return fail(Status::Unsupported, name + ": unsupported mesh format; " + kSupported);
@@ -208,7 +222,15 @@ Result readMeshBytes(std::string_view bytes, const std::string& name, TetMesh& o
   out = TetMesh{};
   std::string ext = lowerExtension(name);
   Format fmt = byExtension(ext);
-  if (fmt == Format::Unknown) fmt = sniff(bytes.substr(0, 4096), ext);
+  if (fmt == Format::Unknown) {
+    // netCDF and ADF hold Exodus II and CGNS (HDF5 may hold other formats: left to sniff()).
+    const vtkio::Container c = vtkio::containerSignature(bytes);
+    if (c != vtkio::Container::None && c != vtkio::Container::Hdf5)
+      return fail(Status::Unsupported,
+                  name + ": " + vtkio::containerName(c) +
+                      " container (an Exodus II or CGNS file?); these are read by path, not from bytes");
+    fmt = sniff(bytes.substr(0, 4096), ext);
+  }
   if (fmt == Format::Unknown)
     return fail(Status::Unsupported, name + ": unsupported mesh format '" + ext + "'; " + kSupported);
   return guarded(name, out, [&] { return readOneFile(fmt, bytes, name, out, report); });
@@ -223,7 +245,10 @@ Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const
     // Sniff the first bytes before reading a possibly large file we cannot read anyway.
     std::string head;
     if (Result r = readHead(path, head); !r) return r;
-    fmt = sniff(head, ext);
+    const vtkio::HpcFormat hpc = vtkio::hpcFormatByContent(path, head);
+    fmt = hpc == vtkio::HpcFormat::Exodus ? Format::Exodus
+          : hpc == vtkio::HpcFormat::Cgns ? Format::Cgns
+                                          : sniff(head, ext);
     if (fmt == Format::Unknown)
       return fail(Status::Unsupported,
                   path + ": unsupported mesh format '" + ext + "' (content not recognized); " + kSupported);
@@ -236,6 +261,9 @@ Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const
                                          ") goes with a PLOT3D grid or a Medit mesh, and this is " + formatName(fmt));
 
   if (fmt == Format::VtkHdf) return guarded(path, out, [&] { return readVtkHdf(path, options, out, report); });
+  // The Exodus II and CGNS libraries read the file themselves.
+  if (fmt == Format::Exodus) return guarded(path, out, [&] { return readExodus(path, options, out, report); });
+  if (fmt == Format::Cgns) return guarded(path, out, [&] { return readCgns(path, options, out, report); });
 
   std::string bytes, second;
   std::string secondPath;

@@ -1,9 +1,11 @@
 // Mesh files in and out (pack side). Readers: VTK XML (.vtu UnstructuredGrid, .vts StructuredGrid,
 // .vti ImageData), legacy VTK (.vtk: UNSTRUCTURED_GRID, STRUCTURED_POINTS, STRUCTURED_GRID,
 // RECTILINEAR_GRID), Gmsh .msh 2.2/4.1 (ASCII and binary), TetGen .node/.ele, Medit .mesh (+ .sol),
-// PLOT3D grid + Q, XDMF 2/3 (.xdmf/.xmf; heavy data in HDF5, XML or raw binary; time steps) and
-// VTKHDF UnstructuredGrid (.vtkhdf/.hdf, or HDF5 with a /VTKHDF group; partitions, time steps).
-// HDF5 is read through the HDF5 library (hdf5_file.h). Writer: .vtu.
+// PLOT3D grid + Q, Exodus II (.exo, .e, .ex2, .exii, .g; through SEACAS's library, over netCDF or
+// HDF5), CGNS (.cgns, ADF or HDF5; through the CGNS library), XDMF 2/3 (.xdmf/.xmf; heavy data in
+// HDF5, XML or raw binary) and VTKHDF UnstructuredGrid (.vtkhdf/.hdf, or HDF5 with a /VTKHDF
+// group; partitions), the last four with time steps. HDF5 is read through the HDF5 library
+// (hdf5_file.h). Writer: .vtu.
 //
 // The readers take bytes from strangers: every failure is a Result whose message names the file,
 // the array, section, line or cell, and what was expected vs. found. They never throw, never
@@ -18,7 +20,9 @@
 //   - Coincident vertices (equal coordinates) are merged; tetrahedra that then repeat a vertex are
 //     dropped; vertices no tetrahedron uses (mid-edge nodes, unreferenced points) are dropped.
 //   - 1-component point arrays become scalar fields under their own name; n-component arrays
-//     become "NAME_magnitude" (Euclidean norm of the tuple). Cell data becomes point data: the
+//     become "NAME_magnitude" (Euclidean norm of the tuple). Exodus II and CGNS store vectors as
+//     one variable per component (vel_x, MomentumX, ...): those stay fields, and a NAME_magnitude
+//     is added. Cell data becomes point data: the
 //     volume-weighted average over the cells around each vertex ("NAME_cell" when a point array has
 //     the name). Lower-dimensional cells are counted by name and listed in notes and skippedCells.
 //   - Orientation and flat tetrahedra are left to the packer (it re-orients and removes them).
@@ -72,16 +76,18 @@ struct ReadOptions {
 };
 
 // Reads a mesh file, choosing the reader by extension (case-insensitive): .vtu/.vts/.vti, .vtk,
-// .msh, .mesh, .node/.ele (reads both), .xyz, .xdmf/.xmf (heavy data from the file's folder or
-// below it), .vtkhdf/.hdf; other extensions are recognized by their content (an HDF5 signature:
-// VTKHDF; XML with <Xdmf: XDMF; PLOT3D for binary data under .x, .g, .grd, .p3d, .bin, .dat).
-// out.name is the file's stem.
+// .msh, .mesh, .node/.ele (reads both), .xyz, .exo/.e/.ex2/.exii, .cgns, .xdmf/.xmf (heavy data
+// from the file's folder or below it), .vtkhdf/.hdf; other extensions are recognized by their
+// content (Exodus II for netCDF, or HDF5 with Exodus's variables; CGNS for ADF, or HDF5 with a
+// CGNSLibraryVersion node; any other HDF5: VTKHDF; XML with <Xdmf: XDMF; PLOT3D for binary data
+// under .x, .g, .grd, .p3d, .bin, .dat). out.name is the file's stem.
 Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const ReadOptions& options = {});
 
 // The same from bytes already in memory; `name` supplies the extension and the label in messages.
 // Formats of two files read only the first here (a PLOT3D grid without Q, a Medit mesh without
 // .sol); TetGen needs readTetgen (readers.h). XDMF reads only XML data items (HDF and Binary ones
-// are in other files: Unsupported); VTKHDF is Unsupported (read it by path).
+// are in other files: Unsupported); Exodus II, CGNS and VTKHDF are Unsupported (their libraries
+// read files, not memory: read them by path).
 Result readMeshBytes(std::string_view bytes, const std::string& name, TetMesh& out, ReadReport& report);
 
 // Writes a .vtu (VTK XML, appended raw binary; see vtu_writer.cpp). Only .vtu is supported.

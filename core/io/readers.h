@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <map>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <string>
@@ -67,6 +68,20 @@ Result readXdmf(std::string_view xml, const std::string& label, const std::optio
 // in .vtu; a Steps group makes time steps (options.step / options.time, default the last) and
 // only the chosen step's rows are read. Read by path through the HDF5 library.
 Result readVtkHdf(const std::string& path, const ReadOptions& options, TetMesh& out, ReadReport& report);
+// Exodus II (SEACAS) through its own library, over netCDF classic, 64-bit offset, 64-bit data
+// or netCDF-4 (HDF5). Element blocks of tetrahedra, hexahedra, wedges and pyramids of any order
+// (higher-order nodes dropped) are merged; other blocks (TRI, QUAD, SHELL, BAR, ...) are skipped
+// with a count by type. Nodal variables become fields, element variables cell data, both of the
+// time step chosen by options (chooseTimeStep; only that step is read). By path only: the library
+// reads the file itself.
+Result readExodus(const std::string& path, const ReadOptions& options, TetMesh& out, ReadReport& report);
+
+// CGNS (ADF or HDF5) through the CGNS library: the first base with 3D cells; unstructured zones
+// (TETRA, PYRA, PENTA, HEXA of any order and MIXED sections; NFACE_n refused) and structured
+// zones (split as structured grids are), zones joined where their points coincide;
+// FlowSolution at Vertex (fields) and CellCenter (cell data), of the time step chosen by
+// options when the base has BaseIterativeData. By path only.
+Result readCgns(const std::string& path, const ReadOptions& options, TetMesh& out, ReadReport& report);
 
 // VTK XML, appended raw binary: Float32 points, Int64 connectivity/offsets, UInt8 types, Float32
 // point data. One fwrite per array; writes PATH.tmp, then renames.
@@ -225,6 +240,65 @@ Result finishMesh(const std::string& label, TetMesh& mesh, CellSoup& soup, std::
 // index 0, and then --step or --time is a BadArgument, as is an index past the end.
 Result chooseTimeStep(std::span<const double> times, const ReadOptions& options, const std::string& label,
                       ReadReport& report, size_t& index);
+
+// ------------------------------------------------------------------ HPC containers (hpc_container.cpp)
+// The storage under Exodus II and CGNS files, by its first bytes.
+enum class Container : uint8_t { None, NetcdfClassic, Netcdf64BitOffset, Netcdf64BitData, Hdf5, Adf };
+Container containerSignature(std::string_view head);
+const char* containerName(Container c);  // "netCDF classic", "HDF5", "ADF", ...
+
+// Exodus II or CGNS, told by content for a file whose extension says nothing: ADF is CGNS; an
+// HDF5 file is CGNS with a CGNSLibraryVersion node, Exodus II with the netCDF attributes and
+// variables Exodus writes; a netCDF file is Exodus II with them. Anything else (VTKHDF, other
+// netCDF or HDF5 data) is None.
+enum class HpcFormat : uint8_t { None, Exodus, Cgns };
+HpcFormat hpcFormatByContent(const std::string& path, std::string_view head);
+
+// The HDF5, netCDF, Exodus II and CGNS libraries keep global state and are not built thread-safe:
+// every call into them holds this lock.
+std::mutex& hpcLibraryMutex();
+
+// Checks a netCDF classic header (CDF-1/2/5; `head` is the file's first bytes) before the netCDF
+// library reads it: every count must fit in the file's bytes, every variable's data in the file
+// (else Truncated, or Corrupt), as the library believes the counts and allocates by them.
+// needMore: the header goes on past `head` (give more of the file and check again).
+struct NetcdfHeaderResult {
+  Result result;
+  bool needMore = false;
+};
+NetcdfHeaderResult checkNetcdfClassicHeader(std::string_view head, uint64_t fileSize, const std::string& label);
+
+// Where an ADF file's data ends (its header's end-of-file pointer, a byte offset); false when
+// `head` (the first bytes) has no ADF header. The ADF library reads past a file's end unchecked.
+bool adfDataEnd(std::string_view head, uint64_t& end);
+
+// Closes what HDF5 still holds of the file at `path` (the CGNS library leaves groups of a file it
+// failed to open behind; HDF5 would report them on stderr at exit).
+void closeHdf5Leftovers(const std::string& path);
+
+// An Exodus II file as the Exodus library may be given it (exodus_checks.cpp): a netCDF classic
+// header that checks out, a file netCDF opens, and variables and attributes that hold what the
+// library's buffers expect. `container` is set from the signature.
+Result checkExodusFile(const std::string& path, uint64_t fileBytes, Container& container);
+
+// The most bytes a container of fileBytes can decode to: what it stores, or for HDF5 (which may
+// compress) the deflate limit. Counts a file declares are checked against this before allocating.
+uint64_t maxDecodedBytes(uint64_t fileBytes, Container c);
+
+// Exodus II and CGNS store vectors as one scalar per component ("vel_x", "vel_y", "vel_z";
+// "MomentumX", "MomentumY", "MomentumZ"). Three consecutive names that differ only in a last
+// x/y/z (either case, the same for all three, after an optional '_') form a vector: names[first]
+// .. names[first + 2], called `stem` ("vel", "Momentum").
+struct ComponentTriple {
+  std::string stem;
+  size_t first = 0;
+};
+std::vector<ComponentTriple> componentTriples(const std::vector<std::string>& names);
+// For every triple among mesh.fields[firstField ..] (or arrays[first ..]), adds the vector's
+// magnitude as STEM_magnitude (the readers' name for a vector's norm; the components stay), with
+// a note. A cell's magnitude is NaN where a component is.
+void addComponentMagnitudes(TetMesh& mesh, size_t firstField, ReadReport& report);
+void addComponentMagnitudes(std::vector<CellArray>& arrays, size_t first, ReadReport& report);
 
 // Whitespace-separated text with '#' comments (TetGen, Medit), with line numbers for messages.
 struct TextReader {

@@ -322,6 +322,20 @@ void twoFiles(const char* format, const uint8_t* data, size_t size) {
   if (r) checkReaderPromise(m);
 }
 
+void hpcHeaders(const uint8_t* data, size_t size) {
+  const std::string_view bytes(reinterpret_cast<const char*>(data), size);
+  const vtkio::NetcdfHeaderResult whole = vtkio::checkNetcdfClassicHeader(bytes, size, "fuzz.exo");
+  FUZZ_CHECK(!whole.needMore);  // the whole file was given
+  FUZZ_CHECK(whole.result || whole.result.message.starts_with("fuzz.exo: "));
+  // Given only the first half of the same file, the check asks for more or reaches the same verdict
+  // (the header alone decides; the data's extents use the file's size).
+  const vtkio::NetcdfHeaderResult half = vtkio::checkNetcdfClassicHeader(bytes.substr(0, size / 2), size, "fuzz.exo");
+  if (!half.needMore) FUZZ_CHECK(half.result.status == whole.result.status);
+  uint64_t end = 0;
+  if (vtkio::adfDataEnd(bytes, end)) FUZZ_CHECK(end < (uint64_t(1) << 48));
+  (void)vtkio::containerSignature(bytes);
+}
+
 bool runTarget(const std::string& name, const uint8_t* data, size_t size) {
   if (name == "manifest")
     manifest(data, size);
@@ -335,6 +349,8 @@ bool runTarget(const std::string& name, const uint8_t* data, size_t size) {
     meshFile(std::string(".").append(name, 5).c_str(), data, size);
   else if (name == "pair-tetgen" || name == "pair-medit" || name == "pair-plot3d")
     twoFiles(name.c_str() + 5, data, size);
+  else if (name == "hpc-headers")
+    hpcHeaders(data, size);
   else
     return false;
   return true;

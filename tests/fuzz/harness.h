@@ -38,10 +38,15 @@ void baseChunk(const uint8_t* data, size_t size);
 // must be a mesh whose tets reference existing vertices and whose fields have one value each.
 void meshFile(const char* extension, const uint8_t* data, size_t size);
 
+// The checks made before the Exodus II and CGNS libraries see a file (readers.h): a netCDF
+// classic header against the file's size (whole, and from its first half, which must ask for
+// more or agree), and an ADF header's end-of-file pointer. Never a crash, nor a huge allocation.
+void hpcHeaders(const uint8_t* data, size_t size);
+
 // Runs the target of that name ("manifest", "split-chunk", "node-chunk", "base-chunk", "mesh-vtu" for
 // meshFile(".vtu"), ..., "mesh-xdmf" for meshFile(".xdmf": the XML and its XML data items; heavy
-// data in other files is refused from bytes), "pair-tetgen" for twoFiles("tetgen"), ...). False
-// for an unknown name.
+// data in other files is refused from bytes), "pair-tetgen" for twoFiles("tetgen"), ...,
+// "hpc-headers"). False for an unknown name.
 bool runTarget(const std::string& name, const uint8_t* data, size_t size);
 
 // The formats made of two files (TetGen .node + .ele, Medit .mesh + .sol, PLOT3D grid + Q):

@@ -19,7 +19,7 @@ cmake --preset fuzz >/dev/null
 cmake --build build/fuzz -j2 >/dev/null
 TARGETS=("$@")
 [ ${#TARGETS[@]} -gt 0 ] || TARGETS=(manifest split-chunk base-chunk mesh-vtu mesh-vtk mesh-vts mesh-vti mesh-msh
-  mesh-mesh mesh-xyz mesh-xdmf pair-tetgen pair-medit pair-plot3d)
+  mesh-mesh mesh-xyz mesh-xdmf pair-tetgen pair-medit pair-plot3d hpc-headers)
 # A two-file seed: 4-byte little-endian length of the first file, then both files.
 pair_seed() { python3 -c 'import sys,struct; a=open(sys.argv[1],"rb").read(); b=open(sys.argv[2],"rb").read(); sys.stdout.buffer.write(struct.pack("<I",len(a))+a+b)' "$1" "$2"; }
 
@@ -37,6 +37,7 @@ for t in "${TARGETS[@]}"; do
     pair-tetgen) for n in $F/*.node; do pair_seed "$n" "${n%.node}.ele" > "$seeds/$(basename "${n%.node}")"; done ;;
     pair-medit) pair_seed $F/grid.mesh $F/grid.sol > "$seeds/grid"; pair_seed $F/mixed.mesh /dev/null > "$seeds/mixed" ;;
     pair-plot3d) for g in $F/p3d_*; do [[ $g == *.q ]] || pair_seed "$g" "${g%.*}.q" > "$seeds/$(basename "$g")"; done ;;
+    hpc-headers) for h in tests/fixtures/hpc/exo_blocks.exo tests/fixtures/hpc/*.adf.cgns; do head -c 8192 "$h" > "$seeds/$(basename "$h")"; done ;;
     *) build/fuzz/write_seeds "$t" "$seeds" ;;
   esac
   echo "fuzz: $t for ${SECONDS_EACH}s"

@@ -168,6 +168,48 @@ test('XDMF and VTKHDF: info lists the steps, --step picks one, pack and iso read
   const refused = cli('info', escape);
   assert.equal(refused.status, 1);
   assert.match(refused.stderr, /escape\.xdmf Grid 'Grid' Geometry .*'\/etc\/passwd' is an absolute path/);
+// Exodus II and CGNS (tests/fixtures/hpc): info lists the time steps, --step and --time pick one,
+// and pack + iso work on what was read.
+test('Exodus II and CGNS: steps listed by info, --step/--time, pack and iso', () => {
+  const fx = (name) => path.join(root, 'tests/fixtures/hpc', name);
+  const info = cli('info', fx('exo_blocks.exo'), '--json');
+  assert.equal(info.status, 0, info.stderr);
+  assert.match(info.json.inputFormat, /^Exodus II \(netCDF 64-bit offset\), 6 element blocks/);
+  assert.deepEqual(info.json.steps, [{ index: 0, time: 0 }, { index: 1, time: 0.5 }, { index: 2, time: 1 }]);
+  assert.equal(info.json.stepRead, 2);
+  assert.equal(info.json.tets, 960);
+  const temperature = (j) => j.fields.find((f) => f.name === 'temperature');
+  assert.equal(temperature(info.json).max, 17, 'the last step: x + 2y + 3z + 10 at (2, 1, 1)');
+  const first = cli('info', fx('exo_blocks.exo'), '--step', '0', '--json');
+  assert.equal(first.json.stepRead, 0);
+  assert.equal(temperature(first.json).max, 7);
+  const near = cli('info', fx('exo_blocks.exo'), '--time', '0.6', '--json');
+  assert.equal(near.json.stepRead, 1);
+  const text = cli('info', fx('exo_blocks.exo'));
+  assert.match(text.stdout, /^ {2}steps {5}3, read step 2 \(t = 1\)$/m);
+  const past = cli('info', fx('exo_blocks.exo'), '--step', '7');
+  assert.equal(past.status, 1);
+  assert.match(past.stderr, /--step 7 does not exist; it has 3 time steps/);
+
+  const dir = tempDir('hpc');
+  const pack = cli('pack', fx('exo_blocks.exo'), '--step', '1', '--field', 'temperature', '-o', path.join(dir, 'exo'), '--json');
+  assert.equal(pack.status, 0, pack.stderr);
+  assert.equal(pack.json.tets, 960);
+  const iso = cli('iso', path.join(dir, 'exo'), '--value', '8', '--json');
+  assert.equal(iso.status, 0, iso.stderr);
+  assert.ok(iso.json.triangles > 0 && iso.json.area > 0, JSON.stringify(iso.json));
+  // The same surface from the file itself at that step (the pack is within half a grid step).
+  const direct = cli('iso', fx('exo_blocks.exo'), '--step', '1', '--field', 'temperature', '--value', '8', '--json');
+  assert.equal(direct.status, 0, direct.stderr);
+  assert.ok(Math.abs(direct.json.area - iso.json.area) < 1e-3 * direct.json.area, `${direct.json.area} vs ${iso.json.area}`);
+
+  const cgns = cli('pack', fx('cgns_structured.adf.cgns'), '-o', path.join(dir, 'cgns'));
+  assert.equal(cgns.status, 0, cgns.stderr);
+  assert.match(cgns.stdout, /^ {2}format {4}CGNS \(ADF\), base 'Base', 2 structured zones$/m);
+  const poly = cli('info', fx('cgns_polyhedra.cgns'), '--json');
+  assert.equal(poly.status, 1);
+  assert.match(poly.stderr, /NFACE_n cells \(polyhedra given by their faces\) are not read/);
+  assert.equal(poly.stdout.includes('Warning'), false, 'library warnings stay off stdout');
 });
 
 // The commands that read an input start the program again with glibc's huge pages on
