@@ -168,6 +168,8 @@ test('XDMF and VTKHDF: info lists the steps, --step picks one, pack and iso read
   const refused = cli('info', escape);
   assert.equal(refused.status, 1);
   assert.match(refused.stderr, /escape\.xdmf Grid 'Grid' Geometry .*'\/etc\/passwd' is an absolute path/);
+});
+
 // Exodus II and CGNS (tests/fixtures/hpc): info lists the time steps, --step and --time pick one,
 // and pack + iso work on what was read.
 test('Exodus II and CGNS: steps listed by info, --step/--time, pack and iso', () => {
