@@ -83,7 +83,8 @@ Runner addPack(CLI::App& app) {
   auto o = std::make_shared<Opts>();
   CLI::App* sub = app.add_subcommand("pack", "Pack a mesh into a progressive dataset folder (manifest + chunks)");
   sub->add_option("input", o->input,
-                  "mesh file: .vtu/.vts/.vti, .vtk, .msh (Gmsh), .node/.ele (TetGen), .mesh (Medit), PLOT3D grid")
+                  "mesh file: .vtu/.vts/.vti, .vtk, .pvtu/.vtm/.pvtk (with their pieces), .msh (Gmsh), .node/.ele "
+                  "(TetGen), .mesh (Medit), PLOT3D grid")
       ->required();
   addReadOptions(sub, o->read);
   sub->add_option("-o,--output", o->out, "output folder (created; an earlier pack there is replaced)")->required();

@@ -24,15 +24,17 @@ std::string lowerExtension(const std::string& path) {
 }
 
 constexpr const char* kSupported =
-    "supported: .vtu/.vts/.vti (VTK XML), .vtk (legacy VTK), .msh (Gmsh 2.2/4.1), .node/.ele (TetGen), "
-    ".mesh (Medit), PLOT3D grids (.xyz, .x, .g, .grd, .p3d, .bin; Q file with --q)";
+    "supported: .vtu/.vts/.vti (VTK XML), .vtk (legacy VTK), partitioned VTK output (.pvtu, .vtm, .pvtk, with "
+    "their pieces), .msh (Gmsh 2.2/4.1), .node/.ele (TetGen), .mesh (Medit), PLOT3D grids (.xyz, .x, .g, .grd, "
+    ".p3d, .bin; Q file with --q)";
 
-enum class Format { Unknown, VtkXml, LegacyVtk, Gmsh, Medit, Tetgen, Plot3d };
+enum class Format { Unknown, VtkXml, LegacyVtk, Gmsh, Medit, Tetgen, Plot3d, Listing };
 
 // The extensions that name a format outright; anything else is sniffed from the content.
 Format byExtension(const std::string& ext) {
   if (ext == ".vtu" || ext == ".vts" || ext == ".vti") return Format::VtkXml;
   if (ext == ".vtk") return Format::LegacyVtk;
+  if (ext == ".pvtu" || ext == ".vtm" || ext == ".pvtk") return Format::Listing;
   if (ext == ".msh") return Format::Gmsh;
   if (ext == ".mesh") return Format::Medit;
   if (ext == ".node" || ext == ".ele") return Format::Tetgen;
@@ -89,6 +91,7 @@ const char* formatName(Format f) {
     case Format::Medit: return "Medit";
     case Format::Tetgen: return "TetGen";
     case Format::Plot3d: return "PLOT3D";
+    case Format::Listing: return "a listing of VTK pieces";
     default: return "unknown";
   }
 }
@@ -159,6 +162,10 @@ Result readOneFile(Format fmt, std::string_view bytes, const std::string& name, 
     case Format::Tetgen:
       return fail(Status::Unsupported,
                   name + ": a TetGen mesh is two files (.node and .ele); read it by path, not from bytes");
+    case Format::Listing:
+      return fail(Status::Unsupported, name +
+                                           ": a listing of piece files (.pvtu, .vtm, .pvtk); read it by path, "
+                                           "which finds the pieces beside it");
     default: break;
   }
   return fail(Status::Unsupported, name + ": unsupported mesh format; " + kSupported);
@@ -186,6 +193,20 @@ std::vector<std::string> plot3dSolutionCandidates(const std::string& path) {
   return existing;
 }
 
+// Reads the pieces a listing at `listingPath` names from its folder (readListing has checked
+// that each path stays inside it).
+PieceLoader pieceFiles(const std::string& listingPath) {
+  namespace fs = std::filesystem;
+  return [listingPath](const std::string& relative, std::string& bytes) {
+    const fs::path full = fs::path(listingPath).parent_path() / relative;
+    std::error_code ec;
+    if (fs::equivalent(full, listingPath, ec)) return fail(Status::Corrupt, full.string() + " is the listing itself");
+    if (fs::exists(full, ec) && !fs::is_regular_file(full, ec))
+      return fail(Status::IoError, full.string() + ": not a file");
+    return readWholeFile(full.string(), bytes);
+  };
+}
+
 }  // namespace
 
 Result readMeshBytes(std::string_view bytes, const std::string& name, TetMesh& out, ReadReport& report) {
@@ -195,6 +216,7 @@ Result readMeshBytes(std::string_view bytes, const std::string& name, TetMesh& o
   if (fmt == Format::Unknown) fmt = sniff(bytes.substr(0, 4096), ext);
   if (fmt == Format::Unknown)
     return fail(Status::Unsupported, name + ": unsupported mesh format '" + ext + "'; " + kSupported);
+  if (fmt == Format::VtkXml && listingKind(bytes.substr(0, 4096)) != ListingKind::None) fmt = Format::Listing;
   return guarded(name, out, [&] { return readOneFile(fmt, bytes, name, out, report); });
 }
 
@@ -258,6 +280,10 @@ Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const
     return guarded(path, out, [&] { return readMedit(bytes, path, second, secondPath, out, report); });
   if (fmt == Format::Plot3d)
     return guarded(path, out, [&] { return readPlot3d(bytes, path, second, secondPath, out, report); });
+  // A listing of pieces, by its extension or by its content (a .pvtu saved as .vtu, say).
+  if (fmt == Format::Listing ||
+      (fmt == Format::VtkXml && listingKind(std::string_view(bytes).substr(0, 4096)) != ListingKind::None))
+    return guarded(path, out, [&] { return readListing(bytes, path, pieceFiles(path), out, report); });
   return guarded(path, out, [&] { return readOneFile(fmt, bytes, path, out, report); });
 }
 

@@ -1,7 +1,9 @@
 // Mesh files in and out (pack side). Readers: VTK XML (.vtu UnstructuredGrid, .vts StructuredGrid,
 // .vti ImageData), legacy VTK (.vtk: UNSTRUCTURED_GRID, STRUCTURED_POINTS, STRUCTURED_GRID,
-// RECTILINEAR_GRID), Gmsh .msh 2.2/4.1 (ASCII and binary), TetGen .node/.ele, Medit .mesh (+ .sol),
-// PLOT3D grid + Q. Writer: .vtu.
+// RECTILINEAR_GRID), partitioned VTK output (.pvtu with its .vtu pieces, .vtm multiblock of
+// unstructured blocks, legacy .pvtk with its .vtk pieces, and a .vtu of several <Piece>s),
+// Gmsh .msh 2.2/4.1 (ASCII and binary), TetGen .node/.ele, Medit .mesh (+ .sol), PLOT3D grid + Q.
+// Writer: .vtu.
 //
 // The readers take bytes from strangers: every failure is a Result whose message names the file,
 // the array, section, line or cell, and what was expected vs. found. They never throw, never
@@ -19,6 +21,12 @@
 //     become "NAME_magnitude" (Euclidean norm of the tuple). Cell data becomes point data: the
 //     volume-weighted average over the cells around each vertex ("NAME_cell" when a point array has
 //     the name). Lower-dimensional cells are counted by name and listed in notes and skippedCells.
+//   - Pieces of a partitioned mesh (piece_merge.cpp) become one mesh: ghost cells (vtkGhostType
+//     DUPLICATECELL, and HIDDENCELL) are dropped; the points pieces share are welded by global ids
+//     (GlobalIds, GlobalNodeIds) when every piece has them, else by exact coordinates, and take
+//     the owning piece's values (disagreements between pieces are counted in a note, never
+//     averaged). vtkGhostType and global id arrays are not fields. A listing's pieces are read
+//     only from its folder and subfolders (no absolute paths, none leaving it).
 //   - Orientation and flat tetrahedra are left to the packer (it re-orients and removes them).
 // Errors: IoError (file), BadMagic (not this format), Unsupported (valid file, feature not read,
 // e.g. DATASET POLYDATA or an LZ4 compressor), Truncated, Corrupt, OutOfRange (a cell's vertex id;
@@ -70,13 +78,14 @@ struct ReadOptions {
 };
 
 // Reads a mesh file, choosing the reader by extension (case-insensitive): .vtu/.vts/.vti, .vtk,
-// .msh, .mesh, .node/.ele (reads both), .xyz; other extensions are recognized by their content
-// (PLOT3D for binary data under .x, .g, .grd, .p3d, .bin, .dat). out.name is the file's stem.
+// .pvtu/.vtm/.pvtk (and the pieces they list), .msh, .mesh, .node/.ele (reads both), .xyz; other
+// extensions are recognized by their content (a listing under any name, PLOT3D for binary data
+// under .x, .g, .grd, .p3d, .bin, .dat). out.name is the file's stem.
 Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const ReadOptions& options = {});
 
 // The same from bytes already in memory; `name` supplies the extension and the label in messages.
 // Formats of two files read only the first here (a PLOT3D grid without Q, a Medit mesh without
-// .sol); TetGen needs readTetgen (readers.h).
+// .sol); TetGen needs readTetgen (readers.h), a listing of pieces readListing (readers.h).
 Result readMeshBytes(std::string_view bytes, const std::string& name, TetMesh& out, ReadReport& report);
 
 // Writes a .vtu (VTK XML, appended raw binary; see vtu_writer.cpp). Only .vtu is supported.
