@@ -150,11 +150,11 @@ std::string withThousands(uint64_t n) {
 
 std::string describeMerge(const PieceMergeSummary& s, const char* pieceWord) {
   std::string d = ", " + withThousands(s.pieces) + " " + (s.pieces == 1 ? "piece" : pieceWord);
-  if (s.ghostCells) d += ", " + withThousands(s.ghostCells) + " ghost cells dropped";
-  if (s.hiddenCells) d += ", " + withThousands(s.hiddenCells) + " hidden cells dropped";
-  if (s.duplicateCells) d += ", " + withThousands(s.duplicateCells) + " cells held twice dropped";
+  if (s.ghostCells) d += ", " + plural(s.ghostCells, "ghost cell", "ghost cells") + " dropped";
+  if (s.hiddenCells) d += ", " + plural(s.hiddenCells, "hidden cell", "hidden cells") + " dropped";
+  if (s.duplicateCells) d += ", " + plural(s.duplicateCells, "cell", "cells") + " held twice dropped";
   if (s.pieces > 1)
-    d += ", " + withThousands(s.weldedPoints) + " interface points welded by " +
+    d += ", " + plural(s.weldedPoints, "interface point", "interface points") + " welded by " +
          (s.byGlobalIds ? s.globalIdsName : std::string("coordinates"));
   return d;
 }
