@@ -280,9 +280,12 @@ Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const
     return guarded(path, out, [&] { return readMedit(bytes, path, second, secondPath, out, report); });
   if (fmt == Format::Plot3d)
     return guarded(path, out, [&] { return readPlot3d(bytes, path, second, secondPath, out, report); });
-  // A listing of pieces, by its extension or by its content (a .pvtu saved as .vtu, say).
-  if (fmt == Format::Listing ||
-      (fmt == Format::VtkXml && listingKind(std::string_view(bytes).substr(0, 4096)) != ListingKind::None))
+  // A listing of pieces, by its extension or by its content (a .pvtu saved as .vtu, say); a
+  // VTK XML mesh saved under a listing's extension is read as the mesh it is.
+  const std::string_view head = std::string_view(bytes).substr(0, 4096);
+  const bool listing = listingKind(head) != ListingKind::None;
+  if (fmt == Format::Listing && !listing && !vtkio::vtkXmlFileType(head).empty()) fmt = Format::VtkXml;
+  if (fmt == Format::Listing || (fmt == Format::VtkXml && listing))
     return guarded(path, out, [&] { return readListing(bytes, path, pieceFiles(path), out, report); });
   return guarded(path, out, [&] { return readOneFile(fmt, bytes, path, out, report); });
 }

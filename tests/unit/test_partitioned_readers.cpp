@@ -618,7 +618,8 @@ TEST(PartitionedReaders, RecognisedByContent) {
   fs::copy_file(c.path("ghost.pvtu"), c.path("ghost.xml"));
   fs::copy_file(c.path("ghost.pvtu"), c.path("listing.vtu"));
   fs::copy_file(c.path("legacy.pvtk"), c.path("legacy.txt"));
-  for (const char* name : {"ghost.xml", "listing.vtu", "legacy.txt"}) {
+  fs::copy_file(c.path("box.vtu"), c.path("box.pvtu"));  // a mesh under a listing's name
+  for (const char* name : {"ghost.xml", "listing.vtu", "legacy.txt", "box.pvtu"}) {
     TetMesh m;
     ReadReport r;
     Result res = read(c.path(name), m, r);
