@@ -94,7 +94,8 @@ Runner addPack(CLI::App& app) {
                   "cost weights G,F,S: boundary geometry, field, tet shape (default 100,1,0.005)")
       ->delimiter(',')
       ->expected(3);
-  auto* bf = sub->add_option("--base-fraction", o->baseFraction, "base mesh size as a fraction of the vertices (at most 65,536 of them)")
+  auto* bf = sub->add_option("--base-fraction", o->baseFraction,
+                             "base mesh size as a fraction of the vertices (at most 65,536 of them)")
                  ->check(CLI::Range(0.0, 1.0))
                  ->capture_default_str();
   auto* bv = sub->add_option("--base-vertices", o->baseVertices, "base mesh size in vertices");
