@@ -25,17 +25,18 @@ std::string lowerExtension(const std::string& path) {
 }
 
 constexpr const char* kSupported =
-    "supported: .vtu/.vts/.vti (VTK XML), .vtk (legacy VTK), .msh (Gmsh 2.2/4.1), .node/.ele (TetGen), "
-    ".mesh (Medit), PLOT3D grids (.xyz, .x, .g, .grd, .p3d, .bin; Q file with --q), Exodus II (.exo, .e, .ex2, "
-    ".exii, .g), CGNS (.cgns), .xdmf/.xmf (XDMF 2/3, HDF5 or XML data), .vtkhdf/.hdf (VTKHDF; .h5/.hdf5 with a "
-    "/VTKHDF group)";
+    "supported: .vtu/.vts/.vti (VTK XML), .vtk (legacy VTK), partitioned VTK output (.pvtu, .vtm, .pvtk, with "
+    "their pieces), .msh (Gmsh 2.2/4.1), .node/.ele (TetGen), .mesh (Medit), PLOT3D grids (.xyz, .x, .g, .grd, "
+    ".p3d, .bin; Q file with --q), Exodus II (.exo, .e, .ex2, .exii, .g), CGNS (.cgns), .xdmf/.xmf (XDMF 2/3, "
+    "HDF5 or XML data), .vtkhdf/.hdf (VTKHDF; .h5/.hdf5 with a /VTKHDF group)";
 
-enum class Format { Unknown, VtkXml, LegacyVtk, Gmsh, Medit, Tetgen, Plot3d, Exodus, Cgns, Xdmf, VtkHdf };
+enum class Format { Unknown, VtkXml, LegacyVtk, Gmsh, Medit, Tetgen, Plot3d, Listing, Exodus, Cgns, Xdmf, VtkHdf };
 
 // The extensions that name a format outright; anything else is sniffed from the content.
 Format byExtension(const std::string& ext) {
   if (ext == ".vtu" || ext == ".vts" || ext == ".vti") return Format::VtkXml;
   if (ext == ".vtk") return Format::LegacyVtk;
+  if (ext == ".pvtu" || ext == ".vtm" || ext == ".pvtk") return Format::Listing;
   if (ext == ".msh") return Format::Gmsh;
   if (ext == ".mesh") return Format::Medit;
   if (ext == ".node" || ext == ".ele") return Format::Tetgen;
@@ -108,6 +109,7 @@ const char* formatName(Format f) {
     case Format::VtkHdf: return "VTKHDF";
     case Format::Exodus: return "Exodus II";
     case Format::Cgns: return "CGNS";
+    case Format::Listing: return "a listing of VTK pieces";
     default: return "unknown";
   }
 }
@@ -189,6 +191,10 @@ Result readOneFile(Format fmt, std::string_view bytes, const std::string& name, 
       return fail(Status::Unsupported,
                   name + ": " + formatName(fmt) +
                       " files are read by their library from disk; read it by path, not from bytes");
+    case Format::Listing:
+      return fail(Status::Unsupported, name +
+                                           ": a listing of piece files (.pvtu, .vtm, .pvtk); read it by path, "
+                                           "which finds the pieces beside it");
     default: break;
   }
   return fail(Status::Unsupported, name + ": unsupported mesh format; " + kSupported);
@@ -216,6 +222,20 @@ std::vector<std::string> plot3dSolutionCandidates(const std::string& path) {
   return existing;
 }
 
+// Reads the pieces a listing at `listingPath` names from its folder (readListing has checked
+// that each path stays inside it).
+PieceLoader pieceFiles(const std::string& listingPath) {
+  namespace fs = std::filesystem;
+  return [listingPath](const std::string& relative, std::string& bytes) {
+    const fs::path full = fs::path(listingPath).parent_path() / relative;
+    std::error_code ec;
+    if (fs::equivalent(full, listingPath, ec)) return fail(Status::Corrupt, full.string() + " is the listing itself");
+    if (fs::exists(full, ec) && !fs::is_regular_file(full, ec))
+      return fail(Status::IoError, full.string() + ": not a file");
+    return readWholeFile(full.string(), bytes);
+  };
+}
+
 }  // namespace
 
 Result readMeshBytes(std::string_view bytes, const std::string& name, TetMesh& out, ReadReport& report) {
@@ -233,6 +253,7 @@ Result readMeshBytes(std::string_view bytes, const std::string& name, TetMesh& o
   }
   if (fmt == Format::Unknown)
     return fail(Status::Unsupported, name + ": unsupported mesh format '" + ext + "'; " + kSupported);
+  if (fmt == Format::VtkXml && listingKind(bytes.substr(0, 4096)) != ListingKind::None) fmt = Format::Listing;
   return guarded(name, out, [&] { return readOneFile(fmt, bytes, name, out, report); });
 }
 
@@ -254,8 +275,8 @@ Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const
                   path + ": unsupported mesh format '" + ext + "' (content not recognized); " + kSupported);
   }
   if ((options.step || options.time) && !hasTimeSteps(fmt))
-    return fail(Status::BadArgument, path + ": a " + formatName(fmt) +
-                                         " file holds one state; --step and --time apply to files with time steps");
+    return fail(Status::BadArgument, path + " (" + formatName(fmt) +
+                                         ") holds one state; --step and --time apply to files with time steps");
   if (!options.solution.empty() && fmt != Format::Plot3d && fmt != Format::Medit)
     return fail(Status::BadArgument, path + ": a solution file (--q " + options.solution +
                                          ") goes with a PLOT3D grid or a Medit mesh, and this is " + formatName(fmt));
@@ -308,6 +329,13 @@ Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const
     const std::string folder = fs::path(path).parent_path().string();
     return guarded(path, out, [&] { return readXdmf(bytes, path, folder, options, out, report); });
   }
+  // A listing of pieces, by its extension or by its content (a .pvtu saved as .vtu, say); a
+  // VTK XML mesh saved under a listing's extension is read as the mesh it is.
+  const std::string_view head = std::string_view(bytes).substr(0, 4096);
+  const bool listing = listingKind(head) != ListingKind::None;
+  if (fmt == Format::Listing && !listing && !vtkio::vtkXmlFileType(head).empty()) fmt = Format::VtkXml;
+  if (fmt == Format::Listing || (fmt == Format::VtkXml && listing))
+    return guarded(path, out, [&] { return readListing(bytes, path, pieceFiles(path), out, report); });
   return guarded(path, out, [&] { return readOneFile(fmt, bytes, path, out, report); });
 }
 

@@ -214,6 +214,52 @@ test('Exodus II and CGNS: steps listed by info, --step/--time, pack and iso', ()
   assert.equal(poly.stdout.includes('Warning'), false, 'library warnings stay off stdout');
 });
 
+// Partitioned output (tests/fixtures/partitioned, written by VTK): info says what was read, and a
+// pack of the pieces has the isosurface of the whole mesh.
+test('partitioned VTK output: info, pack and iso as of the whole mesh', () => {
+  const fx = (name) => path.join(root, 'tests/fixtures/partitioned', name);
+  const info = cli('info', fx('ghost.pvtu'), '--json');
+  assert.equal(info.status, 0, info.stderr);
+  assert.match(info.json.inputFormat,
+    /^parallel VTK \(\.pvtu\), 3 pieces, 392 ghost cells dropped, 50 interface points welded by coordinates; pieces: VTK XML UnstructuredGrid/);
+  assert.equal(info.json.vertices, 112);
+  assert.equal(info.json.tets, 324);
+  assert.equal(info.json.validation.boundaryFaces, 180);
+  assert.deepEqual(info.json.fields.map((f) => f.name), ['T', 'S', 'v_magnitude', 'region']);
+  const ids = cli('info', fx('ids.pvtu'), '--json');
+  assert.match(ids.json.inputFormat, /4 pieces, 76 interface points welded by GlobalIds/);
+  const text = cli('info', fx('disagree.pvtu'));
+  assert.match(text.stdout, /note {6}field 'T': 3 of 26 interface points disagree between pieces \(largest difference 0\.5\)/);
+
+  const dir = tempDir('partitioned');
+  for (const listing of ['ghost.pvtu', 'blocks.vtm', 'legacy.pvtk', 'petsc.vtu']) {
+    const out = path.join(dir, listing.replace('.', '-'));
+    const pack = cli('pack', fx(listing), '--lossless', '--field', 'T', '-o', out, '--json');
+    assert.equal(pack.status, 0, pack.stderr);
+    for (const value of ['1.5', '3.25']) {
+      const whole = cli('iso', fx('box.vtu'), '--field', 'T', '--value', value, '--json').json;
+      const packed = cli('iso', out, '--field', 'T', '--value', value, '--json').json;
+      // petsc.vtu holds the box as hexahedra, split by the joined mesh's numbering: other tets,
+      // but T is linear, so the same plane.
+      if (listing !== 'petsc.vtu') {
+        for (const k of ['triangles', 'vertices']) assert.equal(packed[k], whole[k], `${listing} ${value} ${k}`);
+      }
+      assert.ok(packed.triangles > 0);
+      assert.ok(Math.abs(packed.area - whole.area) <= 1e-6 * whole.area, `${listing}: ${packed.area} vs ${whole.area}`);
+    }
+  }
+
+  // A listing whose piece climbs out of its folder: refused, named, exit 1.
+  fs.cpSync(path.join(root, 'tests/fixtures/partitioned'), path.join(dir, 'copy'), { recursive: true });
+  const listing = path.join(dir, 'copy', 'ghost.pvtu');
+  fs.writeFileSync(listing, fs.readFileSync(listing, 'utf8').replace('ghost/ghost_1.vtu', '../../etc/passwd'));
+  const bad = cli('info', listing, '--json');
+  assert.equal(bad.status, 1);
+  assert.match(bad.stderr, /ghost\.pvtu piece 1: '\.\.\/\.\.\/etc\/passwd' leaves the listing's folder/);
+  assert.equal(bad.json.error.status, 'unsupported');
+  fs.rmSync(dir, { recursive: true, force: true });
+});
+
 // The commands that read an input start the program again with glibc's huge pages on
 // (core/cli/huge_pages.h): the pack must be the same byte for byte with them, without them
 // (TETSTREAM_HUGE_PAGES=0) and with a user's own GLIBC_TUNABLES kept (a small input also gets
