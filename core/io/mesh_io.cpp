@@ -275,8 +275,8 @@ Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const
                   path + ": unsupported mesh format '" + ext + "' (content not recognized); " + kSupported);
   }
   if ((options.step || options.time) && !hasTimeSteps(fmt))
-    return fail(Status::BadArgument, path + " (" + formatName(fmt) +
-                                         ") holds one state; --step and --time apply to files with time steps");
+    return fail(Status::BadArgument,
+                path + " (" + formatName(fmt) + ") holds one state; --step and --time apply to files with time steps");
   if (!options.solution.empty() && fmt != Format::Plot3d && fmt != Format::Medit)
     return fail(Status::BadArgument, path + ": a solution file (--q " + options.solution +
                                          ") goes with a PLOT3D grid or a Medit mesh, and this is " + formatName(fmt));
