@@ -672,13 +672,7 @@ class CgnsReader {
       s += zonesText(unstructured, "unstructured") + " + " + zonesText(structured_, "structured");
     else
       s += zonesText(zones_.size(), structured_ ? "structured" : "unstructured");
-    if (!report_.steps.empty()) {
-      char t[64];
-      std::snprintf(t, sizeof t, "%g", report_.steps[report_.stepRead].time);
-      s += ", step " + std::to_string(report_.stepRead) + " of " + std::to_string(report_.steps.size()) +
-           " (0-based; t = " + t + ")";
-    }
-    return s;
+    return s + stepText(report_);
   }
 
   const std::string& path_;

@@ -452,13 +452,7 @@ class ExodusReader {
                     (container_ == Container::Hdf5 ? "netCDF-4" : containerName(container_)) + "), " +
                     std::to_string(blocks_.size()) + (blocks_.size() == 1 ? " element block" : " element blocks");
     if (volume != blocks_.size()) s += " (" + std::to_string(volume) + " of volume cells)";
-    if (!report_.steps.empty()) {
-      char t[64];
-      std::snprintf(t, sizeof t, "%g", report_.steps[report_.stepRead].time);
-      s += ", step " + std::to_string(report_.stepRead) + " of " + std::to_string(report_.steps.size()) +
-           " (0-based; t = " + t + ")";
-    }
-    return s;
+    return s + stepText(report_);
   }
 
   const std::string& path_;

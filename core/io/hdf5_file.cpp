@@ -280,31 +280,29 @@ Result File::select(const std::string& dataset, const Slab& slab, uint64_t expec
   return Result::success();
 }
 
-Result File::readDoubles(const std::string& dataset, const Slab& slab, uint64_t expect,
-                         std::vector<double>& out) const {
+// Reads a selection into `out`, converted by the library to `memType` (its C type is T's).
+template <typename T>
+Result File::readSelection(const std::string& dataset, const Slab& slab, uint64_t expect, hid_t memType,
+                           std::vector<T>& out) const {
   out.clear();
   Handle ds, fileSpace, memSpace;
   if (Result r = select(dataset, slab, expect, ds, fileSpace, memSpace); !r) return r;
   if (expect == 0) return Result::success();
   out.resize(expect);
-  if (H5Dread(ds.get(), H5T_NATIVE_DOUBLE, memSpace.get(), fileSpace.get(), H5P_DEFAULT, out.data()) < 0) {
+  if (H5Dread(ds.get(), memType, memSpace.get(), fileSpace.get(), H5P_DEFAULT, out.data()) < 0) {
     out.clear();
     return fail(Status::Corrupt, withLibraryMessage(where(dataset) + " cannot be read"));
   }
   return Result::success();
 }
 
+Result File::readDoubles(const std::string& dataset, const Slab& slab, uint64_t expect,
+                         std::vector<double>& out) const {
+  return readSelection(dataset, slab, expect, H5T_NATIVE_DOUBLE, out);
+}
+
 Result File::readInts(const std::string& dataset, const Slab& slab, uint64_t expect, std::vector<int64_t>& out) const {
-  out.clear();
-  Handle ds, fileSpace, memSpace;
-  if (Result r = select(dataset, slab, expect, ds, fileSpace, memSpace); !r) return r;
-  if (expect == 0) return Result::success();
-  out.resize(expect);
-  if (H5Dread(ds.get(), H5T_NATIVE_INT64, memSpace.get(), fileSpace.get(), H5P_DEFAULT, out.data()) < 0) {
-    out.clear();
-    return fail(Status::Corrupt, withLibraryMessage(where(dataset) + " cannot be read"));
-  }
-  return Result::success();
+  return readSelection(dataset, slab, expect, H5T_NATIVE_INT64, out);
 }
 
 bool File::hasAttribute(const std::string& object, const char* name) const {

@@ -104,6 +104,9 @@ class File {
   // Opens the dataset and selects `slab` in it, checked against its shape and storage.
   Result select(const std::string& dataset, const Slab& slab, uint64_t expect, Handle& ds, Handle& fileSpace,
                 Handle& memSpace) const;
+  template <typename T>
+  Result readSelection(const std::string& dataset, const Slab& slab, uint64_t expect, hid_t memType,
+                       std::vector<T>& out) const;
 
   std::string path_;
   Handle file_;

@@ -258,6 +258,9 @@ Result finishMesh(const std::string& label, TetMesh& mesh, CellSoup& soup, std::
 // index 0, and then --step or --time is a BadArgument, as is an index past the end.
 Result chooseTimeStep(std::span<const double> times, const ReadOptions& options, const std::string& label,
                       ReadReport& report, size_t& index);
+// ", step 3 of 5 (t = 0.75)" for ReadReport::format (steps counted from 0, as --step takes them);
+// "" for a file of one state.
+std::string stepText(const ReadReport& report);
 
 // ------------------------------------------------------------------ HPC containers (hpc_container.cpp)
 // The storage under Exodus II and CGNS files, by its first bytes.

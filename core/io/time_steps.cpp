@@ -51,4 +51,10 @@ Result chooseTimeStep(std::span<const double> times, const ReadOptions& options,
   return Result::success();
 }
 
+std::string stepText(const ReadReport& report) {
+  if (report.steps.empty()) return "";
+  return ", step " + std::to_string(report.stepRead) + " of " + std::to_string(report.steps.size()) +
+         " (t = " + number(report.steps[report.stepRead].time) + ")";
+}
+
 }  // namespace tetstream::vtkio

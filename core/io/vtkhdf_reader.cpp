@@ -27,12 +27,6 @@ using namespace vtkio;
 const std::string kRoot = "/VTKHDF";
 constexpr int64_t kMaxPartitions = int64_t(1) << 24;  // far beyond any run's rank count
 
-std::string number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-
 // Rows [first, first + count) of a rank-1 or rank-2 dataset, with its column count.
 template <class T>
 Result readRows(const hdf5::File& f, const std::string& dataset, uint64_t first, uint64_t count, std::vector<T>& out,
@@ -221,10 +215,7 @@ Result readVtkHdf(const std::string& path, const ReadOptions& options, TetMesh& 
   }
   if (parts > 1) report.notes.push_back("concatenated " + std::to_string(parts) + " partitions");
   report.format = "VTKHDF" + versionText + " UnstructuredGrid, " + std::to_string(parts) +
-                  (parts == 1 ? " partition" : " partitions") +
-                  (temporal ? ", step " + std::to_string(step) + " of " + std::to_string(times.size()) +
-                                  " (t = " + number(times[step]) + ")"
-                            : std::string());
+                  (parts == 1 ? " partition" : " partitions") + stepText(report);
   if (Result r = finishMesh(path, mesh, soup, std::move(cellArrays), report); !r) return r;
   out = std::move(mesh);
   return Result::success();

@@ -129,12 +129,6 @@ bool isTemporal(pugi::xml_node g) {
   return isCollection(g) && iequals(g.attribute("CollectionType").value(), "Temporal");
 }
 
-std::string number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-
 // A piece's arrays, merged across pieces like the VTK XML reader does.
 struct PieceArrays {
   std::vector<ScalarField> fields;
@@ -664,8 +658,7 @@ Result XdmfReader::read(TetMesh& out) {
     if (Result r = stepTimes(temporal[0], steps, what, times); !r) return r;
     size_t index = 0;
     if (Result r = chooseTimeStep(times, options_, label, report_, index); !r) return r;
-    stepText = ", step " + std::to_string(index) + " of " + std::to_string(times.size()) +
-               " (t = " + number(times[index]) + ")";
+    stepText = vtkio::stepText(report_);
     const std::string stepWhat = what + " step " + std::to_string(index);
     if (Result r = flatten(steps[index], stepWhat, 0, pieces); !r) return r;
     for (size_t k = 1; k < temporal.size(); ++k) {

@@ -84,7 +84,9 @@ TEST(FetchPlan, HoldsWhatTheIsovalueNeedsParentsFirst) {
   EXPECT_EQ(plan.size(), chunks);
   for (uint32_t k = 0; k < m.nodes.size(); ++k) {
     const Range r = m.nodes[k].ranges[0];
-    if (r.min <= s.isovalue && s.isovalue <= r.max) EXPECT_TRUE(seen[k]) << "node " << k << " is needed";
+    if (r.min <= s.isovalue && s.isovalue <= r.max) {
+      EXPECT_TRUE(seen[k]) << "node " << k << " is needed";
+    }
   }
   EXPECT_LT(plan.size(), m.chunks.size()) << "not everything";
   EXPECT_EQ(s.fetch.missing, plan.size());

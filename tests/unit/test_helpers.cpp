@@ -32,6 +32,21 @@ namespace tetstream::test {
 
 std::string fixturePath(const std::string& name) { return std::string(TETSTREAM_FIXTURES) + "/" + name; }
 
+const nlohmann::json& fixtureJson(const std::string& name) {
+  static std::map<std::string, nlohmann::json> parsed;
+  auto it = parsed.find(name);
+  if (it == parsed.end())
+    it = parsed.emplace(name, nlohmann::json::parse(loadFile(fixturePath(name)), nullptr, false)).first;
+  return it->second;
+}
+
+int64_t findVertex(const TetMesh& m, double x, double y, double z) {
+  for (uint32_t v = 0; v < m.vertexCount(); ++v)
+    if (m.positions[3 * v] == float(x) && m.positions[3 * v + 1] == float(y) && m.positions[3 * v + 2] == float(z))
+      return v;
+  return -1;
+}
+
 std::vector<std::string> fixtureFiles() {
   std::vector<std::string> out;
   std::error_code ec;

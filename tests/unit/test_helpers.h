@@ -2,6 +2,7 @@
 // Each section belongs to the tests named in its heading; add new sections below.
 #pragma once
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,11 @@ std::vector<std::string> fixtureFiles();
 std::string loadFile(const std::string& path);
 // Writes bytes; false on failure.
 bool saveFile(const std::string& path, const std::string& bytes);
+// A fixture folder's expectations (JSON written with the fixtures), parsed once per path; a
+// discarded value when the file is missing or not JSON.
+const nlohmann::json& fixtureJson(const std::string& name);
+// The vertex at exactly these coordinates (compared as float), or -1.
+int64_t findVertex(const TetMesh& m, double x, double y, double z);
 // A fresh folder under the system temp dir, unique to this process and `name`; removed again
 // when the object goes out of scope (also when an ASSERT returns early).
 struct ScratchDir {

@@ -24,6 +24,7 @@ namespace {
 using test::allNotes;
 using test::boundaryArea;
 using test::expectValid;
+using test::findVertex;
 using test::fixturePath;
 using test::hasNote;
 using test::loadFile;
@@ -33,17 +34,7 @@ using test::totalVolume;
 
 std::string hpcPath(const std::string& name) { return fixturePath("hpc/" + name); }
 
-const nlohmann::json& expected() {
-  static const nlohmann::json j = nlohmann::json::parse(loadFile(hpcPath("expected_exodus_cgns.json")), nullptr, false);
-  return j;
-}
-
-int64_t findVertex(const TetMesh& m, double x, double y, double z) {
-  for (uint32_t v = 0; v < m.vertexCount(); ++v)
-    if (m.positions[3 * v] == float(x) && m.positions[3 * v + 1] == float(y) && m.positions[3 * v + 2] == float(z))
-      return v;
-  return -1;
-}
+const nlohmann::json& expected() { return test::fixtureJson("hpc/expected_exodus_cgns.json"); }
 
 const std::vector<float>& field(const TetMesh& m, const std::string& name) {
   static const std::vector<float> none;

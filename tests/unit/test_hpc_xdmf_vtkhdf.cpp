@@ -23,6 +23,7 @@ namespace fs = std::filesystem;
 using test::allNotes;
 using test::boundaryArea;
 using test::expectValid;
+using test::findVertex;
 using test::fixturePath;
 using test::hasNote;
 using test::loadFile;
@@ -32,17 +33,7 @@ using test::totalVolume;
 
 std::string hpcPath(const std::string& name) { return fixturePath("hpc/" + name); }
 
-const nlohmann::json& expected() {
-  static const nlohmann::json j = nlohmann::json::parse(loadFile(hpcPath("xdmf_vtkhdf_expected.json")), nullptr, false);
-  return j;
-}
-
-int64_t findVertex(const TetMesh& m, double x, double y, double z) {
-  for (uint32_t v = 0; v < m.vertexCount(); ++v)
-    if (m.positions[3 * v] == float(x) && m.positions[3 * v + 1] == float(y) && m.positions[3 * v + 2] == float(z))
-      return v;
-  return -1;
-}
+const nlohmann::json& expected() { return test::fixtureJson("hpc/xdmf_vtkhdf_expected.json"); }
 
 // f = x + 2y + 3z + offset at every vertex.
 void expectLinearField(const TetMesh& m, const char* name, double offset, const std::string& what) {

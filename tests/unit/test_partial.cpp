@@ -332,11 +332,15 @@ TEST(Partial, ADatasetReceivesNodesInAnyParentFirstOrder) {
   for (uint32_t k : order) {
     const NodeInfo& n = m.nodes[k];
     // Out of turn: a later chunk of the node first, or a child before it.
-    if (n.chunkCount > 1) EXPECT_FALSE(ds.canReceive(n.firstChunk + 1));
+    if (n.chunkCount > 1) {
+      EXPECT_FALSE(ds.canReceive(n.firstChunk + 1));
+    }
     for (uint32_t ch = n.firstChunk; ch < n.firstChunk + n.chunkCount; ++ch) {
       ASSERT_TRUE(receiveChunk(ds, ch, file(ch))) << "chunk " << ch;
       // Half the time the level follows at once, else it catches up later.
-      if (rng() % 2) ASSERT_TRUE(stepTowards(ds, ds.splitsReceived(), ~0u, changed, &reached));
+      if (rng() % 2) {
+        ASSERT_TRUE(stepTowards(ds, ds.splitsReceived(), ~0u, changed, &reached));
+      }
     }
   }
   ASSERT_TRUE(stepTowards(ds, ds.splitsReceived(), ~0u, changed, &reached) && reached);

@@ -32,10 +32,7 @@ using test::totalVolume;
 
 std::string partitioned(const std::string& name) { return fixturePath("partitioned/" + name); }
 
-const nlohmann::json& expected() {
-  static const nlohmann::json j = nlohmann::json::parse(loadFile(partitioned("expected.json")), nullptr, false);
-  return j;
-}
+const nlohmann::json& expected() { return test::fixtureJson("partitioned/expected.json"); }
 
 Result read(const std::string& path, TetMesh& m, ReadReport& r) {
   r = ReadReport{};
