@@ -4,7 +4,8 @@
 // below was found by truncating and changing bytes of real files, or by reading the library:
 //   - a netCDF classic header is walked first (checkNetcdfClassicHeader): netCDF itself
 //     allocates and fills by the header's counts;
-//   - netCDF opens the file (ex_open prints to stderr whatever ex_opts says when it cannot);
+//   - netCDF opens the file (ex_open prints to stderr whatever ex_opts says when it cannot); a
+//     netCDF-4 file first in a child process, as HDF5 frees wild pointers on some damaged files;
 //   - the global attributes the library reads into one number hold one value;
 //   - the variables the library reads whole hold what their dimensions say: eb_prop1 one id per
 //     block, connectK one node id per node of each element, the number maps one id per node or
@@ -123,6 +124,13 @@ Result checkExodusFile(const std::string& path, uint64_t fileBytes, Container& c
       break;
     }
   }
+  // netCDF-4: HDF5 reads the file's metadata as netCDF opens it; first in a child process.
+  if (container == Container::Hdf5 && runInChildProcess([&] {
+                                        int id = -1;
+                                        if (nc_open(path.c_str(), NC_NOWRITE, &id) == NC_NOERR) nc_close(id);
+                                        return 0;
+                                      }) != 0)
+    return fail(Status::Corrupt, path + ": damaged: the HDF5 library crashed opening it (in a separate process)");
   int ncid = -1;
   if (const int status = nc_open(path.c_str(), NC_NOWRITE, &ncid); status != NC_NOERR)
     return fail(Status::Corrupt, path + ": netCDF cannot open it (" + nc_strerror(status) + ")");

@@ -3,6 +3,7 @@
 #pragma once
 #include <algorithm>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <span>
@@ -236,6 +237,14 @@ const char* containerName(Container c);  // "netCDF classic", "HDF5", "ADF", ...
 // netCDF or HDF5 data) is None.
 enum class HpcFormat : uint8_t { None, Exodus, Cgns };
 HpcFormat hpcFormatByContent(const std::string& path, std::string_view head);
+
+// HDF5 1.10 (also under netCDF-4 and CGNS) can free wild pointers while it opens a damaged file:
+// such opens are tried first in a forked child process with its output discarded, so that a crash
+// there takes down the child only. Returns the child's exit code (probe's value, 0..255; a probe
+// returns 0 for "went through", and anything else means it did not), -1 when it died by a signal.
+// Where no child can be made the probe runs in this process. Call it where no other thread is
+// running library code (the readers hold hpcLibraryMutex()).
+int runInChildProcess(const std::function<int()>& probe);
 
 // The HDF5, netCDF, Exodus II and CGNS libraries keep global state and are not built thread-safe:
 // every call into them holds this lock.

@@ -11,6 +11,7 @@
 #include <netcdf.h>
 
 #include <cmath>
+#include <csignal>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -334,6 +335,32 @@ TEST(ExodusErrors, MessagesNameNodesAndElementsByTheirIds) {
                "element block 20 (wedge) element 2 (id 5100) uses node 9999, but the nodes are numbered 1..450");
   edit("coordy", {4}, std::nan(""));
   EXPECT_FAILS(readMesh(copy, m, r), Status::NonFinite, "node 5 (id 1009) has a non-finite coordinate");
+}
+
+// damaged_hdf5_wild_free.exo: a netCDF-4 file with bytes changed on which HDF5 1.10.8 frees a
+// wild pointer while netCDF opens it (AddressSanitizer stops there; plain builds may go on or
+// crash). The open is tried in a child process first: either way the read is a Result.
+TEST(ExodusErrors, FileThatMakesHdf5FreeAWildPointerIsAResult) {
+  TetMesh m;
+  ReadReport r;
+  const std::string file = hpcPath("damaged_hdf5_wild_free.exo");
+  const Result res = readMesh(file, m, r);
+  EXPECT_EQ(res.status, Status::Corrupt) << res.message;
+  EXPECT_NE(res.message.find(file + ": "), std::string::npos) << res.message;
+}
+
+TEST(ExodusCgnsProbe, ACrashStaysInTheChildProcess) {
+  EXPECT_EQ(vtkio::runInChildProcess([] { return 7; }), 7);
+  EXPECT_EQ(vtkio::runInChildProcess([] {
+              std::raise(SIGSEGV);
+              return 0;
+            }),
+            -1);
+  EXPECT_EQ(vtkio::runInChildProcess([] {
+              std::abort();
+              return 0;
+            }),
+            -1);
 }
 
 // A 2D mesh (num_dim 2: a block of quadrilaterals, as 2D solvers write) has no volume cells.
