@@ -23,15 +23,6 @@ namespace tetstream::vtkio {
 
 namespace {
 
-Result readHead(const std::string& path, size_t bytes, std::string& head) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) return fail(Status::IoError, path + ": cannot open");
-  head.assign(bytes, '\0');
-  head.resize(std::fread(head.data(), 1, head.size(), f));
-  std::fclose(f);
-  return Result::success();
-}
-
 class SchemaCheck {
  public:
   SchemaCheck(int ncid, const std::string& path) : nc_(ncid), path_(path) {}
@@ -107,23 +98,18 @@ class SchemaCheck {
 
 }  // namespace
 
-Result checkExodusFile(const std::string& path, uint64_t fileBytes, Container& container) {
-  std::string head;
-  for (size_t want = 1 << 16;; want *= 4) {
-    if (Result r = readHead(path, want, head); !r) return r;
-    if (want == 1 << 16) {
-      container = containerSignature(head);
-      if (container == Container::None || container == Container::Adf)
-        return fail(Status::BadMagic, path + ": not an Exodus II file: it starts with neither the netCDF (CDF) " +
-                                          "nor the HDF5 signature" + (head.empty() ? " (the file is empty)" : ""));
-      if (container == Container::Hdf5) break;
-    }
-    const NetcdfHeaderResult h = checkNetcdfClassicHeader(head, fileBytes, path);
-    if (!h.needMore) {
-      if (!h.result) return h.result;
-      break;
-    }
-  }
+Result checkExodusFile(const std::string& path, Container& container) {
+  std::string head(4096, '\0');
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return fail(Status::IoError, path + ": cannot open");
+  head.resize(std::fread(head.data(), 1, head.size(), f));
+  std::fclose(f);
+  container = containerSignature(head);
+  if (container == Container::None || container == Container::Adf)
+    return fail(Status::BadMagic, path + ": not an Exodus II file: it starts with neither the netCDF (CDF) " +
+                                      "nor the HDF5 signature" + (head.empty() ? " (the file is empty)" : ""));
+  if (container != Container::Hdf5)
+    if (Result r = checkNetcdfClassicFile(path); !r) return r;
   // netCDF-4: HDF5 reads the file's metadata as netCDF opens it; first in a child process.
   if (container == Container::Hdf5 && runInChildProcess([&] {
                                         int id = -1;

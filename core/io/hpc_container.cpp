@@ -116,7 +116,13 @@ HpcFormat hpcFormatByContent(const std::string& path, std::string_view head) {
   if (c == Container::None) return HpcFormat::None;
   if (c == Container::Adf) return HpcFormat::Cgns;  // ADF is CGNS's own container
   std::lock_guard<std::mutex> lock(hpcLibraryMutex());
-  if (c != Container::Hdf5) return netcdfContent(path);  // the header was not checked yet: in a child too
+  if (c != Container::Hdf5) {
+    // netCDF believes a classic header's counts: checked first. A damaged header with Exodus's
+    // node count dimension in it is taken for Exodus II, whose reader then says what is wrong.
+    if (!checkNetcdfClassicFile(path))
+      return head.find("num_nodes") != std::string_view::npos ? HpcFormat::Exodus : HpcFormat::None;
+    return netcdfContent(path);
+  }
   // Exit codes 10 + the format, so that a child that ended otherwise (a sanitizer's exit code 1)
   // is not taken for an answer.
   const int found = runInChildProcess([&] { return 10 + int(hdf5Content(path)); }) - 10;

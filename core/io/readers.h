@@ -259,6 +259,8 @@ struct NetcdfHeaderResult {
   bool needMore = false;
 };
 NetcdfHeaderResult checkNetcdfClassicHeader(std::string_view head, uint64_t fileSize, const std::string& label);
+// The same for the file at `path`, reading as much of it as the header needs.
+Result checkNetcdfClassicFile(const std::string& path);
 
 // Where an ADF file's data ends (its header's end-of-file pointer, a byte offset); false when
 // `head` (the first bytes) has no ADF header. The ADF library reads past a file's end unchecked.
@@ -271,7 +273,7 @@ void closeHdf5Leftovers(const std::string& path);
 // An Exodus II file as the Exodus library may be given it (exodus_checks.cpp): a netCDF classic
 // header that checks out, a file netCDF opens, and variables and attributes that hold what the
 // library's buffers expect. `container` is set from the signature.
-Result checkExodusFile(const std::string& path, uint64_t fileBytes, Container& container);
+Result checkExodusFile(const std::string& path, Container& container);
 
 // The most bytes a container of fileBytes can decode to: what it stores, or for HDF5 (which may
 // compress) the deflate limit. Counts a file declares are checked against this before allocating.

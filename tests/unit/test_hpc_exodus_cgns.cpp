@@ -515,9 +515,14 @@ TEST(ExodusSniff, ContentDecidesWhenTheExtensionDoesNot) {
     ASSERT_TRUE(res) << c.to << ": " << res.message;
     EXPECT_NE(r.format.find(c.format), std::string::npos) << c.to << ": " << r.format;
   }
-  // A PLOT3D grid under .g stays PLOT3D.
+  // A damaged netCDF header is checked before netCDF reads it, also when only content tells.
+  std::string damaged = loadFile(hpcPath("exo_blocks.exo"));
+  damaged[12] = '\x7f';  // the dimension count
+  ASSERT_TRUE(saveFile(dir.path + "/damaged.dat", damaged));
   TetMesh m;
   ReadReport r;
+  EXPECT_FAILS(readMesh(dir.path + "/damaged.dat", m, r), Status::Truncated, "damaged.dat: the netCDF header lists");
+  // A PLOT3D grid under .g stays PLOT3D.
   ASSERT_TRUE(readMesh(fixturePath("formats/p3d_two_blocks.g"), m, r));
   EXPECT_NE(r.format.find("PLOT3D"), std::string::npos) << r.format;
 }
