@@ -6,7 +6,7 @@
 # writers use.
 #
 # Debian has no static netCDF, and static HDF5 needs curl and OpenSSL's archives, so a program
-# that links these is linked to them dynamically (see cmake/static_cli.cmake).
+# that links these is linked to them dynamically, the CLI included.
 pkg_check_modules(HDF5 REQUIRED IMPORTED_TARGET hdf5-serial)
 pkg_check_modules(NETCDF REQUIRED IMPORTED_TARGET netcdf)
 find_library(TETSTREAM_EXODUS_LIBRARY NAMES exoIIv2c exodus REQUIRED)

@@ -3,6 +3,7 @@
 // for the page's side, is in docs/js-api.md.
 #include <emscripten.h>
 #include <emscripten/heap.h>
+#include <malloc.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -308,6 +309,7 @@ EMSCRIPTEN_KEEPALIVE const char* ts_view_json() {
 // Everything, as JSON, for tests and scripts; valid until the next call.
 EMSCRIPTEN_KEEPALIVE const char* ts_stats_json() {
   g_app.state.memory.heapBytes = emscripten_get_heap_size();
+  g_app.state.memory.allocatedBytes = uint64_t(mallinfo().uordblks);
   g_statsBuffer = statsJson(g_app.state);
   return g_statsBuffer.c_str();
 }

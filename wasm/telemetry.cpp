@@ -89,6 +89,7 @@ std::string statsJson(const ViewerState& s) {
       {"memoryLimited", s.memory.limited},
       {"memory",
        {{"heapBytes", s.memory.heapBytes},
+        {"allocatedBytes", s.memory.allocatedBytes},
         {"dataBytes", memoryInUse(s)},
         {"gpuBytes", s.memory.gpuBytes},
         {"limitBytes", s.memory.limitBytes ? json(s.memory.limitBytes) : json(nullptr)},

@@ -21,24 +21,44 @@ constexpr double kFixed = 1 << 20;  // zstd context, scratch, the JSON of the ma
 
 }  // namespace
 
+LevelCounts chunkCounts(const Manifest& m, uint32_t index) {
+  LevelCounts c;
+  if (index >= m.chunks.size()) return c;
+  const ChunkInfo& info = m.chunks[index];
+  const ChunkInfo* before = index > 0 ? &m.chunks[index - 1] : nullptr;
+  c.vertices = double(info.vertices) - (before ? double(before->vertices) : 0);
+  c.tets = double(info.tets) - (before ? double(before->tets) : 0);
+  c.largestRaw = double(info.rawBytes);
+  if (index > 0) {
+    c.splits = info.splits;
+    c.payloadBytes = double(info.rawBytes);
+  }
+  return c;
+}
+
+void addCounts(LevelCounts& total, const LevelCounts& more) {
+  total.vertices += more.vertices;
+  total.tets += more.tets;
+  total.splits += more.splits;
+  total.payloadBytes += more.payloadBytes;
+  total.largestRaw = std::max(total.largestRaw, more.largestRaw);
+}
+
+uint64_t estimateBytes(const Manifest& m, const LevelCounts& c) {
+  const double v = c.vertices, t = c.tets;
+  const double hullTriangles = 4 * std::cbrt(t * t);  // a cube of 6n³ tets has 12n² ≈ 3.6 t^(2/3)
+  const double bytes = kFixed + v * (kPerVertex + kPerFieldValue * double(m.fields.size())) + t * kPerTet +
+                       c.splits * (kPerSplit + kPerSplitKept) + c.payloadBytes + c.largestRaw + t * kSurfacePerTet +
+                       hullTriangles * kHullPerTriangle;
+  return uint64_t(bytes);
+}
+
 uint64_t estimateLevelBytes(const Manifest& m, uint32_t chunks) {
   chunks = std::min<uint32_t>(chunks, uint32_t(m.chunks.size()));
   if (chunks == 0) return 0;
-  const ChunkInfo& last = m.chunks[chunks - 1];
-  double splits = 0, payloads = 0, largestRaw = 0;
-  for (uint32_t c = 0; c < chunks; ++c) {
-    const ChunkInfo& info = m.chunks[c];
-    largestRaw = std::max(largestRaw, double(info.rawBytes));  // the decoder's buffer
-    if (c == 0) continue;
-    splits += info.splits;
-    payloads += double(info.rawBytes);  // split records are kept for redo
-  }
-  const double v = last.vertices, t = last.tets;
-  const double hullTriangles = 4 * std::cbrt(t * t);  // a cube of 6n³ tets has 12n² ≈ 3.6 t^(2/3)
-  const double bytes = kFixed + v * (kPerVertex + kPerFieldValue * double(m.fields.size())) + t * kPerTet +
-                       splits * (kPerSplit + kPerSplitKept) + payloads + largestRaw + t * kSurfacePerTet +
-                       hullTriangles * kHullPerTriangle;
-  return uint64_t(bytes);
+  LevelCounts total;
+  for (uint32_t c = 0; c < chunks; ++c) addCounts(total, chunkCounts(m, c));
+  return estimateBytes(m, total);
 }
 
 uint32_t chunksThatFit(const Manifest& m, uint64_t budgetBytes) {

@@ -19,21 +19,38 @@
 
 namespace tetstream::viewer {
 
+// What a set of chunks brings, from the manifest's counts: the estimate's inputs.
+struct LevelCounts {
+  double vertices = 0, tets = 0, splits = 0;
+  double payloadBytes = 0;  // decompressed split records, kept for redo
+  double largestRaw = 0;    // the decoder's buffer: the largest chunk
+};
+// What chunk `index` adds (the base: its mesh). A chunk's vertices and tets are the difference
+// of the manifest's counts after it and after the chunk before it, so they hold in whatever order
+// the chunks of a patch hierarchy arrive.
+LevelCounts chunkCounts(const Manifest& m, uint32_t index);
+void addCounts(LevelCounts& total, const LevelCounts& more);
+
 // The memory budget (bytes). The platform sets the limit (the browser's wasm maximum, or the
 // page's ?maxMemoryMB=; 0 = none), the heap in use before any dataset (code, stack, UI), the heap
 // size and the GPU buffers, and may install reserveHeap. openManifest sets the rest.
 struct MemoryBudget {
   uint64_t limitBytes = 0, baseBytes = 0;
   uint64_t heapBytes = 0, gpuBytes = 0;
-  uint64_t neededBytes = 0;    // estimate for the whole dataset
-  uint32_t chunksAllowed = 0;  // chunks whose level fits the limit (all of them without one)
-  bool limited = false;        // stopped short of the full dataset for lack of memory
+  uint64_t allocatedBytes = 0;  // what malloc has handed out and not taken back (the heap less its free space)
+  uint64_t neededBytes = 0;     // estimate for the whole dataset
+  LevelCounts received;         // what the chunks received so far bring
+  uint32_t chunksAllowed = 0;   // chunks whose level fits the limit (all of them without one)
+  bool limited = false;         // stopped short of the full dataset for lack of memory
   // Grows the heap to at least `bytes` now; false when the browser refuses.
   bool (*reserveHeap)(uint64_t bytes) = nullptr;
 };
 
-// Heap bytes the viewer's data takes at the level made of the first `chunks` chunks (base
-// included, clamped to the manifest), with the mesh arrays reserved for that level.
+// Heap bytes the viewer's data takes for those counts, with the mesh arrays reserved for them.
+uint64_t estimateBytes(const Manifest& m, const LevelCounts& counts);
+
+// The same for the level made of the first `chunks` chunks (base included, clamped to the
+// manifest).
 uint64_t estimateLevelBytes(const Manifest& m, uint32_t chunks);
 
 // The most chunks whose level fits in `budgetBytes` (0 when not even the base fits).

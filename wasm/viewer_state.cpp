@@ -197,6 +197,7 @@ Result openManifest(ViewerState& s, std::string_view manifestJson) {
   s.slice.setPlane({0, 0, 1}, 0.5f * (m.bounds.min[2] + m.bounds.max[2]));
 
   resetPlan(s);
+  s.memory.received = {};
   s.memory.neededBytes = s.memory.baseBytes + estimateLevelBytes(m, s.chunksTotal);
   s.memory.chunksAllowed = s.chunksTotal;
   if (s.memory.limitBytes) {
@@ -269,7 +270,11 @@ Result addChunk(ViewerState& s, uint32_t index, std::span<const uint8_t> bytes, 
   // here with a message instead of failing an allocation half way through. With the base, the
   // arrays are sized for the last level that will come (reserveLevel), so that much is asked
   // for first; if the browser will not give it now, the arrays grow as levels come instead.
-  const uint64_t need = s.memory.baseBytes + estimateLevelBytes(ds.manifest, ds.chunksReceived + 1);
+  // What the chunks received so far and this one bring (chunks of a patch hierarchy come in any
+  // order, so not the manifest's first chunks).
+  LevelCounts after = s.memory.received;
+  addCounts(after, chunkCounts(ds.manifest, index));
+  const uint64_t need = s.memory.baseBytes + estimateBytes(ds.manifest, after);
   const bool reserveAll =
       index == 0 && (!s.memory.reserveHeap || s.memory.reserveHeap(s.memory.baseBytes + plannedLevelBytes(s)));
   if (s.memory.reserveHeap && !reserveAll && !s.memory.reserveHeap(need)) {
@@ -286,6 +291,7 @@ Result addChunk(ViewerState& s, uint32_t index, std::span<const uint8_t> bytes, 
                     (ds.chunksReceived ? ". Showing the last complete level." : "."));
     return r;
   }
+  s.memory.received = after;
   notePlannedChunk(s, index);
   if (ds.chunksReceived == 1) {  // the base: shown at once
     if (reserveAll) reserveLevel(s);

@@ -83,8 +83,8 @@ Runner addPack(CLI::App& app) {
   auto o = std::make_shared<Opts>();
   CLI::App* sub = app.add_subcommand("pack", "Pack a mesh into a progressive dataset folder (manifest + chunks)");
   sub->add_option("input", o->input,
-                  "mesh file: .vtu/.vts/.vti, .vtk, .msh (Gmsh), .node/.ele (TetGen), .mesh (Medit), PLOT3D grid, "
-                  ".exo (Exodus II), .cgns (CGNS)")
+                  "mesh file: .vtu/.vts/.vti, .vtk, .pvtu/.vtm/.pvtk (with their pieces), .msh (Gmsh), .node/.ele "
+                  "(TetGen), .mesh (Medit), PLOT3D grid, .exo (Exodus II), .cgns (CGNS), .xdmf (XDMF), .vtkhdf")
       ->required();
   addReadOptions(sub, o->read);
   sub->add_option("-o,--output", o->out, "output folder (created; an earlier pack there is replaced)")->required();
@@ -94,7 +94,8 @@ Runner addPack(CLI::App& app) {
                   "cost weights G,F,S: boundary geometry, field, tet shape (default 100,1,0.005)")
       ->delimiter(',')
       ->expected(3);
-  auto* bf = sub->add_option("--base-fraction", o->baseFraction, "base mesh size as a fraction of the vertices")
+  auto* bf = sub->add_option("--base-fraction", o->baseFraction,
+                             "base mesh size as a fraction of the vertices (at most 65,536 of them)")
                  ->check(CLI::Range(0.0, 1.0))
                  ->capture_default_str();
   auto* bv = sub->add_option("--base-vertices", o->baseVertices, "base mesh size in vertices");

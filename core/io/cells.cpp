@@ -136,8 +136,9 @@ std::string plural(uint64_t n, const char* one, const char* many) {
   return std::to_string(n) + " " + (n == 1 ? one : many);
 }
 
-// Finds bit-equal positions. Returns how many vertices have an earlier copy; remap[v] is the
-// first copy of v's position (empty when there are none).
+}  // namespace
+
+// (readers.h)
 uint64_t findCoincident(const TetMesh& mesh, std::vector<uint32_t>& remap) {
   const uint32_t nv = uint32_t(mesh.positions.size() / 3);
   // Sorting (position bits, vertex) records themselves keeps memory access sequential; sorting
@@ -169,6 +170,8 @@ uint64_t findCoincident(const TetMesh& mesh, std::vector<uint32_t>& remap) {
     }
   return found;
 }
+
+namespace {
 
 // Averages the fields of each merged group into its first copy. Returns how many merged vertices
 // had values other than their first copy's.

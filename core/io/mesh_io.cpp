@@ -12,6 +12,7 @@
 #include <limits>
 #include <new>
 
+#include "io/hdf5_file.h"
 #include "io/readers.h"
 
 namespace tetstream {
@@ -24,20 +25,24 @@ std::string lowerExtension(const std::string& path) {
 }
 
 constexpr const char* kSupported =
-    "supported: .vtu/.vts/.vti (VTK XML), .vtk (legacy VTK), .msh (Gmsh 2.2/4.1), .node/.ele (TetGen), "
-    ".mesh (Medit), PLOT3D grids (.xyz, .x, .g, .grd, .p3d, .bin; Q file with --q), Exodus II (.exo, .e, .ex2, "
-    ".exii, .g), CGNS (.cgns)";
+    "supported: .vtu/.vts/.vti (VTK XML), .vtk (legacy VTK), partitioned VTK output (.pvtu, .vtm, .pvtk, with "
+    "their pieces), .msh (Gmsh 2.2/4.1), .node/.ele (TetGen), .mesh (Medit), PLOT3D grids (.xyz, .x, .g, .grd, "
+    ".p3d, .bin; Q file with --q), Exodus II (.exo, .e, .ex2, .exii, .g), CGNS (.cgns), .xdmf/.xmf (XDMF 2/3, "
+    "HDF5 or XML data), .vtkhdf/.hdf (VTKHDF; .h5/.hdf5 with a /VTKHDF group)";
 
-enum class Format { Unknown, VtkXml, LegacyVtk, Gmsh, Medit, Tetgen, Plot3d, Exodus, Cgns };
+enum class Format { Unknown, VtkXml, LegacyVtk, Gmsh, Medit, Tetgen, Plot3d, Listing, Exodus, Cgns, Xdmf, VtkHdf };
 
 // The extensions that name a format outright; anything else is sniffed from the content.
 Format byExtension(const std::string& ext) {
   if (ext == ".vtu" || ext == ".vts" || ext == ".vti") return Format::VtkXml;
   if (ext == ".vtk") return Format::LegacyVtk;
+  if (ext == ".pvtu" || ext == ".vtm" || ext == ".pvtk") return Format::Listing;
   if (ext == ".msh") return Format::Gmsh;
   if (ext == ".mesh") return Format::Medit;
   if (ext == ".node" || ext == ".ele") return Format::Tetgen;
   if (ext == ".xyz") return Format::Plot3d;
+  if (ext == ".xdmf" || ext == ".xmf") return Format::Xdmf;
+  if (ext == ".vtkhdf" || ext == ".hdf") return Format::VtkHdf;
   // ".g" (a Genesis mesh, or a PLOT3D grid) is told by content.
   if (ext == ".exo" || ext == ".e" || ext == ".ex2" || ext == ".exii") return Format::Exodus;
   if (ext == ".cgns") return Format::Cgns;
@@ -70,7 +75,10 @@ Format sniff(std::string_view head, const std::string& ext) {
     break;
   }
   std::string_view t = head.substr(std::min(p, head.size()));
-  if (t.starts_with("<")) return Format::VtkXml;
+  // An HDF5 file (.h5, .hdf5, ...) that is not Exodus II or CGNS (hpcFormatByContent, before this)
+  // is taken as VTKHDF; its reader says so when /VTKHDF is missing.
+  if (hdf5::hasSignature(head)) return Format::VtkHdf;
+  if (t.starts_with("<")) return head.find("<Xdmf") != std::string_view::npos ? Format::Xdmf : Format::VtkXml;
   if (t.starts_with("# vtk DataFile")) return Format::LegacyVtk;
   if (t.starts_with("$MeshFormat")) return Format::Gmsh;
   if (t.starts_with("MeshVersionFormatted")) return Format::Medit;
@@ -82,7 +90,9 @@ Format sniff(std::string_view head, const std::string& ext) {
 bool hasTimeSteps(Format f) {
   switch (f) {
     case Format::Exodus:
-    case Format::Cgns: return true;
+    case Format::Cgns:
+    case Format::Xdmf:
+    case Format::VtkHdf: return true;
     default: return false;
   }
 }
@@ -95,8 +105,11 @@ const char* formatName(Format f) {
     case Format::Medit: return "Medit";
     case Format::Tetgen: return "TetGen";
     case Format::Plot3d: return "PLOT3D";
+    case Format::Xdmf: return "XDMF";
+    case Format::VtkHdf: return "VTKHDF";
     case Format::Exodus: return "Exodus II";
     case Format::Cgns: return "CGNS";
+    case Format::Listing: return "a listing of VTK pieces";
     default: return "unknown";
   }
 }
@@ -167,11 +180,21 @@ Result readOneFile(Format fmt, std::string_view bytes, const std::string& name, 
     case Format::Tetgen:
       return fail(Status::Unsupported,
                   name + ": a TetGen mesh is two files (.node and .ele); read it by path, not from bytes");
+    // From bytes an XDMF file has no folder: only XML data items can be read.
+    case Format::Xdmf: return readXdmf(bytes, name, std::nullopt, {}, out, report);
+    case Format::VtkHdf:
+      return fail(Status::Unsupported, name +
+                                           ": a VTKHDF file is HDF5, which is read through the HDF5 library from "
+                                           "a file; read it by path, not from bytes");
     case Format::Exodus:
     case Format::Cgns:
       return fail(Status::Unsupported,
                   name + ": " + formatName(fmt) +
                       " files are read by their library from disk; read it by path, not from bytes");
+    case Format::Listing:
+      return fail(Status::Unsupported, name +
+                                           ": a listing of piece files (.pvtu, .vtm, .pvtk); read it by path, "
+                                           "which finds the pieces beside it");
     default: break;
   }
   return fail(Status::Unsupported, name + ": unsupported mesh format; " + kSupported);
@@ -199,6 +222,20 @@ std::vector<std::string> plot3dSolutionCandidates(const std::string& path) {
   return existing;
 }
 
+// Reads the pieces a listing at `listingPath` names from its folder (readListing has checked
+// that each path stays inside it).
+PieceLoader pieceFiles(const std::string& listingPath) {
+  namespace fs = std::filesystem;
+  return [listingPath](const std::string& relative, std::string& bytes) {
+    const fs::path full = fs::path(listingPath).parent_path() / relative;
+    std::error_code ec;
+    if (fs::equivalent(full, listingPath, ec)) return fail(Status::Corrupt, full.string() + " is the listing itself");
+    if (fs::exists(full, ec) && !fs::is_regular_file(full, ec))
+      return fail(Status::IoError, full.string() + ": not a file");
+    return readWholeFile(full.string(), bytes);
+  };
+}
+
 }  // namespace
 
 Result readMeshBytes(std::string_view bytes, const std::string& name, TetMesh& out, ReadReport& report) {
@@ -216,6 +253,7 @@ Result readMeshBytes(std::string_view bytes, const std::string& name, TetMesh& o
   }
   if (fmt == Format::Unknown)
     return fail(Status::Unsupported, name + ": unsupported mesh format '" + ext + "'; " + kSupported);
+  if (fmt == Format::VtkXml && listingKind(bytes.substr(0, 4096)) != ListingKind::None) fmt = Format::Listing;
   return guarded(name, out, [&] { return readOneFile(fmt, bytes, name, out, report); });
 }
 
@@ -237,12 +275,13 @@ Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const
                   path + ": unsupported mesh format '" + ext + "' (content not recognized); " + kSupported);
   }
   if ((options.step || options.time) && !hasTimeSteps(fmt))
-    return fail(Status::BadArgument, path + ": a " + formatName(fmt) +
-                                         " file holds one state; --step and --time apply to files with time steps");
+    return fail(Status::BadArgument,
+                path + " (" + formatName(fmt) + ") holds one state; --step and --time apply to files with time steps");
   if (!options.solution.empty() && fmt != Format::Plot3d && fmt != Format::Medit)
     return fail(Status::BadArgument, path + ": a solution file (--q " + options.solution +
                                          ") goes with a PLOT3D grid or a Medit mesh, and this is " + formatName(fmt));
 
+  if (fmt == Format::VtkHdf) return guarded(path, out, [&] { return readVtkHdf(path, options, out, report); });
   // The Exodus II and CGNS libraries read the file themselves.
   if (fmt == Format::Exodus) return guarded(path, out, [&] { return readExodus(path, options, out, report); });
   if (fmt == Format::Cgns) return guarded(path, out, [&] { return readCgns(path, options, out, report); });
@@ -286,6 +325,17 @@ Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const
     return guarded(path, out, [&] { return readMedit(bytes, path, second, secondPath, out, report); });
   if (fmt == Format::Plot3d)
     return guarded(path, out, [&] { return readPlot3d(bytes, path, second, secondPath, out, report); });
+  if (fmt == Format::Xdmf) {
+    const std::string folder = fs::path(path).parent_path().string();
+    return guarded(path, out, [&] { return readXdmf(bytes, path, folder, options, out, report); });
+  }
+  // A listing of pieces, by its extension or by its content (a .pvtu saved as .vtu, say); a
+  // VTK XML mesh saved under a listing's extension is read as the mesh it is.
+  const std::string_view head = std::string_view(bytes).substr(0, 4096);
+  const bool listing = listingKind(head) != ListingKind::None;
+  if (fmt == Format::Listing && !listing && !vtkio::vtkXmlFileType(head).empty()) fmt = Format::VtkXml;
+  if (fmt == Format::Listing || (fmt == Format::VtkXml && listing))
+    return guarded(path, out, [&] { return readListing(bytes, path, pieceFiles(path), out, report); });
   return guarded(path, out, [&] { return readOneFile(fmt, bytes, path, out, report); });
 }
 

@@ -1,8 +1,13 @@
 // Mesh files in and out (pack side). Readers: VTK XML (.vtu UnstructuredGrid, .vts StructuredGrid,
 // .vti ImageData), legacy VTK (.vtk: UNSTRUCTURED_GRID, STRUCTURED_POINTS, STRUCTURED_GRID,
-// RECTILINEAR_GRID), Gmsh .msh 2.2/4.1 (ASCII and binary), TetGen .node/.ele, Medit .mesh (+ .sol),
-// PLOT3D grid + Q, Exodus II (.exo, .e, .ex2, .exii, .g; through SEACAS's library, over netCDF or
-// HDF5) and CGNS (.cgns, ADF or HDF5; through the CGNS library), both with time steps. Writer: .vtu.
+// RECTILINEAR_GRID), partitioned VTK output (.pvtu with its .vtu pieces, .vtm multiblock of
+// unstructured blocks, legacy .pvtk with its .vtk pieces, and a .vtu of several <Piece>s),
+// Gmsh .msh 2.2/4.1 (ASCII and binary), TetGen .node/.ele, Medit .mesh (+ .sol), PLOT3D grid + Q,
+// Exodus II (.exo, .e, .ex2, .exii, .g; through SEACAS's library, over netCDF or HDF5), CGNS
+// (.cgns, ADF or HDF5; through the CGNS library), XDMF 2/3 (.xdmf/.xmf; heavy data in HDF5, XML or
+// raw binary) and VTKHDF UnstructuredGrid (.vtkhdf/.hdf, or HDF5 with a /VTKHDF group;
+// partitions), the last four with time steps. HDF5 is read through the HDF5 library
+// (hdf5_file.h). Writer: .vtu.
 //
 // The readers take bytes from strangers: every failure is a Result whose message names the file,
 // the array, section, line or cell, and what was expected vs. found. They never throw, never
@@ -22,6 +27,12 @@
 //     is added. Cell data becomes point data: the
 //     volume-weighted average over the cells around each vertex ("NAME_cell" when a point array has
 //     the name). Lower-dimensional cells are counted by name and listed in notes and skippedCells.
+//   - Pieces of a partitioned mesh (piece_merge.cpp) become one mesh: ghost cells (vtkGhostType
+//     DUPLICATECELL, and HIDDENCELL) are dropped; the points pieces share are welded by global ids
+//     (GlobalIds, GlobalNodeIds) when every piece has them, else by exact coordinates, and take
+//     the owning piece's values (disagreements between pieces are counted in a note, never
+//     averaged). vtkGhostType and global id arrays are not fields. A listing's pieces are read
+//     only from its folder and subfolders (no absolute paths, none leaving it).
 //   - Orientation and flat tetrahedra are left to the packer (it re-orients and removes them).
 // Errors: IoError (file), BadMagic (not this format), Unsupported (valid file, feature not read,
 // e.g. DATASET POLYDATA or an LZ4 compressor), Truncated, Corrupt, OutOfRange (a cell's vertex id;
@@ -73,16 +84,19 @@ struct ReadOptions {
 };
 
 // Reads a mesh file, choosing the reader by extension (case-insensitive): .vtu/.vts/.vti, .vtk,
-// .msh, .mesh, .node/.ele (reads both), .xyz, .exo/.e/.ex2/.exii, .cgns; other extensions are
-// recognized by their content (Exodus II for netCDF, or HDF5 with Exodus's variables; CGNS for
-// ADF, or HDF5 with a CGNSLibraryVersion node; else PLOT3D for binary data under .x, .g, .grd,
-// .p3d, .bin, .dat). out.name is the file's stem.
+// .pvtu/.vtm/.pvtk (and the pieces they list), .msh, .mesh, .node/.ele (reads both), .xyz,
+// .exo/.e/.ex2/.exii, .cgns, .xdmf/.xmf (heavy data from the file's folder or below it),
+// .vtkhdf/.hdf; other extensions are recognized by their content (a listing under any name;
+// Exodus II for netCDF, or HDF5 with Exodus's variables; CGNS for ADF, or HDF5 with a
+// CGNSLibraryVersion node; any other HDF5: VTKHDF; XML with <Xdmf: XDMF; PLOT3D for binary data
+// under .x, .g, .grd, .p3d, .bin, .dat). out.name is the file's stem.
 Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const ReadOptions& options = {});
 
 // The same from bytes already in memory; `name` supplies the extension and the label in messages.
 // Formats of two files read only the first here (a PLOT3D grid without Q, a Medit mesh without
-// .sol); TetGen needs readTetgen (readers.h). Exodus II and CGNS are Unsupported here: their
-// libraries read files, not memory.
+// .sol); TetGen needs readTetgen (readers.h), a listing of pieces readListing (readers.h). XDMF
+// reads only XML data items (HDF and Binary ones are in other files: Unsupported); Exodus II, CGNS
+// and VTKHDF are Unsupported (their libraries read files, not memory: read them by path).
 Result readMeshBytes(std::string_view bytes, const std::string& name, TetMesh& out, ReadReport& report);
 
 // Writes a .vtu (VTK XML, appended raw binary; see vtu_writer.cpp). Only .vtu is supported.

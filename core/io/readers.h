@@ -6,6 +6,7 @@
 #include <functional>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -20,14 +21,16 @@ namespace tetstream {
 // VTK XML UnstructuredGrid (.vtu), StructuredGrid (.vts) and ImageData (.vti), by the VTKFile
 // type: format="ascii", inline "binary" (base64) and appended data (encoding="raw" or "base64"),
 // optionally vtkZLibDataCompressor, header_type UInt32 or UInt64, LittleEndian or BigEndian.
-// Several Pieces are concatenated (points they share are merged by finishMesh). Point and cell
-// data are read. `label` names the source in messages.
+// Several Pieces are the pieces of one mesh (PETSc writes one per rank): mergePieces() drops ghost
+// cells and welds the points they share. Point and cell data are read; vtkGhostType and global id
+// arrays describe the partition and are not fields. `label` names the source in messages.
 Result readVtu(std::string_view bytes, const std::string& label, TetMesh& out, ReadReport& report);
 
 // Legacy VTK (.vtk) DATASET UNSTRUCTURED_GRID, STRUCTURED_POINTS, STRUCTURED_GRID or
 // RECTILINEAR_GRID, ASCII or BINARY (big-endian), versions up to 5.1: classic CELLS n size and
 // the 5.1 OFFSETS/CONNECTIVITY layout; POINT_DATA SCALARS, VECTORS, NORMALS, TENSORS(6) and FIELD
-// arrays become fields, CELL_DATA ones become point data.
+// arrays become fields, CELL_DATA ones become point data (vtkGhostType and GLOBAL_IDS do not: ghost
+// cells are dropped as in readVtu).
 Result readLegacyVtk(std::string_view bytes, const std::string& label, TetMesh& out, ReadReport& report);
 
 // Gmsh .msh 2.2 and 4.1, ASCII and binary (either byte order). Tetrahedra, hexahedra, prisms and
@@ -52,6 +55,23 @@ Result readMedit(std::string_view mesh, const std::string& label, std::string_vi
 Result readPlot3d(std::string_view grid, const std::string& gridLabel, std::string_view q, const std::string& qLabel,
                   TetMesh& out, ReadReport& report);
 
+// XDMF 2 and 3 (.xdmf, .xmf; xdmf_reader.cpp): unstructured grids (Tetrahedron, Pyramid, Wedge,
+// Hexahedron, their quadratic forms, Mixed), Geometry XYZ or X_Y_Z, Node and Cell attributes,
+// legacy DOLFIN finite element functions, spatial collections (merged) and temporal collections
+// (one step read: options.step / options.time, default the last). DataItems in XML, HDF5
+// ("FILE:/dataset") or raw binary, HyperSlab and JOIN functions; References and <xi:include>
+// within the document. Heavy-data files are looked up in `dataFolder` (the XDMF file's folder)
+// or below it; without a folder (nullopt: bytes in memory) HDF and Binary items are refused with
+// Unsupported. `xml` is the XDMF file's text; `label` names it in messages.
+Result readXdmf(std::string_view xml, const std::string& label, const std::optional<std::string>& dataFolder,
+                const ReadOptions& options, TetMesh& out, ReadReport& report);
+
+// VTKHDF (vtkhdf_reader.cpp): /VTKHDF of Type UnstructuredGrid, any number of partitions
+// (concatenated; their shared points merged by finishMesh), PointData and CellData, cell types as
+// in .vtu; a Steps group makes time steps (options.step / options.time, default the last) and
+// only the chosen step's rows are read. Read by path through the HDF5 library.
+Result readVtkHdf(const std::string& path, const ReadOptions& options, TetMesh& out, ReadReport& report);
+
 // Exodus II (SEACAS) through its own library, over netCDF classic, 64-bit offset, 64-bit data
 // or netCDF-4 (HDF5). Element blocks of tetrahedra, hexahedra, wedges and pyramids of any order
 // (higher-order nodes dropped) are merged; other blocks (TRI, QUAD, SHELL, BAR, ...) are skipped
@@ -66,6 +86,20 @@ Result readExodus(const std::string& path, const ReadOptions& options, TetMesh& 
 // FlowSolution at Vertex (fields) and CellCenter (cell data), of the time step chosen by
 // options when the base has BaseIterativeData. By path only.
 Result readCgns(const std::string& path, const ReadOptions& options, TetMesh& out, ReadReport& report);
+
+// The listing files of partitioned VTK output (partitioned_reader.cpp): parallel VTK XML (.pvtu,
+// PUnstructuredGrid), VTK multiblock (.vtm, vtkMultiBlockDataSet) and legacy parallel VTK (.pvtk,
+// vtkPDataSetWriter's <File version="pvtk-1.0">). `load` gives the bytes of a piece by the path the
+// listing names, relative to the listing's folder; the listing is checked first (no absolute path,
+// none leaving the folder, none naming the listing itself, none named twice, at most kMaxPieces).
+// Every piece is read by the serial reader of its format and the pieces are merged by
+// mergePieces(). `label` names the listing in messages (its path).
+enum class ListingKind { None, Pvtu, Vtm, Pvtk };
+// What a file's first bytes say it is: a listing, or None for anything else (a .vtu, junk).
+ListingKind listingKind(std::string_view head);
+using PieceLoader = std::function<Result(const std::string& relativePath, std::string& bytes)>;
+Result readListing(std::string_view listing, const std::string& label, const PieceLoader& load, TetMesh& out,
+                   ReadReport& report);
 
 // VTK XML, appended raw binary: Float32 points, Int64 connectivity/offsets, UInt8 types, Float32
 // point data. One fwrite per array; writes PATH.tmp, then renames.
@@ -293,6 +327,91 @@ std::vector<ComponentTriple> componentTriples(const std::vector<std::string>& na
 // a note. A cell's magnitude is NaN where a component is.
 void addComponentMagnitudes(TetMesh& mesh, size_t firstField, ReadReport& report);
 void addComponentMagnitudes(std::vector<CellArray>& arrays, size_t first, ReadReport& report);
+// ------------------------------------------------------------------ pieces (piece_merge.cpp)
+// A mesh written in pieces (a parallel run's ranks, a multiblock's blocks, the <Piece>s of one
+// VTK XML file) is read piece by piece into MeshPieces and joined by mergePieces(), which then
+// hands the whole to finishMesh() like any other reader.
+
+// VTK's ghost flags (vtkDataSetAttributes::CellGhostTypes and PointGhostTypes).
+inline constexpr uint8_t kDuplicateCell = 1;   // a copy of a cell another piece owns
+inline constexpr uint8_t kHiddenCell = 32;     // blanked: not part of the dataset
+inline constexpr uint8_t kDuplicatePoint = 1;  // a copy of a point another piece owns
+inline constexpr uint8_t kHiddenPoint = 2;     // there for the cells that use it, not shown itself
+
+// Arrays that describe how a mesh was partitioned: they never become fields.
+enum class PartitionArray { None, GhostType, GhostLevels, PointIds, CellIds };
+// `idsAttribute` is the array a VTK XML <PointData GlobalIds="..."> (or <CellData>) names.
+// vtkGhostType; vtkGhostLevels (VTK before 8.1: a level above 0 is a ghost); GlobalIds,
+// GlobalNodeIds (Exodus) for points; GlobalIds, GlobalCellIds, GlobalElementIds for cells.
+PartitionArray partitionArrayKind(std::string_view name, bool cellData, std::string_view idsAttribute = {});
+
+struct MeshPiece {
+  std::string where;                  // starts every message: "a.pvtu piece 2 (a_2.vtu)"
+  std::string name;                   // in notes: "Piece 1", "piece 2 (a_2.vtu)"
+  TetMesh mesh;                       // the piece's points and point fields (tets unused)
+  CellSoup soup;                      // corners index this piece's points
+  std::vector<CellArray> cellArrays;  // one value per input cell of the piece
+  std::vector<uint8_t> pointGhost;    // vtkGhostType per point; empty when absent
+  std::vector<uint8_t> cellGhost;     // vtkGhostType per input cell; empty when absent
+  std::vector<int64_t> globalIds;     // per point; empty when absent
+  std::string globalIdsName;          // the array they came from ("GlobalIds")
+};
+
+// Checks and keeps a partition array read as numbers: `values` holds `tuples` x `components`.
+// Ghost flags must be integers 0..255 (GhostLevels: 0..255, any level above 0 is a duplicate),
+// global ids integers in 0..2^53. Corrupt otherwise, naming `what` ("a.vtu: DataArray 'GlobalIds'").
+// Cell global ids are only dropped. A second array of a kind that is already there is ignored.
+Result takePartitionArray(PartitionArray kind, const std::string& name, const std::string& what,
+                          std::span<const double> values, uint64_t components, bool cellData, MeshPiece& piece);
+
+struct PieceMergeRules {
+  // The field names a listing declares (.pvtu PPointData/PCellData, after the magnitude rule):
+  // a piece without one is an error, arrays it does not declare are dropped with a note. When
+  // `declared` is false, an array some piece lacks is dropped with a note naming that piece.
+  bool declared = false;
+  // (field name, how the listing declares it: "'v' (3 components)")
+  std::vector<std::pair<std::string, std::string>> pointFields, cellFields;
+  const char* joined = "concatenated";  // the note's verb for several pieces
+};
+
+// What mergePieces did, for ReadReport::format.
+struct PieceMergeSummary {
+  uint64_t pieces = 0;
+  uint64_t ghostCells = 0;      // dropped: vtkGhostType DUPLICATECELL
+  uint64_t hiddenCells = 0;     // dropped: vtkGhostType HIDDENCELL
+  uint64_t duplicateCells = 0;  // dropped: a cell another piece also holds, unflagged
+  uint64_t weldedPoints = 0;    // interface points: distinct points that kept cells of 2+ pieces use
+  bool byGlobalIds = false;     // welded by GlobalIds (else by coordinates)
+  std::string globalIdsName;
+};
+// ", 4 pieces, 1,234 ghost cells dropped, 5,678 interface points welded by GlobalIds".
+std::string describeMerge(const PieceMergeSummary& s, const char* pieceWord = "pieces");
+// "1,234".
+std::string withThousands(uint64_t n);
+
+// Joins the pieces into one mesh and finishes it (finishMesh). Per piece: ghost and hidden cells
+// are dropped. Between pieces: points are welded by global id when every piece has global ids
+// (points with one id must lie within kGlobalIdTolerance of each other: Corrupt otherwise, with
+// counts), else by exact coordinates (finishMesh's merge of coincident vertices); a welded point
+// takes the values of its owning piece (the first piece whose copy is neither DUPLICATEPOINT
+// nor HIDDENPOINT), and every field's disagreements are counted in a note. Cells that two pieces
+// both hold (ghost cells left unflagged) are kept once. `pieces` is consumed.
+Result mergePieces(const std::string& label, std::vector<MeshPiece>& pieces, const PieceMergeRules& rules, TetMesh& out,
+                   ReadReport& report, PieceMergeSummary& summary);
+
+// The pieces of a VTK XML file, one MeshPiece per <Piece> (vtu_reader.cpp); report.format says
+// what was read. readVtu() is this followed by mergePieces().
+Result readVtuPieces(std::string_view bytes, const std::string& label, std::vector<MeshPiece>& pieces,
+                     ReadReport& report);
+// A legacy VTK file as one MeshPiece (vtk_reader.cpp); readLegacyVtk() merges it alone.
+Result readLegacyVtkPiece(std::string_view bytes, const std::string& label, MeshPiece& piece, ReadReport& report);
+// The VTKFile type attribute of a VTK XML file ("UnstructuredGrid"), from its first bytes; empty
+// when there is no <VTKFile> start tag there.
+std::string vtkXmlFileType(std::string_view head);
+
+// Finds bit-equal positions (-0 = +0). Returns how many vertices have an earlier copy; remap[v]
+// is the first copy of v's position (empty when there are none). (cells.cpp)
+uint64_t findCoincident(const TetMesh& mesh, std::vector<uint32_t>& remap);
 
 // Whitespace-separated text with '#' comments (TetGen, Medit), with line numbers for messages.
 struct TextReader {
@@ -356,6 +475,11 @@ struct TextReader {
 // Caps on what a file may declare before we believe it.
 inline constexpr uint64_t kMaxComponents = 1024;  // per array tuple
 inline constexpr uint64_t kMaxVertices = 0xFFFFFFFFull;
+inline constexpr uint64_t kMaxPieces = uint64_t(1) << 20;  // pieces or blocks in one listing
+// Points with one global id may lie this far apart, relative to the size of the model (its
+// bounding-box diagonal plus its largest coordinate): float32 copies of float64 coordinates, or
+// coordinates moved by a rounding, differ by far less; ids that are not global, by far more.
+inline constexpr double kGlobalIdTolerance = 1e-5;
 
 }  // namespace vtkio
 }  // namespace tetstream

@@ -122,6 +122,7 @@ struct Legacy {
   std::vector<ScalarField> fields;
   std::vector<CellArray> cellArrays;
   std::vector<std::string> skippedArrays;
+  MeshPiece partition;  // the arrays that describe the partition (vtkGhostType, GLOBAL_IDS)
   Section section = Section::Dataset;
   uint64_t sectionCount = 0;
 
@@ -420,8 +421,12 @@ struct Legacy {
   }
 
   // Keeps or skips one attribute array of `tuples` x `comps` values.
+  // GLOBAL_IDS sections are global ids whatever their name; other arrays by their name.
   Result attributeArray(const std::string& name, const LegacyType& t, uint64_t tuples, uint64_t comps,
-                        const std::string& what, bool convertible) {
+                        const std::string& what, bool convertible, bool globalIds = false) {
+    const PartitionArray partitionKind =
+        globalIds ? (section == Section::CellData ? PartitionArray::CellIds : PartitionArray::PointIds)
+                  : partitionArrayKind(name, section == Section::CellData);
     if (comps == 0 || comps > kMaxComponents)
       return error(
           Status::Corrupt, pos,
@@ -430,6 +435,13 @@ struct Legacy {
     if (__builtin_mul_overflow(tuples, comps, &count))
       return error(Status::TooLarge, pos, what + ": value count overflows");
     const bool cellSection = section == Section::CellData;
+    if (partitionKind != PartitionArray::None && section != Section::Dataset &&
+        tuples == (cellSection ? sectionCount : pointCount)) {
+      const std::string where = label + " " + at(pos) + ": " + what;
+      std::vector<double> v;
+      if (Result r = readValues<double>(t, count, what, &v); !r) return r;
+      return takePartitionArray(partitionKind, name, where, v, comps, cellSection, partition);
+    }
     bool keep = convertible &&
                 ((section == Section::PointData && tuples == pointCount) || (cellSection && tuples == sectionCount));
     if (!keep) {
@@ -513,7 +525,8 @@ struct Legacy {
     if (iequals(kw, "GLOBAL_IDS") || iequals(kw, "PEDIGREE_IDS") || iequals(kw, "EDGE_FLAGS")) {
       if (Result r = need(2); !r) return r;
       if (Result r = parseType(a[1], p, t); !r) return r;
-      return attributeArray(decodeName(a[0]), t, n, 1, std::string(kw) + " '" + decodeName(a[0]) + "'", false);
+      return attributeArray(decodeName(a[0]), t, n, 1, std::string(kw) + " '" + decodeName(a[0]) + "'", false,
+                            iequals(kw, "GLOBAL_IDS"));
     }
     if (iequals(kw, "TEXTURE_COORDINATES")) {
       if (Result r = need(3); !r) return r;
@@ -677,13 +690,14 @@ struct Legacy {
 
 }  // namespace
 
-Result readLegacyVtk(std::string_view bytes, const std::string& label, TetMesh& out, ReadReport& report) {
-  out = TetMesh{};
+Result vtkio::readLegacyVtkPiece(std::string_view bytes, const std::string& label, MeshPiece& piece,
+                                 ReadReport& report) {
+  piece = MeshPiece{};
   Legacy lg(label, bytes, report);
   if (Result r = lg.parse(); !r) return r;
 
-  TetMesh mesh;
-  CellSoup soup;
+  TetMesh& mesh = piece.mesh;
+  CellSoup& soup = piece.soup;
   if (lg.kind == Kind::Unstructured) {
     if (!lg.haveCells)
       return fail(Status::NoTets,
@@ -712,10 +726,24 @@ Result readLegacyVtk(std::string_view bytes, const std::string& label, TetMesh& 
     appendStructuredCells(nx, ny, nz, 0, 0, soup);
     soup.inputCells = lg.structuredCellCount();
   }
-  for (ScalarField& f : lg.fields) addField(mesh, std::move(f), report);
+  mesh.fields = std::move(lg.fields);
+  piece.cellArrays = std::move(lg.cellArrays);
+  piece.pointGhost = std::move(lg.partition.pointGhost);
+  piece.cellGhost = std::move(lg.partition.cellGhost);
+  piece.globalIds = std::move(lg.partition.globalIds);
+  piece.globalIdsName = std::move(lg.partition.globalIdsName);
+  piece.where = label;
   for (const std::string& w : lg.skippedArrays) report.notes.push_back("skipped " + w);
-  if (Result r = finishMesh(label, mesh, soup, std::move(lg.cellArrays), report); !r) return r;
-  out = std::move(mesh);
+  return Result::success();
+}
+
+Result readLegacyVtk(std::string_view bytes, const std::string& label, TetMesh& out, ReadReport& report) {
+  out = TetMesh{};
+  std::vector<MeshPiece> pieces(1);
+  if (Result r = readLegacyVtkPiece(bytes, label, pieces[0], report); !r) return r;
+  PieceMergeSummary summary;
+  if (Result r = mergePieces(label, pieces, PieceMergeRules{}, out, report, summary); !r) return r;
+  if (summary.ghostCells + summary.hiddenCells) report.format += describeMerge(summary);
   return Result::success();
 }
 

@@ -417,11 +417,6 @@ Result readComponents(pugi::xml_node da, const ArrayRef& ref, uint64_t& comps) {
   return Result::success();
 }
 
-struct PieceResult {
-  std::vector<ScalarField> fields;
-  std::vector<CellArray> cellArrays;  // one value per cell of this piece
-};
-
 enum class GridKind { Unstructured, Structured, Image };
 
 // The geometry of a structured piece: its Extent and, for ImageData, how indices become points.
@@ -461,12 +456,14 @@ Result readExtent(pugi::xml_node node, const char* attr, const std::string& wher
   return Result::success();
 }
 
-// Reads the PointData and CellData arrays of one piece (np points, nc cells).
+// Reads the PointData and CellData arrays of one piece (np points, nc cells) into it: fields,
+// cell arrays, and the arrays that describe the partition (vtkGhostType, global ids).
 Result readPieceData(Vtu& vtu, pugi::xml_node piece, const std::string& where, uint64_t np, uint64_t nc,
-                     ReadReport& report, bool notePieceConversions, PieceResult& pr) {
+                     ReadReport& report, bool notePieceConversions, MeshPiece& out) {
   for (const char* section : {"PointData", "CellData"}) {
     const bool cells = section[0] == 'C';
     const char* kind = cells ? "cell" : "point";
+    const std::string_view idsAttribute = piece.child(section).attribute("GlobalIds").value();
     int index = 0;
     for (pugi::xml_node da : piece.child(section).children("DataArray")) {
       std::string name = da.attribute("Name").value();
@@ -484,21 +481,27 @@ Result readPieceData(Vtu& vtu, pugi::xml_node piece, const std::string& where, u
       if (Result r = readComponents(da, ref, comps); !r) return r;
       std::vector<double> values;
       if (Result r = readDataArray(vtu, da, ref, (cells ? nc : np) * comps, values); !r) return r;
+      if (const PartitionArray p = partitionArrayKind(name, cells, idsAttribute); p != PartitionArray::None) {
+        if (Result r = takePartitionArray(p, name, ref.str(), values, comps, cells, out); !r) return r;
+        continue;
+      }
       ReadReport scratch;
       std::string fname = fieldNameFor(name, uint32_t(comps), notePieceConversions ? report : scratch, kind);
       std::vector<float> scalars = tuplesToScalars(values, uint32_t(comps));
       if (cells)
-        pr.cellArrays.push_back({fname, std::vector<double>(scalars.begin(), scalars.end())});
+        out.cellArrays.push_back({fname, std::vector<double>(scalars.begin(), scalars.end())});
       else
-        pr.fields.push_back({fname, std::move(scalars)});
+        out.mesh.fields.push_back({fname, std::move(scalars)});
     }
   }
   return Result::success();
 }
 
-// Reads one Piece: appends its points to mesh and its cells to the soup, returns its arrays.
+// Reads one Piece: its points, its cells (numbered within the piece) and its arrays.
 Result readPiece(Vtu& vtu, GridKind kind, const Grid& whole, pugi::xml_node piece, const std::string& where,
-                 TetMesh& mesh, CellSoup& soup, ReadReport& report, bool notePieceConversions, PieceResult& pr) {
+                 MeshPiece& out, ReadReport& report, bool notePieceConversions) {
+  TetMesh& mesh = out.mesh;
+  CellSoup& soup = out.soup;
   uint64_t np = 0, nc = 0;
   Grid g = whole;
   if (kind == GridKind::Unstructured) {
@@ -528,8 +531,8 @@ Result readPiece(Vtu& vtu, GridKind kind, const Grid& whole, pugi::xml_node piec
   // ImageData's geometry costs nothing to declare: read its arrays first, so a file that does not
   // carry the values for its extent stops before a grid is built for it.
   if (kind == GridKind::Image) {
-    if (Result r = readPieceData(vtu, piece, where, np, nc, report, notePieceConversions, pr); !r) return r;
-    if (pr.fields.empty() && pr.cellArrays.empty())
+    if (Result r = readPieceData(vtu, piece, where, np, nc, report, notePieceConversions, out); !r) return r;
+    if (mesh.fields.empty() && out.cellArrays.empty())
       return fail(Status::MissingField, where + ": the image has no numeric PointData or CellData arrays to show");
   }
 
@@ -587,7 +590,7 @@ Result readPiece(Vtu& vtu, GridKind kind, const Grid& whole, pugi::xml_node piec
     if (Result r = appendVtkCells(where, conn, offsets, types, vertexBase, np, soup); !r) return r;
   }
   if (kind == GridKind::Image) return Result::success();
-  return readPieceData(vtu, piece, where, np, nc, report, notePieceConversions, pr);
+  return readPieceData(vtu, piece, where, np, nc, report, notePieceConversions, out);
 }
 
 // Locates <AppendedData ...> and its '_' marker in the raw bytes. xmlEnd is where the parsable XML
@@ -640,8 +643,9 @@ Result locateAppended(std::string_view bytes, const std::string& label, size_t& 
 
 }  // namespace
 
-Result readVtu(std::string_view bytes, const std::string& label, TetMesh& out, ReadReport& report) {
-  out = TetMesh{};
+Result vtkio::readVtuPieces(std::string_view bytes, const std::string& label, std::vector<MeshPiece>& pieces,
+                            ReadReport& report) {
+  pieces.clear();
   // Sniff before XML parsing so a legacy file or junk gets a clear message.
   size_t start = 0;
   if (bytes.substr(0, 3) == "\xEF\xBB\xBF") start = 3;
@@ -681,8 +685,12 @@ Result readVtu(std::string_view bytes, const std::string& label, TetMesh& out, R
     kind = GridKind::Structured;
   else if (type == "ImageData")
     kind = GridKind::Image;
-  else
+  else if (type == "PUnstructuredGrid" || type == "vtkMultiBlockDataSet")
     return fail(Status::Unsupported, label + ": VTKFile type '" + type +
+                                         "' lists piece files; read it by its path (as .pvtu or .vtm), which finds "
+                                         "the pieces beside it");
+  else
+    return fail(Status::Unsupported, label + ": VTKFile type '" + printable(type) +
                                          "' is not supported; tetstream reads UnstructuredGrid (.vtu), StructuredGrid "
                                          "(.vts) and ImageData (.vti)");
   vtu.fileBytes = bytes.size();
@@ -727,58 +735,18 @@ Result readVtu(std::string_view bytes, const std::string& label, TetMesh& out, R
     return fail(Status::NoTets, label + ": WholeExtent " + std::to_string(whole.n(0)) + "x" +
                                     std::to_string(whole.n(1)) + "x" + std::to_string(whole.n(2)) +
                                     " is not a 3D grid (no volume cells)");
-  std::vector<pugi::xml_node> pieces;
-  for (pugi::xml_node p : grid.children("Piece")) pieces.push_back(p);
-  if (pieces.empty()) return fail(Status::Corrupt, label + ": <" + type + "> has no <Piece>");
+  std::vector<pugi::xml_node> nodes;
+  for (pugi::xml_node p : grid.children("Piece")) nodes.push_back(p);
+  if (nodes.empty()) return fail(Status::Corrupt, label + ": <" + type + "> has no <Piece>");
 
-  TetMesh mesh;
-  CellSoup soup;
-  std::vector<ScalarField> fields;
-  std::vector<CellArray> cellArrays;
-  std::vector<bool> keep, keepCell;
-  for (size_t k = 0; k < pieces.size(); ++k) {
-    std::string where = pieces.size() == 1 ? label : label + " Piece " + std::to_string(k);
-    PieceResult pr;
-    if (Result r = readPiece(vtu, kind, whole, pieces[k], where, mesh, soup, report, k == 0, pr); !r) return r;
-    if (k == 0) {
-      fields = std::move(pr.fields);
-      keep.assign(fields.size(), true);
-      cellArrays = std::move(pr.cellArrays);
-      keepCell.assign(cellArrays.size(), true);
-      continue;
-    }
-    // Several pieces: an array survives only if every piece has it.
-    for (size_t i = 0; i < fields.size(); ++i) {
-      auto it = std::find_if(pr.fields.begin(), pr.fields.end(),
-                             [&](const ScalarField& f) { return f.name == fields[i].name; });
-      if (it == pr.fields.end()) {
-        if (keep[i])
-          report.notes.push_back("dropped point array '" + fields[i].name + "': Piece " + std::to_string(k) +
-                                 " lacks it");
-        keep[i] = false;
-      } else {
-        fields[i].values.insert(fields[i].values.end(), it->values.begin(), it->values.end());
-      }
-    }
-    for (size_t i = 0; i < cellArrays.size(); ++i) {
-      auto it = std::find_if(pr.cellArrays.begin(), pr.cellArrays.end(),
-                             [&](const CellArray& f) { return f.name == cellArrays[i].name; });
-      if (it == pr.cellArrays.end()) {
-        if (keepCell[i])
-          report.notes.push_back("dropped cell array '" + cellArrays[i].name + "': Piece " + std::to_string(k) +
-                                 " lacks it");
-        keepCell[i] = false;
-      } else {
-        cellArrays[i].values.insert(cellArrays[i].values.end(), it->values.begin(), it->values.end());
-      }
-    }
+  pieces.clear();
+  pieces.reserve(nodes.size());  // bounded: each is an element of the file
+  for (size_t k = 0; k < nodes.size(); ++k) {
+    MeshPiece& piece = pieces.emplace_back();
+    piece.where = nodes.size() == 1 ? label : label + " Piece " + std::to_string(k);
+    piece.name = "Piece " + std::to_string(k);
+    if (Result r = readPiece(vtu, kind, whole, nodes[k], piece.where, piece, report, k == 0); !r) return r;
   }
-  for (size_t i = 0; i < fields.size(); ++i)
-    if (keep[i]) addField(mesh, std::move(fields[i]), report);
-  std::vector<CellArray> keptCells;
-  for (size_t i = 0; i < cellArrays.size(); ++i)
-    if (keepCell[i]) keptCells.push_back(std::move(cellArrays[i]));
-  if (pieces.size() > 1) report.notes.push_back("concatenated " + std::to_string(pieces.size()) + " pieces");
 
   std::string enc;
   for (const std::string& e : vtu.encodings) enc += (enc.empty() ? "" : ", ") + e;
@@ -788,10 +756,30 @@ Result readVtu(std::string_view bytes, const std::string& label, TetMesh& out, R
   report.format = "VTK XML " + type + " (" + (enc.empty() ? std::string("no arrays") : enc) +
                   (vtu.zlib ? ", zlib" : "") + (vtu.header64 ? ", UInt64 header" : ", UInt32 header") +
                   (vtu.bigEndian ? ", BigEndian" : "") + dims + ")";
-
-  if (Result r = finishMesh(label, mesh, soup, std::move(keptCells), report); !r) return r;
-  out = std::move(mesh);
   return Result::success();
+}
+
+Result readVtu(std::string_view bytes, const std::string& label, TetMesh& out, ReadReport& report) {
+  out = TetMesh{};
+  std::vector<MeshPiece> pieces;
+  if (Result r = readVtuPieces(bytes, label, pieces, report); !r) return r;
+  PieceMergeSummary summary;
+  if (Result r = mergePieces(label, pieces, PieceMergeRules{}, out, report, summary); !r) return r;
+  if (summary.pieces > 1 || summary.ghostCells + summary.hiddenCells) report.format += describeMerge(summary);
+  return Result::success();
+}
+
+std::string vtkio::vtkXmlFileType(std::string_view head) {
+  size_t tag = head.find("<VTKFile");
+  if (tag == std::string_view::npos) return {};
+  size_t gt = head.find('>', tag);
+  if (gt == std::string_view::npos) return {};
+  std::string tagXml(head.substr(tag, gt - tag));
+  if (!tagXml.empty() && tagXml.back() == '/') tagXml.pop_back();
+  tagXml += "/>";
+  pugi::xml_document doc;
+  if (!doc.load_buffer(tagXml.data(), tagXml.size())) return {};
+  return doc.first_child().attribute("type").value();
 }
 
 }  // namespace tetstream

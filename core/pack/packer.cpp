@@ -222,8 +222,12 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
                           ? opt.baseVertices
                           : uint32_t(std::llround(std::clamp(opt.baseFraction, 0.0, 1.0) * mesh.vertexCount()));
   // A fraction of a small mesh would leave a base too coarse to show anything: keep a floor.
+  // And a cap: the base is what a viewer waits for before the first picture, so on a huge mesh
+  // it stays a couple of MB (65,536 vertices: about 2 MB, under 2 s at 10 Mbit/s) rather than
+  // growing with the mesh (1% of Harmonic 256³ is 6.4 MB); the detail comes with the nodes.
   if (!opt.baseVertices && opt.baseFraction > 0)
-    so.targetVertices = std::max(so.targetVertices, std::min(opt.minBaseVertices, mesh.vertexCount()));
+    so.targetVertices =
+        std::max(std::min(so.targetVertices, opt.maxBaseVertices), std::min(opt.minBaseVertices, mesh.vertexCount()));
   if (report.nonManifoldFaces || report.duplicateTets) {
     summary.notes.push_back("non-manifold or duplicated tetrahedra: packed without simplification");
     so.targetVertices = mesh.vertexCount();

@@ -22,6 +22,7 @@ struct PackOptions {
   double baseFraction = 0.01;               // base mesh size as a fraction of the vertices...
   uint32_t baseVertices = 0;                // ...or as a vertex count (wins when non-zero)
   uint32_t minBaseVertices = 256;           // floor for the fraction rule on small meshes
+  uint32_t maxBaseVertices = 65536;         // cap of the fraction rule on huge meshes (see packer.cpp)
   uint32_t baseTets = 0;                    // stop earlier once the base has this many tets
   double maxError = std::numeric_limits<double>::infinity();  // stop at this field error (SimplifyOptions)
   bool lossless = false;                                      // keep float32 values in split records

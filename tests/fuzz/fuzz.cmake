@@ -3,7 +3,8 @@
 # Every library is built with -fsanitize=fuzzer-no-link,address,undefined (CMakeLists.txt);
 # each target below links the fuzzer's main. tests/fuzz/run.sh builds and runs them.
 set(TETSTREAM_FUZZ_TARGETS manifest split-chunk node-chunk base-chunk
-    mesh-vtu mesh-vtk mesh-vts mesh-vti mesh-msh mesh-mesh mesh-xyz pair-tetgen pair-medit pair-plot3d hpc-headers)
+    mesh-vtu mesh-vtk mesh-vts mesh-vti mesh-msh mesh-mesh mesh-xyz mesh-xdmf pair-tetgen pair-medit pair-plot3d
+    hpc-headers listing)
 
 add_library(tetstream_fuzz_harness STATIC tests/fuzz/harness.cpp)
 target_link_libraries(tetstream_fuzz_harness PUBLIC tetstream_pack)

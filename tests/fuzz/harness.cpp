@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <memory>
 #include <string_view>
 
@@ -336,6 +337,46 @@ void hpcHeaders(const uint8_t* data, size_t size) {
   (void)vtkio::containerSignature(bytes);
 }
 
+void listing(const uint8_t* data, size_t size) {
+  if (size < 1) return;
+  static const char* const kExtension[] = {".pvtu", ".vtm", ".pvtk"};
+  const std::string label = std::string("fuzz") + kExtension[data[0] % 3];
+  std::string list;
+  std::map<std::string, std::string> files;
+  bool first = true;
+  for (size_t p = 1; p + 2 <= size;) {
+    const size_t nameLength = std::min<size_t>(size_t(data[p]) | size_t(data[p + 1]) << 8, size - p - 2);
+    p += 2;
+    std::string name(reinterpret_cast<const char*>(data + p), nameLength);
+    p += nameLength;
+    size_t length = 0;
+    if (size - p >= 4) {
+      length = size_t(data[p]) | size_t(data[p + 1]) << 8 | size_t(data[p + 2]) << 16 | size_t(data[p + 3]) << 24;
+      p += 4;
+    }
+    length = std::min(length, size - p);
+    std::string bytes(reinterpret_cast<const char*>(data + p), length);
+    p += length;
+    if (first)
+      list = std::move(bytes);
+    else
+      files.emplace(std::move(name), std::move(bytes));
+    first = false;
+  }
+  int loads = 0;
+  const PieceLoader load = [&](const std::string& path, std::string& bytes) {
+    ++loads;
+    auto it = files.find(path);
+    if (it == files.end()) return fail(Status::IoError, path + ": no such file");
+    bytes = it->second;
+    return Result::success();
+  };
+  TetMesh m;
+  ReadReport report;
+  if (readListing(list, label, load, m, report)) checkReaderPromise(m);
+  FUZZ_CHECK(size_t(loads) <= files.size() + 1);  // no file is read twice; the first missing one stops the read
+}
+
 bool runTarget(const std::string& name, const uint8_t* data, size_t size) {
   if (name == "manifest")
     manifest(data, size);
@@ -351,6 +392,8 @@ bool runTarget(const std::string& name, const uint8_t* data, size_t size) {
     twoFiles(name.c_str() + 5, data, size);
   else if (name == "hpc-headers")
     hpcHeaders(data, size);
+  else if (name == "listing")
+    listing(data, size);
   else
     return false;
   return true;

@@ -44,14 +44,22 @@ void meshFile(const char* extension, const uint8_t* data, size_t size);
 void hpcHeaders(const uint8_t* data, size_t size);
 
 // Runs the target of that name ("manifest", "split-chunk", "node-chunk", "base-chunk", "mesh-vtu" for
-// meshFile(".vtu"), ..., "pair-tetgen" for twoFiles("tetgen"), ..., "hpc-headers"). False for an
-// unknown name.
+// meshFile(".vtu"), ..., "mesh-xdmf" for meshFile(".xdmf": the XML and its XML data items; heavy
+// data in other files is refused from bytes), "pair-tetgen" for twoFiles("tetgen"), ...,
+// "hpc-headers", "listing"). False for an unknown name.
 bool runTarget(const std::string& name, const uint8_t* data, size_t size);
 
 // The formats made of two files (TetGen .node + .ele, Medit .mesh + .sol, PLOT3D grid + Q):
 // the first 4 bytes (little-endian) give the length of the first file, the rest is the second.
 // `format` is "tetgen", "medit" or "plot3d".
 void twoFiles(const char* format, const uint8_t* data, size_t size);
+
+// A listing of pieces (.pvtu, .vtm, .pvtk) with the files it names, all in memory, through
+// readListing: data[0] % 3 picks the listing's extension (.pvtu, .vtm, .pvtk); then records of
+// [u16 name length][name][u32 length][bytes], little-endian, cut short where the input ends. The
+// first record is the listing, the others the files a piece path may name. What reads must be a
+// mesh as meshFile() checks it.
+void listing(const uint8_t* data, size_t size);
 
 // Real inputs to start fuzzing from (for tests/fuzz/run.sh): name -> bytes, per target.
 std::vector<std::pair<std::string, std::vector<uint8_t>>> seeds(const std::string& target);

@@ -19,7 +19,7 @@ cmake --preset fuzz >/dev/null
 cmake --build build/fuzz -j2 >/dev/null
 TARGETS=("$@")
 [ ${#TARGETS[@]} -gt 0 ] || TARGETS=(manifest split-chunk base-chunk mesh-vtu mesh-vtk mesh-vts mesh-vti mesh-msh
-  mesh-mesh mesh-xyz pair-tetgen pair-medit pair-plot3d hpc-headers)
+  mesh-mesh mesh-xyz mesh-xdmf pair-tetgen pair-medit pair-plot3d hpc-headers listing)
 # A two-file seed: 4-byte little-endian length of the first file, then both files.
 pair_seed() { python3 -c 'import sys,struct; a=open(sys.argv[1],"rb").read(); b=open(sys.argv[2],"rb").read(); sys.stdout.buffer.write(struct.pack("<I",len(a))+a+b)' "$1" "$2"; }
 
@@ -30,19 +30,26 @@ for t in "${TARGETS[@]}"; do
   F=tests/fixtures/formats
   case $t in
     mesh-xyz) cp $F/*.xyz $F/*.x $F/*.g "$seeds"/ ;;
-    mesh-*) cp tests/fixtures/*."${t#mesh-}" $F/*."${t#mesh-}" "$seeds"/ 2>/dev/null || true ;;
+    # From bytes only XML data items are read (HDF and binary ones are refused): the XML-data file
+    # and the XML around the others.
+    mesh-xdmf) cp tests/fixtures/hpc/xdmf_*.x*mf "$seeds"/ ;;
+    mesh-*) cp tests/fixtures/*."${t#mesh-}" $F/*."${t#mesh-}" "$seeds"/ 2>/dev/null || true
+            [ "$t" != mesh-vtu ] || cp tests/fixtures/partitioned/petsc.vtu "$seeds"/ ;;
     pair-tetgen) for n in $F/*.node; do pair_seed "$n" "${n%.node}.ele" > "$seeds/$(basename "${n%.node}")"; done ;;
     pair-medit) pair_seed $F/grid.mesh $F/grid.sol > "$seeds/grid"; pair_seed $F/mixed.mesh /dev/null > "$seeds/mixed" ;;
     pair-plot3d) for g in $F/p3d_*; do [[ $g == *.q ]] || pair_seed "$g" "${g%.*}.q" > "$seeds/$(basename "$g")"; done ;;
     hpc-headers) for h in tests/fixtures/hpc/exo_blocks.exo tests/fixtures/hpc/*.adf.cgns; do head -c 8192 "$h" > "$seeds/$(basename "$h")"; done ;;
+    listing) for l in tests/fixtures/partitioned/*.pvt? tests/fixtures/partitioned/*.vtm; do
+               python3 tests/fuzz/listing_seed.py "$l" > "$seeds/$(basename "$l")"; done ;;
     *) build/fuzz/write_seeds "$t" "$seeds" ;;
   esac
   echo "fuzz: $t for ${SECONDS_EACH}s"
   # -rss_limit_mb: a parser that allocates more than this on a small input is a finding.
+  # -max_len: a listing carries its pieces, which need more room than one file.
   # -timeout is wall time: a fuzzer run under `nice` on a busy machine can be starved for many
   # seconds, which at 10 s ended runs early with timeouts that did not reproduce.
   build/fuzz/fuzz-"$t" "$work" "$corpus" "$seeds" -max_total_time="$SECONDS_EACH" -rss_limit_mb=1024 \
-    -max_len="${MAX_LEN:-8192}" -timeout=60 -report_slow_units=60 -artifact_prefix="$found/" -print_final_stats=1 \
+    -max_len="${MAX_LEN:-$([ "$t" = listing ] && echo 65536 || echo 8192)}" -timeout=60 -report_slow_units=60 -artifact_prefix="$found/" -print_final_stats=1 \
     2>build/fuzz/$t.log || true
   grep -E "stat::number_of_executed_units|stat::peak_rss_mb" build/fuzz/$t.log | sed "s/^/  /"
   # A finding must reproduce: a slow unit or timeout can also come from the machine being busy

@@ -134,3 +134,31 @@ TEST(FetchPlan, RegionsOutOfViewComeLast) {
   }
   EXPECT_GT(inViewFirst, order.size() / 4);
 }
+
+namespace {
+uint64_t g_heapAsked = 0;
+bool recordReserveHeap(uint64_t bytes) {
+  g_heapAsked = std::max(g_heapAsked, bytes);
+  return true;
+}
+}  // namespace
+
+// The memory asked for before each chunk of a hierarchy is for what has arrived, whatever its
+// place in the manifest: a plan that skips most of the dataset never asks for the rest (which
+// in a 4 GB wasm heap once refused the chunks of a large dataset's deep regions).
+TEST(FetchPlan, MemoryAskedForIsWhatArrived) {
+  ViewerState s;
+  s.memory.reserveHeap = recordReserveHeap;
+  g_heapAsked = 0;
+  ASSERT_TRUE(openManifest(s, packedNodes().manifest).ok());
+  const Manifest& m = s.dataset.manifest;
+  setIsovalue(s, m.fields[0].range.min + 0.8f * (m.fields[0].range.max - m.fields[0].range.min));
+  const std::vector<uint32_t> plan = plannedChunks(s, ~0u);
+  LevelCounts planned;
+  for (uint32_t c : plan) addCounts(planned, chunkCounts(m, c));
+  for (uint32_t c : plan) offer(s, c);
+  EXPECT_LE(g_heapAsked, estimateBytes(m, planned)) << "no more than the planned chunks need";
+  EXPECT_LT(estimateBytes(m, planned), estimateLevelBytes(m, plan.back() + 1))
+      << "the manifest's prefix up to the last planned chunk needs more: the test tells them apart";
+  EXPECT_EQ(s.memory.received.tets, planned.tets);
+}

@@ -31,9 +31,9 @@ TEST(FuzzCorpus, EveryInputOfEveryTargetRunsClean) {
       ++inputs;
     }
   }
-  for (const char* t :
-       {"manifest", "split-chunk", "node-chunk", "base-chunk", "mesh-vtu", "mesh-vtk", "mesh-vts", "mesh-vti",
-        "mesh-msh", "mesh-mesh", "mesh-xyz", "pair-tetgen", "pair-medit", "pair-plot3d", "hpc-headers"})
+  for (const char* t : {"manifest", "split-chunk", "node-chunk", "base-chunk", "mesh-vtu", "mesh-vtk", "mesh-vts",
+                        "mesh-vti", "mesh-msh", "mesh-mesh", "mesh-xyz", "mesh-xdmf", "pair-tetgen", "pair-medit",
+                        "pair-plot3d", "hpc-headers", "listing"})
     EXPECT_TRUE(targets.count(t)) << "no corpus for " << t;
   EXPECT_GT(inputs, 50u);
 }

@@ -1,0 +1,768 @@
+// XDMF 2 and 3 reader: the grids of an XDMF file (xdmf_document.h reads its XML and data) as one
+// tetrahedral mesh. Layout reference: "XDMF Model and Format" (xdmf.org); the cell type codes of
+// Mixed topologies are XdmfTopologyType's.
+//
+// What is read:
+//   - The Domain's grids. A temporal collection (GridType="Collection" CollectionType="Temporal")
+//     makes time steps, one per child grid, its time from <Time Value=...> (or the collection's
+//     <Time TimeType="List"> / "HyperSlab"); one step is read (options.step / options.time, the
+//     last by default) and only its data. Other top-level temporal collections with the same
+//     times on the same mesh (DOLFINx writes one per function) add their attributes to it; the
+//     top-level grids outside the collections (DOLFINx's mesh grid) are what the steps refer to.
+//   - Without a temporal collection, every top-level grid is read; spatial collections and trees
+//     are flattened into pieces whose points are concatenated (coincident ones merged later). A
+//     grid whose Geometry is one already read (by reference or include) adds its cells to those
+//     points, less the cells it repeats (DOLFINx writes cell tags as such a grid).
+//   - Topology: Tetrahedron, Pyramid, Wedge, Hexahedron, their quadratic forms (corners kept) and
+//     Mixed; grids of surface, line or point cells (DOLFINx's facet tags) and cells of higher
+//     order than quadratic are counted and skipped without reading their data.
+//   - Geometry XYZ and X_Y_Z. Attributes with Center="Node" become fields, Center="Cell" cell
+//     data (volume-weighted to the points), legacy DOLFIN finite element functions (Center=
+//     "Other") are read through their dofs (xdmf_function.h); vectors and tensors become their
+//     magnitude. An attribute survives only if every piece has it.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <set>
+
+#include "io/readers.h"
+#include "io/xdmf_document.h"
+#include "io/xdmf_function.h"
+
+namespace tetstream {
+namespace {
+
+using namespace vtkio;
+using xdmf::Document;
+using xdmf::Values;
+
+constexpr int kMaxGridDepth = 16;
+constexpr size_t kMaxPieces = size_t(1) << 20;
+
+struct TopologyKind {
+  const char* name;  // as XDMF spells it
+  int code;          // in Mixed topologies
+  int64_t vtk;       // the VTK cell type, 0 for none
+  int nodes;         // per cell; 0: given per grid (NodesPerElement) or per cell (Mixed)
+  bool read;         // a volume cell tetstream reads
+};
+
+constexpr TopologyKind kKinds[] = {
+    {"Polyvertex", 0x1, 2, 0, false},
+    {"Polyline", 0x2, 4, 0, false},
+    {"Polygon", 0x3, 7, 0, false},
+    {"Triangle", 0x4, 5, 3, false},
+    {"Quadrilateral", 0x5, 9, 4, false},
+    {"Tetrahedron", 0x6, 10, 4, true},
+    {"Pyramid", 0x7, 14, 5, true},
+    {"Wedge", 0x8, 13, 6, true},
+    {"Hexahedron", 0x9, 12, 8, true},
+    {"Polyhedron", 0x10, 42, 0, false},
+    {"Edge_3", 0x22, 21, 3, false},
+    {"Quadrilateral_9", 0x23, 28, 9, false},
+    {"Triangle_6", 0x24, 22, 6, false},
+    {"Quadrilateral_8", 0x25, 23, 8, false},
+    {"Tetrahedron_10", 0x26, 24, 10, true},
+    {"Pyramid_13", 0x27, 27, 13, true},
+    {"Wedge_15", 0x28, 26, 15, true},
+    {"Wedge_18", 0x29, 32, 18, true},
+    {"Hexahedron_20", 0x30, 25, 20, true},
+    {"Hexahedron_24", 0x31, 33, 24, true},
+    {"Hexahedron_27", 0x32, 29, 27, true},
+    // Higher orders: node orders tetstream does not know, counted and skipped.
+    {"Hexahedron_64", 0x33, 0, 64, false},
+    {"Hexahedron_125", 0x34, 0, 125, false},
+    {"Hexahedron_216", 0x35, 0, 216, false},
+    {"Hexahedron_343", 0x36, 0, 343, false},
+    {"Hexahedron_512", 0x37, 0, 512, false},
+    {"Hexahedron_729", 0x38, 0, 729, false},
+    {"Hexahedron_1000", 0x39, 0, 1000, false},
+    {"Hexahedron_1331", 0x40, 0, 1331, false},
+    {"Hexahedron_Spectral_64", 0x41, 0, 64, false},
+    {"Hexahedron_Spectral_125", 0x42, 0, 125, false},
+    {"Hexahedron_Spectral_216", 0x43, 0, 216, false},
+    {"Hexahedron_Spectral_343", 0x44, 0, 343, false},
+    {"Hexahedron_Spectral_512", 0x45, 0, 512, false},
+    {"Hexahedron_Spectral_729", 0x46, 0, 729, false},
+    {"Hexahedron_Spectral_1000", 0x47, 0, 1000, false},
+    {"Hexahedron_Spectral_1331", 0x48, 0, 1331, false},
+};
+
+// Short spellings some writers use (meshio reads them too).
+constexpr std::pair<const char*, const char*> kAliases[] = {
+    {"Tet_10", "Tetrahedron_10"}, {"Hex_20", "Hexahedron_20"},   {"Hex_24", "Hexahedron_24"},
+    {"Hex_27", "Hexahedron_27"},  {"Quad_8", "Quadrilateral_8"}, {"Quad_9", "Quadrilateral_9"},
+    {"Tri_6", "Triangle_6"},      {"Quad", "Quadrilateral"},     {"Tri", "Triangle"},
+    {"Tet", "Tetrahedron"},       {"Hex", "Hexahedron"},
+};
+
+const TopologyKind* kindByName(std::string_view name) {
+  for (const auto& [alias, full] : kAliases)
+    if (iequals(name, alias)) name = full;
+  for (const TopologyKind& k : kKinds)
+    if (iequals(name, k.name)) return &k;
+  return nullptr;
+}
+
+const TopologyKind* kindByCode(int64_t code) {
+  for (const TopologyKind& k : kKinds)
+    if (k.code == code) return &k;
+  return nullptr;
+}
+
+// Skipped cells are named by their XDMF type, whatever the VTK type behind them.
+void countSkipped(CellSoup& soup, const TopologyKind& k, uint64_t n) {
+  if (n) soup.skipped[{k.vtk, "XDMF " + std::string(k.name)}] += n;
+}
+
+std::string gridName(pugi::xml_node g) {
+  const char* n = g.attribute("Name").value();
+  return *n ? printable(n) : std::string();
+}
+
+bool isCollection(pugi::xml_node g) { return iequals(g.attribute("GridType").value(), "Collection"); }
+bool isTemporal(pugi::xml_node g) {
+  return isCollection(g) && iequals(g.attribute("CollectionType").value(), "Temporal");
+}
+
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+// A piece's arrays, merged across pieces like the VTK XML reader does.
+struct PieceArrays {
+  std::vector<ScalarField> fields;
+  std::vector<CellArray> cellArrays;
+};
+
+class XdmfReader {
+ public:
+  XdmfReader(Document& doc, const ReadOptions& options, ReadReport& report)
+      : doc_(doc), options_(options), report_(report) {}
+  Result read(TetMesh& out);
+
+ private:
+  Result flatten(pugi::xml_node grid, const std::string& what, int depth, std::vector<pugi::xml_node>& pieces);
+  Result stepTimes(pugi::xml_node collection, const std::vector<pugi::xml_node>& steps, const std::string& what,
+                   std::vector<double>& times);
+  Result sameMesh(pugi::xml_node a, pugi::xml_node b, const std::string& what, bool& same);
+  Result readPiece(pugi::xml_node grid, const std::vector<pugi::xml_node>& companions, const std::string& where,
+                   bool first, PieceArrays& arrays, bool& skipped, bool& sharedPoints);
+  void dropRepeatedCells(size_t firstNew, uint64_t vertexBase, uint64_t points, const std::string& where);
+  Result readCells(pugi::xml_node topo, const TopologyKind* kind, const std::string& where, uint64_t points,
+                   uint64_t vertexBase, std::vector<int64_t>& conn, int& nodes, uint64_t& cells);
+  Result readMixed(const std::vector<int64_t>& values, const std::string& where, uint64_t points, uint64_t vertexBase,
+                   uint64_t& cells);
+  Result readPoints(pugi::xml_node geo, const std::string& where, uint64_t& points);
+  Result readAttributes(const std::vector<pugi::xml_node>& attributes, const std::string& where,
+                        const xdmf::GridCells& grid, bool first, bool sharedPoints, PieceArrays& arrays);
+
+  Document& doc_;
+  const ReadOptions& options_;
+  ReadReport& report_;
+  TetMesh mesh_;
+  CellSoup soup_;
+  std::vector<std::string> topologies_;  // read, in order, for ReadReport::format
+  // Geometry elements read so far (after references): their first vertex and point count. A
+  // grid on the points of an earlier one adds its cells to those points.
+  std::map<const void*, std::pair<uint64_t, uint64_t>> geometries_;
+};
+
+Result XdmfReader::flatten(pugi::xml_node grid, const std::string& what, int depth,
+                           std::vector<pugi::xml_node>& pieces) {
+  if (depth > kMaxGridDepth)
+    return fail(Status::Corrupt, what + ": grids nest more than " + std::to_string(kMaxGridDepth) +
+                                     " deep (a collection that includes itself?)");
+  std::string_view type = grid.attribute("GridType").value();
+  if (type.empty() || iequals(type, "Uniform")) {
+    pieces.push_back(grid);
+    if (pieces.size() > kMaxPieces)
+      return fail(Status::TooLarge, what + ": more than " + std::to_string(kMaxPieces) + " grids");
+    return Result::success();
+  }
+  if (iequals(type, "Subset")) return fail(Status::Unsupported, what + ": GridType=\"Subset\" grids are not read");
+  if (!iequals(type, "Collection") && !iequals(type, "Tree"))
+    return fail(Status::Corrupt, what + ": GridType='" + printable(type) + "' (expected Uniform, Collection, Tree)");
+  if (isTemporal(grid))
+    return fail(Status::Unsupported, what +
+                                         ": a temporal collection inside a time step or a spatial collection; "
+                                         "tetstream reads time steps from the top-level temporal collections");
+  std::vector<pugi::xml_node> kids;
+  if (Result r = doc_.children(grid, "Grid", what, kids); !r) return r;
+  for (pugi::xml_node k : kids) {
+    const std::string name = gridName(k);
+    if (Result r = flatten(k, what + " / Grid" + (name.empty() ? "" : " '" + name + "'"), depth + 1, pieces); !r)
+      return r;
+  }
+  return Result::success();
+}
+
+Result XdmfReader::stepTimes(pugi::xml_node collection, const std::vector<pugi::xml_node>& steps,
+                             const std::string& what, std::vector<double>& times) {
+  times.clear();
+  // A collection may give every step's time at once: a List of values, or a HyperSlab (start,
+  // stride, count).
+  if (pugi::xml_node t = collection.child("Time")) {
+    std::string_view type = t.attribute("TimeType").value();
+    if (iequals(type, "List") || iequals(type, "HyperSlab")) {
+      pugi::xml_node item;
+      if (Result r = doc_.dataItem(t, what + " <Time>", item); !r) return r;
+      Values<double> v;
+      if (Result r = doc_.numbers(item, what + " <Time>", v); !r) return r;
+      if (iequals(type, "List")) {
+        if (v.values.size() < steps.size())
+          return fail(Status::Corrupt, what + ": <Time TimeType=\"List\"> gives " + std::to_string(v.values.size()) +
+                                           " times for " + std::to_string(steps.size()) + " steps");
+        times.assign(v.values.begin(), v.values.begin() + std::ptrdiff_t(steps.size()));
+      } else {
+        if (v.values.size() != 3)
+          return fail(Status::Corrupt, what + ": <Time TimeType=\"HyperSlab\"> needs start, stride and count");
+        for (size_t i = 0; i < steps.size(); ++i) times.push_back(v.values[0] + double(i) * v.values[1]);
+      }
+    }
+  }
+  if (times.empty()) {
+    for (pugi::xml_node s : steps) {
+      pugi::xml_node t = s.child("Time");
+      double v;
+      size_t pos = 0;
+      if (!t || parseNextDouble(t.attribute("Value").value(), pos, v) != 1) {
+        times.clear();
+        break;
+      }
+      times.push_back(v);
+    }
+    if (times.empty() && !steps.empty()) {
+      for (size_t i = 0; i < steps.size(); ++i) times.push_back(double(i));
+      report_.notes.push_back(what + ": its steps have no <Time Value>; numbered 0, 1, ... as their times");
+    }
+  }
+  for (size_t i = 0; i < times.size(); ++i)
+    if (!std::isfinite(times[i]))
+      return fail(Status::NonFinite, what + ": step " + std::to_string(i) + " has a non-finite time");
+  return Result::success();
+}
+
+// Whether two grids stand on the same mesh: their Topology and Geometry are the same elements
+// (after references) or name the same data.
+Result XdmfReader::sameMesh(pugi::xml_node a, pugi::xml_node b, const std::string& what, bool& same) {
+  same = true;
+  for (const char* part : {"Topology", "Geometry"}) {
+    std::vector<pugi::xml_node> x, y;
+    if (Result r = doc_.children(a, part, what, x); !r) return r;
+    if (Result r = doc_.children(b, part, what, y); !r) return r;
+    if (x.size() != 1 || y.size() != 1) {
+      same = false;
+      return Result::success();
+    }
+    if (x[0] == y[0]) continue;
+    pugi::xml_node dx, dy;
+    if (!doc_.dataItem(x[0], what, dx) || !doc_.dataItem(y[0], what, dy)) {
+      same = false;
+      return Result::success();
+    }
+    auto key = [](pugi::xml_node d) {
+      std::string s = d.child_value();
+      s.erase(std::remove_if(s.begin(), s.end(), [](char c) { return isSpace(c); }), s.end());
+      return std::string(d.attribute("Format").value()) + "|" + s;
+    };
+    if (dx != dy && key(dx) != key(dy)) same = false;
+  }
+  return Result::success();
+}
+
+Result XdmfReader::readPoints(pugi::xml_node geo, const std::string& where, uint64_t& points) {
+  std::string_view type = geo.attribute("GeometryType").value();
+  if (type.empty()) type = geo.attribute("Type").value();
+  if (type.empty()) type = "XYZ";
+  const std::string what = where + " Geometry";
+  std::vector<double> xyz;
+  if (iequals(type, "XYZ")) {
+    pugi::xml_node item;
+    if (Result r = doc_.dataItem(geo, what, item); !r) return r;
+    Values<double> v;
+    if (Result r = doc_.numbers(item, what, v); !r) return r;
+    if (v.values.size() % 3 != 0)
+      return fail(Status::Corrupt,
+                  what + ": GeometryType XYZ with " + std::to_string(v.values.size()) + " values, not a multiple of 3");
+    xyz = std::move(v.values);
+  } else if (iequals(type, "X_Y_Z")) {
+    std::vector<pugi::xml_node> items;
+    if (Result r = doc_.children(geo, "DataItem", what, items); !r) return r;
+    if (items.size() != 3)
+      return fail(Status::Corrupt,
+                  what + ": GeometryType X_Y_Z with " + std::to_string(items.size()) + " DataItems, expected 3");
+    Values<double> axis[3];
+    for (int a = 0; a < 3; ++a) {
+      if (Result r = doc_.numbers(items[size_t(a)], what + " " + "XYZ"[a], axis[a]); !r) return r;
+      if (axis[a].values.size() != axis[0].values.size())
+        return fail(Status::Corrupt, what + ": X_Y_Z arrays of " + std::to_string(axis[0].values.size()) + " and " +
+                                         std::to_string(axis[a].values.size()) + " values");
+    }
+    xyz.resize(3 * axis[0].values.size());
+    for (size_t i = 0; i < axis[0].values.size(); ++i)
+      for (int a = 0; a < 3; ++a) xyz[3 * i + size_t(a)] = axis[a].values[i];
+  } else if (iequals(type, "XY")) {
+    return fail(Status::Unsupported, what + ": GeometryType XY is a 2D mesh; tetstream reads volume meshes (XYZ)");
+  } else if (iequals(type, "VXVYVZ") || iequals(type, "ORIGIN_DXDYDZ") || iequals(type, "ORIGIN_DXDY")) {
+    return fail(Status::Unsupported, what + ": GeometryType " + printable(type) +
+                                         " belongs to structured grids, which are not read from XDMF (convert to "
+                                         ".vti/.vts)");
+  } else {
+    return fail(Status::Unsupported, what + ": GeometryType '" + printable(type) + "' (expected XYZ or X_Y_Z)");
+  }
+  points = xyz.size() / 3;
+  const uint64_t base = mesh_.positions.size() / 3;
+  if (base + points > kMaxVertices)
+    return fail(Status::TooLarge,
+                where + ": " + std::to_string(base + points) + " points; tetstream indexes vertices with 32 bits");
+  mesh_.positions.reserve(mesh_.positions.size() + xyz.size());
+  for (double x : xyz) mesh_.positions.push_back(float(x));
+  return Result::success();
+}
+
+Result XdmfReader::readMixed(const std::vector<int64_t>& values, const std::string& where, uint64_t points,
+                             uint64_t vertexBase, uint64_t& cells) {
+  // type code, [node count,] nodes; per cell. Cells tetstream does not read keep their place
+  // (as VTK_EMPTY_CELL) so that cell data stays aligned; they are named by XDMF type afterwards.
+  std::vector<int64_t> conn, offsets, types;
+  std::map<const TopologyKind*, uint64_t> notRead;
+  conn.reserve(values.size());
+  const size_t n = values.size();
+  size_t i = 0;
+  auto need = [&](uint64_t k, const char* what) -> Result {
+    if (k > n - i)
+      return fail(Status::Truncated, where + " Topology (Mixed): cell " + std::to_string(types.size()) + " needs " +
+                                         std::to_string(k) + " more values for its " + what + ", " +
+                                         std::to_string(n - i) + " remain");
+    return Result::success();
+  };
+  while (i < n) {
+    const int64_t code = values[i++];
+    const TopologyKind* k = kindByCode(code);
+    if (!k)
+      return fail(Status::Corrupt, where + " Topology (Mixed): cell " + std::to_string(types.size()) +
+                                       " has the unknown cell type code " + std::to_string(code));
+    offsets.push_back(int64_t(conn.size()));
+    uint64_t count = uint64_t(k->nodes);
+    if (k->code == 0x10) {
+      // Polyhedron: the number of faces, then per face its node count and nodes.
+      if (Result r = need(1, "face count"); !r) return r;
+      const int64_t faces = values[i++];
+      if (faces < 0 || uint64_t(faces) > n - i)
+        return fail(Status::Corrupt, where + " Topology (Mixed): polyhedron " + std::to_string(types.size()) +
+                                         " declares " + std::to_string(faces) + " faces");
+      for (int64_t f = 0; f < faces; ++f) {
+        if (Result r = need(1, "face node count"); !r) return r;
+        const int64_t m = values[i++];
+        if (m < 0)
+          return fail(Status::Corrupt,
+                      where + " Topology (Mixed): a polyhedron face of " + std::to_string(m) + " nodes");
+        if (Result r = need(uint64_t(m), "face nodes"); !r) return r;
+        conn.insert(conn.end(), values.begin() + std::ptrdiff_t(i), values.begin() + std::ptrdiff_t(i + size_t(m)));
+        i += size_t(m);
+      }
+      types.push_back(0);
+      ++notRead[k];
+      continue;
+    }
+    if (count == 0) {
+      if (Result r = need(1, "node count"); !r) return r;
+      if (values[i] < 0)
+        return fail(Status::Corrupt, where + " Topology (Mixed): cell " + std::to_string(types.size()) +
+                                         " has a node count of " + std::to_string(values[i]));
+      count = uint64_t(values[i++]);
+    }
+    if (Result r = need(count, "nodes"); !r) return r;
+    conn.insert(conn.end(), values.begin() + std::ptrdiff_t(i), values.begin() + std::ptrdiff_t(i + count));
+    i += count;
+    if (k->read) {
+      types.push_back(k->vtk);
+    } else {
+      types.push_back(0);
+      ++notRead[k];
+    }
+  }
+  offsets.push_back(int64_t(conn.size()));
+  cells = types.size();
+  if (Result r = appendVtkCells(where, conn, offsets, types, vertexBase, points, soup_); !r) return r;
+  uint64_t renamed = 0;
+  for (const auto& [k, c] : notRead) {
+    countSkipped(soup_, *k, c);
+    renamed += c;
+  }
+  if (renamed) {
+    auto it = soup_.skipped.find({0, vtkCellTypeName(0) + " (0)"});
+    if (it != soup_.skipped.end() && (it->second -= renamed) == 0) soup_.skipped.erase(it);
+  }
+  return Result::success();
+}
+
+Result XdmfReader::readCells(pugi::xml_node topo, const TopologyKind* kind, const std::string& where, uint64_t points,
+                             uint64_t vertexBase, std::vector<int64_t>& conn, int& nodes, uint64_t& cells) {
+  const std::string what = where + " Topology";
+  pugi::xml_node item;
+  if (Result r = doc_.dataItem(topo, what, item); !r) return r;
+  Values<int64_t> v;
+  if (Result r = doc_.integers(item, what, v); !r) return r;
+  if (topo.attribute("BaseOffset")) {
+    // XDMF 2: ids start at BaseOffset (1 for Fortran-style numbering).
+    size_t pos = 0;
+    int64_t base = 0;
+    if (parseNextInt(topo.attribute("BaseOffset").value(), pos, base) != 1 || std::abs(base) > (int64_t(1) << 40))
+      return fail(Status::Corrupt, what + ": BaseOffset='" + printable(topo.attribute("BaseOffset").value()) + "'");
+    for (int64_t& id : v.values) id -= base;
+  }
+  uint64_t declared = 0;
+  const bool hasCount = topo.attribute("NumberOfElements") || topo.attribute("Dimensions");
+  if (hasCount) {
+    const char* text = topo.attribute("NumberOfElements") ? topo.attribute("NumberOfElements").value()
+                                                          : topo.attribute("Dimensions").value();
+    size_t pos = 0;
+    std::string_view first = nextToken(text, pos);
+    if (!parseU64(first, declared))
+      return fail(Status::Corrupt, what + ": NumberOfElements='" + printable(text) + "' is not a count");
+  }
+  if (!kind) {  // Mixed
+    if (Result r = readMixed(v.values, where, points, vertexBase, cells); !r) return r;
+    if (hasCount && declared != cells)
+      return fail(Status::Corrupt, what + ": NumberOfElements=" + std::to_string(declared) +
+                                       " but the Mixed data holds " + std::to_string(cells) + " cells");
+    return Result::success();
+  }
+  nodes = kind->nodes;
+  if (nodes == 0) nodes = 1;  // (only cells that are not read have no fixed count; never reached)
+  if (v.values.size() % uint64_t(nodes) != 0)
+    return fail(Status::Corrupt, what + ": " + std::to_string(v.values.size()) + " ids are not a whole number of " +
+                                     kind->name + " cells of " + std::to_string(nodes) + " nodes");
+  cells = v.values.size() / uint64_t(nodes);
+  if (hasCount && declared != cells)
+    return fail(Status::Corrupt, what + ": NumberOfElements=" + std::to_string(declared) + " but the DataItem holds " +
+                                     std::to_string(cells) + " " + kind->name + " cells (" +
+                                     std::to_string(v.values.size()) + " ids)");
+  std::vector<int64_t> offsets(cells + 1), types(cells, kind->vtk);
+  for (uint64_t c = 0; c <= cells; ++c) offsets[c] = int64_t(c * uint64_t(nodes));
+  if (Result r = appendVtkCells(where, v.values, offsets, types, vertexBase, points, soup_); !r) return r;
+  conn = std::move(v.values);
+  return Result::success();
+}
+
+Result XdmfReader::readAttributes(const std::vector<pugi::xml_node>& attributes, const std::string& where,
+                                  const xdmf::GridCells& grid, bool first, bool sharedPoints, PieceArrays& arrays) {
+  ReadReport scratch;  // conversions are noted for the first piece only
+  ReadReport& notes = first ? report_ : scratch;
+  int index = 0;
+  for (pugi::xml_node a : attributes) {
+    std::string name = a.attribute("Name").value();
+    if (name.empty()) name = "attribute" + std::to_string(index);
+    ++index;
+    const std::string what = where + " Attribute '" + printable(name) + "'";
+    std::string_view center = a.attribute("Center").value();
+    if (center.empty()) center = "Node";
+    std::string_view type = a.attribute("AttributeType").value();
+    if (type.empty()) type = a.attribute("Type").value();
+    if (iequals(center, "Other") && iequals(a.attribute("ItemType").value(), "FiniteElementFunction")) {
+      const uint32_t comps = iequals(type, "Vector") ? 3 : iequals(type, "Tensor") ? 9 : 1;
+      if (Result r = xdmf::readFiniteElementFunction(doc_, a, name, comps, what, grid, notes, arrays.fields,
+                                                     arrays.cellArrays);
+          !r)
+        return r;
+      continue;
+    }
+    const bool node = iequals(center, "Node"), cell = iequals(center, "Cell");
+    if (node && sharedPoints) {
+      report_.notes.push_back(where + ": skipped point attribute '" + printable(name) +
+                              "' (the grid stands on the points of an earlier grid, whose point data is read)");
+      continue;
+    }
+    if (!node && !cell) {
+      notes.notes.push_back("skipped attribute '" + printable(name) + "' with Center=\"" + printable(center) +
+                            "\" (tetstream reads Node and Cell data)");
+      continue;
+    }
+    pugi::xml_node item;
+    if (Result r = doc_.dataItem(a, what, item); !r) return r;
+    Values<double> v;
+    if (Result r = doc_.numbers(item, what, v); !r) return r;
+    const uint64_t n = node ? grid.points : grid.cells;
+    if (n == 0) continue;
+    const uint64_t comps = v.values.size() / n;
+    if (v.values.size() % n != 0 || comps == 0 || comps > kMaxComponents)
+      return fail(Status::Corrupt, what + ": holds " + std::to_string(v.values.size()) + " values for " +
+                                       std::to_string(n) + (node ? " points" : " cells") +
+                                       " (expected a whole number of values per " + (node ? "point)" : "cell)"));
+    const std::string fname = fieldNameFor(name, uint32_t(comps), notes, node ? "point" : "cell");
+    std::vector<float> scalars = tuplesToScalars(v.values, uint32_t(comps));
+    if (node)
+      arrays.fields.push_back({fname, std::move(scalars)});
+    else
+      arrays.cellArrays.push_back({fname, std::vector<double>(scalars.begin(), scalars.end())});
+  }
+  return Result::success();
+}
+
+// Cells of a grid that repeat cells already read on the same points (the same corners in any
+// order) are taken out again: DOLFINx writes its cell tags as a second grid of the mesh's cells.
+void XdmfReader::dropRepeatedCells(size_t firstNew, uint64_t vertexBase, uint64_t points, const std::string& where) {
+  using Key = std::array<uint32_t, 8>;
+  auto keyOf = [](const uint32_t* ids, int n) {  // the corners in increasing order
+    Key k;
+    k.fill(UINT32_MAX);
+    for (size_t i = 0; i < size_t(n) && i < k.size(); ++i) {
+      size_t j = i;
+      for (; j > 0 && k[j - 1] > ids[i]; --j) k[j] = k[j - 1];
+      k[j] = ids[i];
+    }
+    return k;
+  };
+  std::set<Key> earlier;
+  size_t at = 0;
+  for (size_t c = 0; c < firstNew; ++c) {
+    const int n = kShapeCorners[soup_.shapes[c]];
+    if (soup_.corners[at] >= vertexBase && soup_.corners[at] < vertexBase + points)
+      earlier.insert(keyOf(&soup_.corners[at], n));
+    at += size_t(n);
+  }
+  size_t write = firstNew, writeAt = at;
+  uint64_t dropped = 0;
+  for (size_t c = firstNew; c < soup_.shapes.size(); ++c) {
+    const int n = kShapeCorners[soup_.shapes[c]];
+    if (earlier.count(keyOf(&soup_.corners[at], n))) {
+      ++dropped;
+    } else {
+      soup_.shapes[write] = soup_.shapes[c];
+      soup_.source[write] = soup_.source[c];
+      std::copy_n(&soup_.corners[at], n, &soup_.corners[writeAt]);
+      ++write;
+      writeAt += size_t(n);
+    }
+    at += size_t(n);
+  }
+  soup_.shapes.resize(write);
+  soup_.source.resize(write);
+  soup_.corners.resize(writeAt);
+  if (dropped)
+    report_.notes.push_back(where + ": " + std::to_string(dropped) +
+                            " cells repeat cells of an earlier grid on the same points (mesh tags?); not added again");
+}
+
+Result XdmfReader::readPiece(pugi::xml_node grid, const std::vector<pugi::xml_node>& companions,
+                             const std::string& where, bool first, PieceArrays& arrays, bool& skipped,
+                             bool& sharedPoints) {
+  skipped = false;
+  sharedPoints = false;
+  std::vector<pugi::xml_node> topos, geos;
+  if (Result r = doc_.children(grid, "Topology", where, topos); !r) return r;
+  if (topos.size() != 1)
+    return fail(Status::Corrupt, where + ": " + (topos.empty() ? "no <Topology>" : "more than one <Topology>"));
+  pugi::xml_node topo = topos[0];
+  std::string_view typeName = topo.attribute("TopologyType").value();
+  if (typeName.empty()) typeName = topo.attribute("Type").value();
+  const bool mixed = iequals(typeName, "Mixed");
+  const TopologyKind* kind = mixed ? nullptr : kindByName(typeName);
+  if (!mixed && !kind) {
+    const bool structured = iequals(typeName.substr(0, 2), "2D") || iequals(typeName.substr(0, 2), "3D");
+    return fail(Status::Unsupported,
+                where + ": TopologyType '" + printable(typeName) + "' " +
+                    (structured ? "is a structured grid, which is not read from XDMF (convert to .vti/.vts)"
+                                : "is not an XDMF cell type tetstream knows"));
+  }
+  if (kind && !kind->read) {
+    // A grid of cells that are not read (DOLFINx's facet tags, higher orders): counted, and
+    // neither its points nor its attributes are read.
+    uint64_t n = 0;
+    const char* count = topo.attribute("NumberOfElements") ? topo.attribute("NumberOfElements").value()
+                                                           : topo.attribute("Dimensions").value();
+    size_t pos = 0;
+    if (!parseU64(nextToken(count, pos), n)) {
+      pugi::xml_node item;
+      if (doc_.dataItem(topo, where, item)) {
+        std::string_view d = item.attribute("Dimensions").value();
+        size_t p = 0;
+        parseU64(nextToken(d, p), n);
+      }
+    }
+    countSkipped(soup_, *kind, n);
+    soup_.inputCells += n;
+    report_.notes.push_back(where + ": " + std::to_string(n) + " " + kind->name +
+                            " cells, not volume cells tetstream reads; the grid was skipped");
+    skipped = true;
+    return Result::success();
+  }
+  if (Result r = doc_.children(grid, "Geometry", where, geos); !r) return r;
+  if (geos.size() != 1)
+    return fail(Status::Corrupt, where + ": " + (geos.empty() ? "no <Geometry>" : "more than one <Geometry>"));
+
+  uint64_t vertexBase = mesh_.positions.size() / 3, points = 0, cells = 0;
+  if (auto seen = geometries_.find(geos[0].internal_object()); seen != geometries_.end()) {
+    sharedPoints = true;
+    vertexBase = seen->second.first;
+    points = seen->second.second;
+  } else {
+    if (Result r = readPoints(geos[0], where, points); !r) return r;
+    geometries_[geos[0].internal_object()] = {vertexBase, points};
+  }
+  std::vector<int64_t> conn;
+  int nodes = 0;
+  const size_t firstNew = soup_.shapes.size();
+  if (Result r = readCells(topo, kind, where, points, vertexBase, conn, nodes, cells); !r) return r;
+  if (sharedPoints) dropRepeatedCells(firstNew, vertexBase, points, where);
+  const std::string name = mixed ? "Mixed" : kind->name;
+  if (std::find(topologies_.begin(), topologies_.end(), name) == topologies_.end()) topologies_.push_back(name);
+
+  std::vector<pugi::xml_node> attributes;
+  if (Result r = doc_.children(grid, "Attribute", where, attributes); !r) return r;
+  for (pugi::xml_node c : companions) {
+    std::vector<pugi::xml_node> more;
+    if (Result r = doc_.children(c, "Attribute", where, more); !r) return r;
+    attributes.insert(attributes.end(), more.begin(), more.end());
+  }
+  xdmf::GridCells gc;
+  gc.connectivity = mixed ? nullptr : &conn;
+  gc.cells = cells;
+  gc.nodes = nodes;
+  gc.corners = kind ? kShapeCorners[int(vtkCellInfo(kind->vtk).shape)] : 0;
+  gc.points = points;
+  return readAttributes(attributes, where, gc, first, sharedPoints, arrays);
+}
+
+Result XdmfReader::read(TetMesh& out) {
+  const std::string& label = doc_.label();
+  pugi::xml_node root = doc_.root();
+  std::string version = root.attribute("Version").value();
+  const std::string major = version.substr(0, version.find('.'));
+  if (!major.empty() && major != "1" && major != "2" && major != "3")
+    return fail(Status::UnsupportedVersion,
+                label + ": XDMF Version='" + printable(version) + "' (tetstream reads XDMF 2 and 3)");
+  std::vector<pugi::xml_node> domains;
+  if (Result r = doc_.children(root, "Domain", label, domains); !r) return r;
+  if (domains.empty()) return fail(Status::Corrupt, label + ": <Xdmf> has no <Domain>");
+  if (domains.size() > 1) report_.notes.push_back("read the first of " + std::to_string(domains.size()) + " Domains");
+  std::vector<pugi::xml_node> top;
+  if (Result r = doc_.children(domains[0], "Grid", label, top); !r) return r;
+  if (top.empty()) return fail(Status::Corrupt, label + ": the Domain has no <Grid>");
+
+  // Time steps: the first top-level temporal collection drives; the others join when they have
+  // the same times.
+  std::vector<pugi::xml_node> temporal;
+  for (pugi::xml_node g : top)
+    if (isTemporal(g)) temporal.push_back(g);
+  std::vector<pugi::xml_node> pieces, companions;
+  std::vector<double> times;
+  std::string stepText;
+  if (!temporal.empty()) {
+    const std::string what = label + " Grid '" + gridName(temporal[0]) + "'";
+    std::vector<pugi::xml_node> steps;
+    if (Result r = doc_.children(temporal[0], "Grid", what, steps); !r) return r;
+    if (steps.empty()) return fail(Status::Corrupt, what + ": a temporal collection without grids");
+    if (Result r = stepTimes(temporal[0], steps, what, times); !r) return r;
+    size_t index = 0;
+    if (Result r = chooseTimeStep(times, options_, label, report_, index); !r) return r;
+    stepText = ", step " + std::to_string(index) + " of " + std::to_string(times.size()) +
+               " (t = " + number(times[index]) + ")";
+    const std::string stepWhat = what + " step " + std::to_string(index);
+    if (Result r = flatten(steps[index], stepWhat, 0, pieces); !r) return r;
+    for (size_t k = 1; k < temporal.size(); ++k) {
+      const std::string otherWhat = label + " Grid '" + gridName(temporal[k]) + "'";
+      std::vector<pugi::xml_node> other;
+      std::vector<double> otherTimes;
+      if (Result r = doc_.children(temporal[k], "Grid", otherWhat, other); !r) return r;
+      if (Result r = stepTimes(temporal[k], other, otherWhat, otherTimes); !r) return r;
+      bool same = otherTimes == times && pieces.size() == 1 && !isCollection(other[index]);
+      if (same)
+        if (Result r = sameMesh(pieces[0], other[index], otherWhat, same); !r) return r;
+      if (same)
+        companions.push_back(other[index]);
+      else
+        report_.notes.push_back("did not read the time series '" + gridName(temporal[k]) +
+                                "': its steps or mesh differ from those of '" + gridName(temporal[0]) + "'");
+    }
+    const size_t others = top.size() - temporal.size();
+    if (others)
+      report_.notes.push_back("read the time series '" + gridName(temporal[0]) + "'" +
+                              (companions.empty() ? "" : " with " + std::to_string(companions.size()) + " more") +
+                              "; " + std::to_string(others) + " top-level grid" + (others == 1 ? "" : "s") +
+                              " outside it (what its steps refer to) not read on " + (others == 1 ? "its" : "their") +
+                              " own");
+  } else {
+    size_t index = 0;
+    if (Result r = chooseTimeStep({}, options_, label, report_, index); !r) return r;
+    for (pugi::xml_node g : top) {
+      const std::string name = gridName(g);
+      if (Result r = flatten(g, label + " Grid" + (name.empty() ? "" : " '" + name + "'"), 0, pieces); !r) return r;
+    }
+  }
+
+  // Pieces, their arrays merged: an array survives only if every piece that was read has it.
+  PieceArrays merged;
+  std::vector<bool> keepField, keepCell;
+  size_t read = 0;
+  for (size_t k = 0; k < pieces.size(); ++k) {
+    const std::string name = gridName(pieces[k]);
+    std::string where = label + " Grid" + (name.empty() ? " " + std::to_string(k) : " '" + name + "'");
+    PieceArrays pa;
+    bool skipped = false, shared = false;
+    if (Result r = readPiece(pieces[k], k == 0 ? companions : std::vector<pugi::xml_node>{}, where, read == 0, pa,
+                             skipped, shared);
+        !r)
+      return r;
+    if (skipped) continue;
+    if (read++ == 0) {
+      merged = std::move(pa);
+      keepField.assign(merged.fields.size(), true);
+      keepCell.assign(merged.cellArrays.size(), true);
+      continue;
+    }
+    auto join = [&](auto& into, auto& from, std::vector<bool>& keep, const char* kind) {
+      for (size_t i = 0; i < into.size(); ++i) {
+        auto it = std::find_if(from.begin(), from.end(), [&](const auto& f) { return f.name == into[i].name; });
+        if (it == from.end()) {
+          if (keep[i])
+            report_.notes.push_back(std::string("dropped ") + kind + " array '" + into[i].name + "': grid " + where +
+                                    " lacks it");
+          keep[i] = false;
+        } else {
+          into[i].values.insert(into[i].values.end(), it->values.begin(), it->values.end());
+        }
+      }
+    };
+    if (!shared) join(merged.fields, pa.fields, keepField, "point");  // (its points are an earlier grid's)
+    join(merged.cellArrays, pa.cellArrays, keepCell, "cell");
+  }
+  for (size_t i = 0; i < merged.fields.size(); ++i)
+    if (keepField[i]) addField(mesh_, std::move(merged.fields[i]), report_);
+  std::vector<CellArray> cellArrays;
+  for (size_t i = 0; i < merged.cellArrays.size(); ++i)
+    if (keepCell[i]) cellArrays.push_back(std::move(merged.cellArrays[i]));
+  if (read > 1) report_.notes.push_back("concatenated " + std::to_string(read) + " grids");
+
+  std::string sources;
+  for (const std::string& s : doc_.sources()) sources += (sources.empty() ? "" : ", ") + s;
+  std::string kinds;
+  for (const std::string& t : topologies_) kinds += (kinds.empty() ? "" : " + ") + t;
+  report_.format = "XDMF" + (major.empty() ? std::string() : " " + major) +
+                   (sources.empty() ? std::string() : " (" + sources + ")") + (kinds.empty() ? "" : ", " + kinds) +
+                   (read > 1 ? ", " + std::to_string(read) + " grids" : "") + stepText;
+  if (Result r = finishMesh(label, mesh_, soup_, std::move(cellArrays), report_); !r) return r;
+  out = std::move(mesh_);
+  return Result::success();
+}
+
+}  // namespace
+
+Result readXdmf(std::string_view xml, const std::string& label, const std::optional<std::string>& dataFolder,
+                const ReadOptions& options, TetMesh& out, ReadReport& report) {
+  out = TetMesh{};
+  Document doc(label, dataFolder);
+  if (Result r = doc.parse(xml); !r) return r;
+  XdmfReader reader(doc, options, report);
+  return reader.read(out);
+}
+
+}  // namespace tetstream
