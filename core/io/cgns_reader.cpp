@@ -131,6 +131,14 @@ class CgnsReader {
   Result readOpen(TetMesh& out) {
     file_.path = path_;
     file_.hdf5 = container_ == Container::Hdf5;
+    // The library reads the whole node tree as it opens the file, through HDF5 or ADF, which can
+    // crash on a damaged file: the open is tried first in a child process.
+    if (runInChildProcess([&] {
+          int fn = -1;
+          if (cg_open(path_.c_str(), CG_MODE_READ, &fn) == CG_OK) cg_close(fn);
+          return 0;
+        }) != 0)
+      return fail(Status::Corrupt, path_ + ": damaged: the CGNS library crashed opening it (in a separate process)");
     if (cg_open(path_.c_str(), CG_MODE_READ, &file_.fn) != CG_OK) {
       file_.fn = -1;
       return fail(Status::Corrupt, path_ + ": not a readable CGNS file: " + lastCgnsError());

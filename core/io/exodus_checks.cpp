@@ -4,7 +4,8 @@
 // below was found by truncating and changing bytes of real files, or by reading the library:
 //   - a netCDF classic header is walked first (checkNetcdfClassicHeader): netCDF itself
 //     allocates and fills by the header's counts;
-//   - netCDF opens the file (ex_open prints to stderr whatever ex_opts says when it cannot);
+//   - netCDF opens the file (ex_open prints to stderr whatever ex_opts says when it cannot); a
+//     netCDF-4 file first in a child process, as HDF5 frees wild pointers on some damaged files;
 //   - the global attributes the library reads into one number hold one value;
 //   - the variables the library reads whole hold what their dimensions say: eb_prop1 one id per
 //     block, connectK one node id per node of each element, the number maps one id per node or
@@ -21,15 +22,6 @@
 namespace tetstream::vtkio {
 
 namespace {
-
-Result readHead(const std::string& path, size_t bytes, std::string& head) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) return fail(Status::IoError, path + ": cannot open");
-  head.assign(bytes, '\0');
-  head.resize(std::fread(head.data(), 1, head.size(), f));
-  std::fclose(f);
-  return Result::success();
-}
 
 class SchemaCheck {
  public:
@@ -106,23 +98,25 @@ class SchemaCheck {
 
 }  // namespace
 
-Result checkExodusFile(const std::string& path, uint64_t fileBytes, Container& container) {
-  std::string head;
-  for (size_t want = 1 << 16;; want *= 4) {
-    if (Result r = readHead(path, want, head); !r) return r;
-    if (want == 1 << 16) {
-      container = containerSignature(head);
-      if (container == Container::None || container == Container::Adf)
-        return fail(Status::BadMagic, path + ": not an Exodus II file: it starts with neither the netCDF (CDF) " +
-                                          "nor the HDF5 signature" + (head.empty() ? " (the file is empty)" : ""));
-      if (container == Container::Hdf5) break;
-    }
-    const NetcdfHeaderResult h = checkNetcdfClassicHeader(head, fileBytes, path);
-    if (!h.needMore) {
-      if (!h.result) return h.result;
-      break;
-    }
-  }
+Result checkExodusFile(const std::string& path, Container& container) {
+  std::string head(4096, '\0');
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return fail(Status::IoError, path + ": cannot open");
+  head.resize(std::fread(head.data(), 1, head.size(), f));
+  std::fclose(f);
+  container = containerSignature(head);
+  if (container == Container::None || container == Container::Adf)
+    return fail(Status::BadMagic, path + ": not an Exodus II file: it starts with neither the netCDF (CDF) " +
+                                      "nor the HDF5 signature" + (head.empty() ? " (the file is empty)" : ""));
+  if (container != Container::Hdf5)
+    if (Result r = checkNetcdfClassicFile(path); !r) return r;
+  // netCDF-4: HDF5 reads the file's metadata as netCDF opens it; first in a child process.
+  if (container == Container::Hdf5 && runInChildProcess([&] {
+                                        int id = -1;
+                                        if (nc_open(path.c_str(), NC_NOWRITE, &id) == NC_NOERR) nc_close(id);
+                                        return 0;
+                                      }) != 0)
+    return fail(Status::Corrupt, path + ": damaged: the HDF5 library crashed opening it (in a separate process)");
   int ncid = -1;
   if (const int status = nc_open(path.c_str(), NC_NOWRITE, &ncid); status != NC_NOERR)
     return fail(Status::Corrupt, path + ": netCDF cannot open it (" + nc_strerror(status) + ")");

@@ -106,7 +106,7 @@ class ExodusReader {
     const uint64_t fileBytes = fileBytes_ = std::filesystem::file_size(path_, ec);
     if (ec) return fail(Status::IoError, path_ + ": cannot open (" + ec.message() + ")");
     std::lock_guard<std::mutex> lock(hpcLibraryMutex());
-    if (Result r = checkExodusFile(path_, fileBytes, container_); !r) return r;
+    if (Result r = checkExodusFile(path_, container_); !r) return r;
     limit_ = maxDecodedBytes(fileBytes, container_);
     ex_opts(0);  // no messages on stderr, never abort: failures come back as return codes
     int cpuWordSize = 8, ioWordSize = 0;

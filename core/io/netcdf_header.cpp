@@ -15,7 +15,9 @@
 // Counts, lengths, ndims, dimids and vsize are 4 bytes in CDF-1/2 and 8 in CDF-5; begin is 4 bytes
 // in CDF-1 and 8 in CDF-2/5; tags and nc_type are 4 bytes.
 #include <bit>
+#include <cstdio>
 #include <cstring>
+#include <filesystem>
 
 #include "io/readers.h"
 
@@ -301,6 +303,23 @@ class HeaderCheck {
 NetcdfHeaderResult checkNetcdfClassicHeader(std::string_view head, uint64_t fileSize, const std::string& label) {
   if (head.size() > fileSize) head = head.substr(0, size_t(fileSize));
   return HeaderCheck(head, fileSize, label).run();
+}
+
+Result checkNetcdfClassicFile(const std::string& path) {
+  std::error_code ec;
+  const uint64_t fileBytes = std::filesystem::file_size(path, ec);
+  if (ec) return fail(Status::IoError, path + ": cannot open (" + ec.message() + ")");
+  // The header is read in growing pieces: most are a few KB, a file of thousands of variables has
+  // megabytes of it.
+  for (size_t want = size_t(1) << 16;; want *= 4) {
+    std::FILE* f = std::fopen(path.c_str(), "rb");
+    if (!f) return fail(Status::IoError, path + ": cannot open");
+    std::string head(size_t(std::min<uint64_t>(want, fileBytes)), '\0');
+    head.resize(std::fread(head.data(), 1, head.size(), f));
+    std::fclose(f);
+    const NetcdfHeaderResult h = checkNetcdfClassicHeader(head, fileBytes, path);
+    if (!h.needMore || head.size() >= fileBytes) return h.result;
+  }
 }
 
 }  // namespace tetstream::vtkio

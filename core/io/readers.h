@@ -275,6 +275,14 @@ const char* containerName(Container c);  // "netCDF classic", "HDF5", "ADF", ...
 enum class HpcFormat : uint8_t { None, Exodus, Cgns };
 HpcFormat hpcFormatByContent(const std::string& path, std::string_view head);
 
+// HDF5 1.10 (also under netCDF-4 and CGNS) can free wild pointers while it opens a damaged file:
+// such opens are tried first in a forked child process with its output discarded, so that a crash
+// there takes down the child only. Returns the child's exit code (probe's value, 0..255; a probe
+// returns 0 for "went through", and anything else means it did not), -1 when it died by a signal.
+// Where no child can be made the probe runs in this process. Call it where no other thread is
+// running library code (the readers hold hpcLibraryMutex()).
+int runInChildProcess(const std::function<int()>& probe);
+
 // The HDF5, netCDF, Exodus II and CGNS libraries keep global state and are not built thread-safe:
 // every call into them holds this lock.
 std::mutex& hpcLibraryMutex();
@@ -288,6 +296,8 @@ struct NetcdfHeaderResult {
   bool needMore = false;
 };
 NetcdfHeaderResult checkNetcdfClassicHeader(std::string_view head, uint64_t fileSize, const std::string& label);
+// The same for the file at `path`, reading as much of it as the header needs.
+Result checkNetcdfClassicFile(const std::string& path);
 
 // Where an ADF file's data ends (its header's end-of-file pointer, a byte offset); false when
 // `head` (the first bytes) has no ADF header. The ADF library reads past a file's end unchecked.
@@ -300,7 +310,7 @@ void closeHdf5Leftovers(const std::string& path);
 // An Exodus II file as the Exodus library may be given it (exodus_checks.cpp): a netCDF classic
 // header that checks out, a file netCDF opens, and variables and attributes that hold what the
 // library's buffers expect. `container` is set from the signature.
-Result checkExodusFile(const std::string& path, uint64_t fileBytes, Container& container);
+Result checkExodusFile(const std::string& path, Container& container);
 
 // The most bytes a container of fileBytes can decode to: what it stores, or for HDF5 (which may
 // compress) the deflate limit. Counts a file declares are checked against this before allocating.

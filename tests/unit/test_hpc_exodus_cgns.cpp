@@ -11,6 +11,7 @@
 #include <netcdf.h>
 
 #include <cmath>
+#include <csignal>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -327,6 +328,32 @@ TEST(ExodusErrors, MessagesNameNodesAndElementsByTheirIds) {
   EXPECT_FAILS(readMesh(copy, m, r), Status::NonFinite, "node 5 (id 1009) has a non-finite coordinate");
 }
 
+// damaged_hdf5_wild_free.exo: a netCDF-4 file with bytes changed on which HDF5 1.10.8 frees a
+// wild pointer while netCDF opens it (AddressSanitizer stops there; plain builds may go on or
+// crash). The open is tried in a child process first: either way the read is a Result.
+TEST(ExodusErrors, FileThatMakesHdf5FreeAWildPointerIsAResult) {
+  TetMesh m;
+  ReadReport r;
+  const std::string file = hpcPath("damaged_hdf5_wild_free.exo");
+  const Result res = readMesh(file, m, r);
+  EXPECT_EQ(res.status, Status::Corrupt) << res.message;
+  EXPECT_NE(res.message.find(file + ": "), std::string::npos) << res.message;
+}
+
+TEST(ExodusCgnsProbe, ACrashStaysInTheChildProcess) {
+  EXPECT_EQ(vtkio::runInChildProcess([] { return 7; }), 7);
+  EXPECT_EQ(vtkio::runInChildProcess([] {
+              std::raise(SIGSEGV);
+              return 0;
+            }),
+            -1);
+  EXPECT_EQ(vtkio::runInChildProcess([] {
+              std::abort();
+              return 0;
+            }),
+            -1);
+}
+
 // A 2D mesh (num_dim 2: a block of quadrilaterals, as 2D solvers write) has no volume cells.
 TEST(ExodusErrors, TwoDimensionalMeshIsSaidSo) {
   ScratchDir dir("exodus-2d");
@@ -479,9 +506,14 @@ TEST(ExodusSniff, ContentDecidesWhenTheExtensionDoesNot) {
     ASSERT_TRUE(res) << c.to << ": " << res.message;
     EXPECT_NE(r.format.find(c.format), std::string::npos) << c.to << ": " << r.format;
   }
-  // A PLOT3D grid under .g stays PLOT3D.
+  // A damaged netCDF header is checked before netCDF reads it, also when only content tells.
+  std::string damaged = loadFile(hpcPath("exo_blocks.exo"));
+  damaged[12] = '\x7f';  // the dimension count
+  ASSERT_TRUE(saveFile(dir.path + "/damaged.dat", damaged));
   TetMesh m;
   ReadReport r;
+  EXPECT_FAILS(readMesh(dir.path + "/damaged.dat", m, r), Status::Truncated, "damaged.dat: the netCDF header lists");
+  // A PLOT3D grid under .g stays PLOT3D.
   ASSERT_TRUE(readMesh(fixturePath("formats/p3d_two_blocks.g"), m, r));
   EXPECT_NE(r.format.find("PLOT3D"), std::string::npos) << r.format;
 }
