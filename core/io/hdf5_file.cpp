@@ -312,14 +312,21 @@ bool File::hasAttribute(const std::string& object, const char* name) const {
   return r > 0;
 }
 
+Result File::openAttribute(const std::string& object, const char* name, const std::string& what, Handle& attr,
+                           Handle& type, Handle& space) const {
+  if (!hasAttribute(object, name)) return fail(Status::Corrupt, what + " does not exist");
+  attr = Handle(H5Aopen_by_name(file_.get(), object.c_str(), name, H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+  type = Handle(attr.valid() ? H5Aget_type(attr.get()) : H5I_INVALID_HID, H5Tclose);
+  space = Handle(attr.valid() ? H5Aget_space(attr.get()) : H5I_INVALID_HID, H5Sclose);
+  if (!type.valid() || !space.valid()) return fail(Status::Corrupt, withLibraryMessage(what + " cannot be opened"));
+  return Result::success();
+}
+
 Result File::stringAttribute(const std::string& object, const char* name, std::string& out) const {
   out.clear();
   const std::string what = where(object, "object") + " attribute '" + name + "'";
-  if (!hasAttribute(object, name)) return fail(Status::Corrupt, what + " does not exist");
-  Handle attr(H5Aopen_by_name(file_.get(), object.c_str(), name, H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
-  Handle type(attr.valid() ? H5Aget_type(attr.get()) : H5I_INVALID_HID, H5Tclose);
-  Handle space(attr.valid() ? H5Aget_space(attr.get()) : H5I_INVALID_HID, H5Sclose);
-  if (!type.valid() || !space.valid()) return fail(Status::Corrupt, withLibraryMessage(what + " cannot be opened"));
+  Handle attr, type, space;
+  if (Result r = openAttribute(object, name, what, attr, type, space); !r) return r;
   if (H5Tget_class(type.get()) != H5T_STRING) return fail(Status::Corrupt, what + " is not a string");
   const hssize_t n = H5Sget_simple_extent_npoints(space.get());
   if (n != 1) return fail(Status::Corrupt, what + " holds " + std::to_string(n) + " strings, expected one");
@@ -349,11 +356,8 @@ Result File::stringAttribute(const std::string& object, const char* name, std::s
 Result File::intAttribute(const std::string& object, const char* name, std::vector<int64_t>& out, size_t max) const {
   out.clear();
   const std::string what = where(object, "object") + " attribute '" + name + "'";
-  if (!hasAttribute(object, name)) return fail(Status::Corrupt, what + " does not exist");
-  Handle attr(H5Aopen_by_name(file_.get(), object.c_str(), name, H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
-  Handle type(attr.valid() ? H5Aget_type(attr.get()) : H5I_INVALID_HID, H5Tclose);
-  Handle space(attr.valid() ? H5Aget_space(attr.get()) : H5I_INVALID_HID, H5Sclose);
-  if (!type.valid() || !space.valid()) return fail(Status::Corrupt, withLibraryMessage(what + " cannot be opened"));
+  Handle attr, type, space;
+  if (Result r = openAttribute(object, name, what, attr, type, space); !r) return r;
   const H5T_class_t cls = H5Tget_class(type.get());
   if (cls != H5T_INTEGER && cls != H5T_FLOAT) return fail(Status::Corrupt, what + " is not a number");
   const hssize_t n = H5Sget_simple_extent_npoints(space.get());

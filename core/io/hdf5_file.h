@@ -104,6 +104,9 @@ class File {
   // Opens the dataset and selects `slab` in it, checked against its shape and storage.
   Result select(const std::string& dataset, const Slab& slab, uint64_t expect, Handle& ds, Handle& fileSpace,
                 Handle& memSpace) const;
+  // Opens attribute `name` of `object` with its type and space; `what` names it in messages.
+  Result openAttribute(const std::string& object, const char* name, const std::string& what, Handle& attr, Handle& type,
+                       Handle& space) const;
   template <typename T>
   Result readSelection(const std::string& dataset, const Slab& slab, uint64_t expect, hid_t memType,
                        std::vector<T>& out) const;
