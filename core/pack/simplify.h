@@ -67,9 +67,42 @@
 #include "adjacency.h"
 #include "mesh.h"
 #include "pack/collapse_log.h"
+#include "pack/quadric.h"
 #include "status.h"
 
 namespace tetstream {
+
+// Packing on several processes (pack/distributed.h) simplifies the mesh as parts: each a region
+// of the input (its own vertices, "owned") with a halo (every other vertex of a tet that has an
+// owned vertex, and those tets), first a rank's region from the input, then, level by level up
+// the tree of ranks, two finished parts merged. Only owned vertices whose tets all have four
+// owned vertices are ever collapsed (the halo is another part's, left as it is), so parts are
+// independent. What collapses accumulate per vertex (below) goes from one part to the next, so
+// costs and fitted values come out as if one process had held the whole mesh.
+struct CarriedVertexState {
+  std::vector<float> fit;                // the steering field's value now (fitted)
+  std::vector<uint32_t> represented;     // input vertices each stands for
+  std::vector<uint8_t> boundary;         // on the input's boundary (its boundary quadric counts)
+  std::vector<Quadric> boundaryQuadric;  // per vertex (zero when not on the boundary)
+  std::vector<FieldQuadric> fieldQuadric;
+};
+
+struct SimplifyPart {
+  const std::vector<uint8_t>* owned = nullptr;  // per vertex of the part's mesh: 1 owned, 0 halo
+  // The state of the previous level, per vertex of the part's mesh (null: computed from the
+  // input, as simplifyMesh does). The part's mesh then holds the current tets; its fields are
+  // the input's samples.
+  const CarriedVertexState* carried = nullptr;
+  // The whole mesh's normalisers (a part's own would differ from rank to rank): the steering
+  // field's range, the bounding box diagonal, the mean volume of an interior vertex.
+  double fieldMin = 0, fieldMax = 0, diagonal = 1, meanVertexVolume = 1;
+  // The range fitted values of the part's top node keep to (the input field over its region).
+  double topMin = 0, topMax = 0;
+  // true: the part's top node collapses like a region of the tree (inner vertices, up to the
+  // level's cost τ) and stops; false: it is the root, the queue of the whole mesh, which goes on
+  // to the target (then nothing may be halo).
+  bool topIsRegion = false;
+};
 
 struct SimplifyOptions {
   double weightGeometry = 100.0, weightField = 1.0, weightShape = 0.005;
@@ -103,6 +136,8 @@ struct SimplifyOptions {
   // link two-thirds idle, and 2,048 reached the exact surface of Harmonic 64³ a fifth sooner
   // with 3% more bytes (docs/design-notes.md).
   uint32_t leafVertices = 2048;
+  // A part of a mesh packed on several processes (SimplifyPart); null: the whole mesh.
+  const SimplifyPart* part = nullptr;
 };
 
 // The tree of regions (simplify.h): a perfect binary tree in heap numbering, the root node 1,
@@ -138,6 +173,7 @@ struct SimplifyResult {
   uint64_t queuePops = 0, requeued = 0;  // pops of current entries, and those pushed back costlier
   uint32_t regionCollapses = 0;          // collapses made below the root, on two threads at once
   RegionTree tree;
+  CarriedVertexState carried;  // with SimplifyOptions::part: the state at the end, per vertex
   std::string stopReason;  // "target reached", "no legal collapse left", "error bound"
 };
 

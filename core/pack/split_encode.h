@@ -49,4 +49,54 @@ struct EncodedStream {
 Result encodeStream(const TetMesh& mesh, SimplifyResult& s, const Manifest& m, const StreamOptions& opt,
                     EncodedStream& out);
 
+// Packing on several processes (pack/distributed.h) encodes the stream in units: a part's
+// collapses (SimplifyPart) as the splits of its nodes, from the mesh the part left (its
+// "handoff": every vertex and tet alive at the end of its simplification) back to the mesh it
+// started from. Split records name vertices by stable id (FORMAT.md §1.1), so a unit needs the
+// stable ids of its handoff, which the unit above it hands down; the ids its own splits create
+// are a range known from the counts of the units before it in manifest order.
+struct UnitEncodeOptions {
+  StreamOptions stream;                // (orderSplits is not supported here; no progress needed)
+  std::vector<uint64_t> stableVertex;  // per vertex of the part's mesh alive at the end: its stable id (else ~0)
+  std::vector<uint64_t> stableTet;     // per tet of the part alive at the end: its stable id (else ~0)
+  uint64_t vertexBegin = 0, tetBegin = 0;  // the stable ids of the unit's first new vertex and tet
+};
+
+// One split chunk, not yet compressed: its index in the manifest is known only once every unit
+// is encoded (finishUnitChunk sets it). Counts in stable terms.
+struct UnitChunk {
+  std::vector<uint8_t> raw;  // header (index 0 for now) and payload
+  uint32_t splits = 0;
+  uint64_t vertices = 0, tets = 0;  // the whole stream's counts after this chunk (stable ids)
+  float maxCollapseError = 0;       // the largest CollapseLog::fieldError of its splits
+};
+
+// A node of the unit: the section of the part's log made by `node` (RegionTree numbering of the
+// part's own tree), in the unit's order (the part's top node first, leaves last).
+struct UnitNode {
+  uint32_t node = 0;
+  uint32_t firstChunk = 0, chunkCount = 0;  // in UnitEncoded::chunks
+  uint64_t vertexBegin = 0, vertexEnd = 0, tetBegin = 0, tetEnd = 0;  // stable ids
+};
+
+struct UnitEncoded {
+  std::vector<UnitChunk> chunks;
+  std::vector<UnitNode> nodes;
+  TetMesh handoff;  // the handoff mesh in stable order (vertex k: the k-th smallest stable id): the base, for the root unit
+  // After all splits: per vertex and tet of the part's mesh alive at its start (before any of
+  // its collapses), its stable id (~0 otherwise): the stable ids the units below need.
+  std::vector<uint64_t> startVertex, startTet;
+};
+
+// Encodes the splits of part `s` (simplifyMesh with SimplifyOptions::part) on `mesh` (the part's
+// mesh as simplified: positions, fields). The stream's order within the unit is that of
+// encodeStream (its nodes' sections from the last to the first, each newest collapse first), and
+// chunk sizes aim at the same bytes with an assumed compression ratio (the real one is known only
+// after compression). No field error is measured (the optional fieldRms/fieldMax keys).
+Result encodeUnit(const TetMesh& mesh, SimplifyResult& s, const Manifest& m, const UnitEncodeOptions& opt,
+                  UnitEncoded& out);
+
+// Sets the chunk's manifest index in its header and compresses it (finishChunk).
+Result finishUnitChunk(UnitChunk& chunk, uint32_t index, int zstdLevel, std::vector<uint8_t>& file, ChunkInfo& info);
+
 }  // namespace tetstream
