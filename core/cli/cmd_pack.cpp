@@ -9,6 +9,7 @@
 
 #include "cli_common.h"
 #include "commands.h"
+#include "dist/distributed_pack.h"
 #include "pack/packer.h"
 
 namespace tetstream::cli {
@@ -68,18 +69,122 @@ double peakMemoryMB() {
   return u.ru_maxrss / 1024.0;  // Linux reports KiB
 }
 
+struct Opts {
+  std::string input, out, field, name;
+  std::vector<double> weights;
+  double baseFraction = 0.01, maxError = -1, maxMemoryGb = 0;
+  uint32_t baseVertices = 0, baseTets = 0, chunkKb = 256, leafVertices = PackOptions{}.leafVertices;
+  int level = 18, threads = 2;
+  bool lossless = false, json = false, samples = false, compact = false;
+  ReadOptions read;
+};
+
+// The command line as PackOptions (maxErrorSet and the others: whether those options were given).
+PackOptions packOptionsOf(const Opts& o, bool maxErrorSet, bool baseVerticesSet, bool baseTetsSet) {
+  PackOptions opt;
+  opt.field = o.field;
+  opt.name = o.name;
+  opt.zstdLevel = o.level;
+  opt.threads = o.threads;
+  opt.fitValues = !o.samples;
+  if (!o.weights.empty())
+    for (int k = 0; k < 3; ++k) opt.weights[k] = o.weights[size_t(k)];
+  opt.baseFraction = o.baseFraction;
+  if (baseVerticesSet) opt.baseVertices = std::max<uint32_t>(o.baseVertices, 4);
+  if (baseTetsSet) opt.baseTets = o.baseTets;
+  if (maxErrorSet) {
+    opt.maxError = o.maxError;
+    opt.baseFraction = 0;  // as far as the error bound allows
+  }
+  opt.lossless = o.lossless;
+  opt.orderSplits = o.compact;
+  opt.chunkKb = o.chunkKb;
+  opt.leafVertices = o.leafVertices;
+  opt.maxMemoryBytes = o.maxMemoryGb * 1e9;
+  return opt;
+}
+
+// `pack` under an MPI launcher: every rank packs its share (dist/distributed_pack.h); rank 0
+// reports, for the whole job and per rank.
+int packOnRanks(const Opts& o, bool maxErrorSet, bool baseVerticesSet, bool baseTetsSet) {
+  std::unique_ptr<dist::Comm> comm;
+  if (Result r = dist::Comm::world(comm); !r) return reportError(r, o.json);
+  const bool lead = comm->rank() == 0;
+  if (o.compact) {
+    Result r = fail(Status::BadArgument, "--compact is not available with several processes");
+    return lead ? reportError(r, o.json) : 1;
+  }
+  Stopwatch total;
+  PackOptions opt = packOptionsOf(o, maxErrorSet, baseVerticesSet, baseTetsSet);
+  ProgressLine bar(lead && !o.json && isatty(2));
+  opt.progress = [&bar](const char* phase, uint64_t done, uint64_t planned) { bar.update(phase, done, planned); };
+  dist::DistributedSummary s;
+  Result r = dist::packDistributed(*comm, o.input, o.read, o.out, opt, s);
+  bar.finishLine();
+  if (!lead) return r ? 0 : 1;
+  if (!r) return reportError(r, o.json);
+  const Manifest& m = s.pack.manifest;
+  const uint64_t bytes = m.totalBytes();
+  json ranks = json::array();
+  double worstPeak = 0;
+  for (size_t k = 0; k < s.ranks.size(); ++k) {
+    const dist::RankFigures& f = s.ranks[k];
+    worstPeak = std::max(worstPeak, f.peakMB);
+    ranks.push_back({{"rank", k},
+                     {"ownedVertices", f.ownedVertices},
+                     {"tets", f.tets},
+                     {"peakMemoryMB", f.peakMB},
+                     {"simplifyMs", f.simplifyMs},
+                     {"encodeMs", f.encodeMs}});
+  }
+  if (o.json) {
+    printJson({{"output", o.out},
+               {"name", m.name},
+               {"ranks", comm->size()},
+               {"vertices", m.vertices},
+               {"tets", m.tets},
+               {"inputTets", s.inputTets},
+               {"inputFormat", s.inputFormat},
+               {"field", m.isoField},
+               {"lossless", m.lossless},
+               {"positionBits", m.positionBits},
+               {"baseVertices", s.pack.baseVertices},
+               {"baseTets", s.pack.baseTets},
+               {"splits", s.pack.splits},
+               {"chunks", m.chunks.size()},
+               {"nodes", m.nodes.size()},
+               {"bytes", bytes},
+               {"baseBytes", m.chunks[0].bytes},
+               {"readMs", s.readMs},
+               {"partitionMs", s.partitionMs},
+               {"simplifyMs", s.combineMs},
+               {"ms", total.ms()},
+               {"peakMemoryMB", worstPeak},
+               {"perRank", ranks},
+               {"notes", s.pack.notes}});
+    return 0;
+  }
+  for (const std::string& n : s.pack.notes) std::printf("note: %s\n", n.c_str());
+  std::printf("packed %s -> %s/ on %d ranks\n", o.input.c_str(), o.out.c_str(), comm->size());
+  std::printf("  format    %s\n", s.inputFormat.c_str());
+  std::printf("  input     %u vertices, %u tets, field '%s'\n", m.vertices, m.tets, m.isoField.c_str());
+  std::printf("  base      %u vertices, %u tets, %.1f KB\n", s.pack.baseVertices, s.pack.baseTets,
+              m.chunks[0].bytes / 1024.0);
+  std::printf("  stream    %u splits in %zu chunks, %zu nodes, %.2f MB in all\n", s.pack.splits, m.chunks.size() - 1,
+              m.nodes.size(), bytes / 1e6);
+  std::printf("  time      read %.0f ms, partition %.0f ms, simplify %.0f ms, all %.0f ms\n", s.readMs, s.partitionMs,
+              s.combineMs, total.ms());
+  for (size_t k = 0; k < s.ranks.size(); ++k)
+    std::printf("  rank %-4zu %llu vertices, %llu tets; simplify %.0f ms, encode %.0f ms; peak memory %.0f MB\n", k,
+                static_cast<unsigned long long>(s.ranks[k].ownedVertices),
+                static_cast<unsigned long long>(s.ranks[k].tets), s.ranks[k].simplifyMs, s.ranks[k].encodeMs,
+                s.ranks[k].peakMB);
+  return 0;
+}
+
 }  // namespace
 
 Runner addPack(CLI::App& app) {
-  struct Opts {
-    std::string input, out, field, name;
-    std::vector<double> weights;
-    double baseFraction = 0.01, maxError = -1, maxMemoryGb = 0;
-    uint32_t baseVertices = 0, baseTets = 0, chunkKb = 256, leafVertices = PackOptions{}.leafVertices;
-    int level = 18, threads = 2;
-    bool lossless = false, json = false, samples = false, compact = false;
-    ReadOptions read;
-  };
   auto o = std::make_shared<Opts>();
   CLI::App* sub = app.add_subcommand("pack", "Pack a mesh into a progressive dataset folder (manifest + chunks)");
   sub->add_option("input", o->input,
@@ -132,6 +237,7 @@ Runner addPack(CLI::App& app) {
       ->capture_default_str();
   sub->add_flag("--json", o->json, "print the result as JSON on stdout");
   return [o, me, bv, bt] {
+    if (dist::launchedByMpi()) return packOnRanks(*o, me->count() > 0, bv->count() > 0, bt->count() > 0);
     Stopwatch total;
     ProgressLine bar(!o->json && isatty(2));
     bar.update("read", 0, 1);
@@ -145,26 +251,7 @@ Runner addPack(CLI::App& app) {
     bar.update("read", 1, 1);
     double readMs = total.ms();
     const uint32_t inputVertices = in.mesh.vertexCount();
-    PackOptions opt;
-    opt.field = o->field;
-    opt.name = o->name;
-    opt.zstdLevel = o->level;
-    opt.threads = o->threads;
-    opt.fitValues = !o->samples;
-    if (!o->weights.empty())
-      for (int k = 0; k < 3; ++k) opt.weights[k] = o->weights[size_t(k)];
-    opt.baseFraction = o->baseFraction;
-    if (bv->count()) opt.baseVertices = std::max<uint32_t>(o->baseVertices, 4);
-    if (bt->count()) opt.baseTets = o->baseTets;
-    if (me->count()) {
-      opt.maxError = o->maxError;
-      opt.baseFraction = 0;  // as far as the error bound allows
-    }
-    opt.lossless = o->lossless;
-    opt.orderSplits = o->compact;
-    opt.chunkKb = o->chunkKb;
-    opt.leafVertices = o->leafVertices;
-    opt.maxMemoryBytes = o->maxMemoryGb * 1e9;
+    PackOptions opt = packOptionsOf(*o, me->count() > 0, bv->count() > 0, bt->count() > 0);
     opt.progress = [&bar](const char* phase, uint64_t done, uint64_t planned) { bar.update(phase, done, planned); };
     PackSummary s;
     Result r = packMesh(std::move(in.mesh), o->out, opt, s);

@@ -6,6 +6,7 @@
 #endif
 
 #include "commands.h"
+#include "dist/comm.h"
 #include "huge_pages.h"
 #include "manifest.h"
 
@@ -34,7 +35,8 @@ int main(int argc, char** argv) {
     if (!sub->parsed()) continue;
     // Every command but gen reads a mesh or a packed dataset: decided once, before any work
     // (the program may start again here, with huge pages: huge_pages.h).
-    if (sub->get_name() != "gen") {
+    // (Not under an MPI launcher: the restart would leave the launcher's process behind.)
+    if (sub->get_name() != "gen" && !tetstream::dist::launchedByMpi()) {
       const CLI::Option* input = sub->get_option_no_throw("input");
       useHugePages(argv, input && input->count() ? input->as<std::string>() : std::string());
     }

@@ -69,6 +69,7 @@ struct ReadReport {
   std::vector<SkippedCells> skippedCells;  // by VTK type, ascending
   std::vector<TimeStep> steps;             // every time step of the file; empty for a single state
   uint64_t stepRead = 0;                   // the index of the step that was read (when steps is not empty)
+  uint64_t filesListed = 0;                // of a listing of pieces: the files it lists (0: not a listing)
 };
 
 struct ReadOptions {
@@ -81,6 +82,11 @@ struct ReadOptions {
   // refuses either with BadArgument.
   std::optional<uint64_t> step;
   std::optional<double> time;
+  // Of a listing of pieces (.pvtu, .vtm, .pvtk), read only share `shareIndex` of `shareCount`:
+  // the listed files from shareIndex·n/shareCount up to (shareIndex + 1)·n/shareCount, n the
+  // files listed (each process of a distributed pack reads its own; every path is still
+  // checked). A share with no file gives an empty mesh. Other formats ignore it.
+  uint32_t shareIndex = 0, shareCount = 1;
 };
 
 // Reads a mesh file, choosing the reader by extension (case-insensitive): .vtu/.vts/.vti, .vtk,

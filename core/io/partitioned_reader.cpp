@@ -159,7 +159,7 @@ ListingKind listingKind(std::string_view head) {
 }
 
 Result readListing(std::string_view listing, const std::string& label, const PieceLoader& load, TetMesh& out,
-                   ReadReport& report) {
+                   ReadReport& report, uint32_t shareIndex, uint32_t shareCount) {
   out = TetMesh{};
   pugi::xml_document doc;
   const pugi::xml_parse_result parsed = doc.load_buffer(listing.data(), listing.size());
@@ -233,6 +233,13 @@ Result readListing(std::string_view listing, const std::string& label, const Pie
       return fail(Status::Corrupt, where + ": " + path + " is listed twice (each piece is one file)");
     l.name += " (" + path + ")";
     l.path = std::move(path);
+  }
+
+  report.filesListed = listed.size();
+  if (shareCount > 1) {
+    const uint64_t n = listed.size(), from = shareIndex * n / shareCount, to = (shareIndex + 1ull) * n / shareCount;
+    listed = std::vector<Listed>(listed.begin() + ptrdiff_t(from), listed.begin() + ptrdiff_t(to));
+    if (listed.empty()) return Result::success();  // (more processes than files)
   }
 
   std::vector<MeshPiece> pieces;

@@ -98,8 +98,9 @@ enum class ListingKind { None, Pvtu, Vtm, Pvtk };
 // What a file's first bytes say it is: a listing, or None for anything else (a .vtu, junk).
 ListingKind listingKind(std::string_view head);
 using PieceLoader = std::function<Result(const std::string& relativePath, std::string& bytes)>;
+// Reads the files of share `shareIndex` of `shareCount` only (ReadOptions).
 Result readListing(std::string_view listing, const std::string& label, const PieceLoader& load, TetMesh& out,
-                   ReadReport& report);
+                   ReadReport& report, uint32_t shareIndex = 0, uint32_t shareCount = 1);
 
 // VTK XML, appended raw binary: Float32 points, Int64 connectivity/offsets, UInt8 types, Float32
 // point data. One fwrite per array; writes PATH.tmp, then renames.

@@ -1,7 +1,6 @@
 #include "packer.h"
 
 #include <unistd.h>
-#include <zlib.h>
 
 #include <algorithm>
 #include <chrono>
@@ -11,6 +10,7 @@
 #include <utility>
 
 #include "chunk_encode.h"
+#include "pack/pack_output.h"
 #include "io/file_writer.h"
 #include "pack/renumber.h"
 #include "pack/simplify.h"
@@ -21,35 +21,6 @@
 namespace tetstream {
 namespace fs = std::filesystem;
 namespace {
-
-Result writeFile(const fs::path& path, const void* data, size_t size) {
-  FileWriter out(path.string());
-  out.write(data, size);
-  return out.commit();
-}
-
-// `text` as a gzip file (deflate at level 9 in a gzip wrapper).
-Result writeGzipped(const fs::path& path, const std::string& text) {
-  z_stream z{};
-  if (deflateInit2(&z, 9, Z_DEFLATED, 15 + 16, 9, Z_DEFAULT_STRATEGY) != Z_OK)
-    return fail(Status::IoError, path.string() + ": cannot start gzip");
-  std::vector<uint8_t> out(deflateBound(&z, uLong(text.size())) + 32);
-  z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(text.data()));
-  z.avail_in = uInt(text.size());
-  z.next_out = out.data();
-  z.avail_out = uInt(out.size());
-  const int done = deflate(&z, Z_FINISH);
-  out.resize(z.total_out);
-  deflateEnd(&z);
-  if (done != Z_STREAM_END) return fail(Status::IoError, path.string() + ": gzip failed");
-  return writeFile(path, out.data(), out.size());
-}
-
-std::string chunkFileName(uint32_t index, uint64_t hash) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "chunks/%05u-%016llx.tsc", index, static_cast<unsigned long long>(hash));
-  return buf;
-}
 
 double msSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -287,32 +258,18 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   fs::create_directories(fs::path(outDir) / "chunks", ec);
   if (ec) return fail(Status::IoError, outDir + ": cannot create folder: " + ec.message());
   base.file = chunkFileName(0, base.hash);
-  if (Result r = writeFile(fs::path(outDir) / base.file, baseFile.data(), baseFile.size()); !r) return r;
+  if (Result r = writeWholeFile((fs::path(outDir) / base.file).string(), baseFile.data(), baseFile.size()); !r) return r;
   m.chunks.push_back(base);
   for (size_t c = 0; c < enc.files.size(); ++c) {
     ChunkInfo info = enc.chunks[c];
     info.file = chunkFileName(uint32_t(c + 1), info.hash);
-    if (Result r = writeFile(fs::path(outDir) / info.file, enc.files[c].data(), enc.files[c].size()); !r) return r;
+    if (Result r = writeWholeFile((fs::path(outDir) / info.file).string(), enc.files[c].data(), enc.files[c].size()); !r) return r;
     m.chunks.push_back(info);
   }
   // One region alone (a small mesh, --leaf-vertices 0) is no hierarchy: one sequence of chunks.
   if (enc.nodes.size() > 1) m.nodes = std::move(enc.nodes);
 
-  // Remove chunk files an earlier pack left behind (only our own *.tsc names).
-  for (const auto& entry : fs::directory_iterator(fs::path(outDir) / "chunks", ec)) {
-    std::string rel = "chunks/" + entry.path().filename().string();
-    bool ours = entry.path().extension() == ".tsc";
-    bool referenced = false;
-    for (const ChunkInfo& c : m.chunks) referenced |= c.file == rel;
-    if (ours && !referenced) fs::remove(entry.path(), ec);
-  }
-  std::string json = writeManifest(m);
-  Result r = writeFile(fs::path(outDir) / "manifest.json", json.data(), json.size());
-  // The manifest gzipped beside it, written after it (so it is never the older of the two, which
-  // servers take as stale): a large hierarchy's manifest is megabytes of JSON, fetched before
-  // anything else, and compresses about six times (server/README.md: precompressed siblings).
-  if (r) r = writeGzipped(fs::path(outDir) / "manifest.json.gz", json);
-  fs::remove(fs::path(outDir) / "manifest.json.br", ec);  // (one from an earlier pack would be stale)
+  Result r = writeManifestFiles(outDir, m);
   summary.writeMs = msSince(t0);
   return r;
 }

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdlib>
 #include <map>
 #include <random>
 #include <string>
@@ -14,6 +15,7 @@
 
 #include "dataset.h"
 #include "io/generators.h"
+#include "io/mesh_io.h"
 #include "isosurface.h"
 #include "isosurface_incremental.h"
 #include "pack/packer.h"
@@ -55,11 +57,34 @@ TetMesh graded(uint32_t n) {
 struct Case {
   std::string name;
   TetMesh mesh;
+  std::string dir;  // packed already (below); else packed here
 };
 
-std::vector<Case> cases() { return {{"grid", harmonic(16)}, {"bitten", bitten(15)}, {"graded", graded(15)}}; }
+// The cases, or packs made elsewhere: TETSTREAM_CHECK_PACKS="DIR=INPUT;DIR=INPUT..." runs every
+// test here on those datasets against their input files (the distributed pack's test packs them
+// on several processes).
+std::vector<Case> cases() {
+  if (const char* given = std::getenv("TETSTREAM_CHECK_PACKS")) {
+    std::vector<Case> out;
+    const std::string list = given;
+    for (size_t at = 0; at < list.size();) {
+      const size_t end = std::min(list.find(';', at), list.size()), eq = list.find('=', at);
+      Case c;
+      c.dir = list.substr(at, eq - at);
+      c.name = c.dir;
+      ReadReport report;
+      const std::string input = list.substr(eq + 1, end - eq - 1);
+      EXPECT_TRUE(readMesh(input, c.mesh, report)) << input;
+      out.push_back(std::move(c));
+      at = end + 1;
+    }
+    return out;
+  }
+  return {{"grid", harmonic(16), ""}, {"bitten", bitten(15), ""}, {"graded", graded(15), ""}};
+}
 
 std::string packCase(const Case& c) {
+  if (!c.dir.empty()) return c.dir;
   PackOptions o;
   o.leafVertices = 128;
   o.chunkKb = 4;

@@ -1,0 +1,448 @@
+#include "dist/distributed_pack.h"
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <future>
+
+#include "adjacency.h"
+#include "dist/partition.h"
+#include "dist/units.h"
+#include "dist/write_pack.h"
+#include "pack/part.h"
+#include "pack/simplify.h"
+#include "pack/split_encode.h"
+#include "quantize.h"
+
+namespace tetstream::dist {
+namespace fs = std::filesystem;
+namespace {
+
+double msSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+double peakMB() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return u.ru_maxrss / 1024.0;
+}
+
+// Packing needs about this many bytes per tet of a rank's part at its peak (as packer.cpp's
+// kPackBytesPerTet, with the halo and the parts it combines).
+constexpr double kBytesPerPartTet = 220;
+
+// The fields every rank read, compared (ranks without tets take them).
+Result agreeOnFields(Comm& comm, TetMesh& mesh) {
+  Bytes mine;
+  Writer w(mine);
+  w.put<uint8_t>(mesh.tetCount() > 0);
+  w.put<uint64_t>(mesh.fields.size());
+  for (const ScalarField& f : mesh.fields) w.putString(f.name);
+  const std::vector<Bytes> all = comm.allGather(mine);
+  std::vector<std::string> names;
+  int from = -1;
+  for (int r = 0; r < comm.size(); ++r) {
+    Reader in(all[size_t(r)]);
+    if (!in.get<uint8_t>()) continue;
+    std::vector<std::string> theirs(in.get<uint64_t>());
+    for (std::string& n : theirs) n = in.getString();
+    if (from < 0) {
+      names = theirs;
+      from = r;
+    } else if (theirs != names) {
+      auto list = [](const std::vector<std::string>& v) {
+        std::string s;
+        for (const std::string& n : v) s += (s.empty() ? "" : ", ") + n;
+        return "(" + s + ")";
+      };
+      return fail(Status::Corrupt, "the pieces of rank " + std::to_string(r) + " have the fields " + list(theirs) +
+                                       ", those of rank " + std::to_string(from) + " " + list(names) +
+                                       ": every piece must have the same point arrays");
+    }
+  }
+  if (from < 0) return fail(Status::NoTets, "the input has no tetrahedra");
+  if (mesh.tetCount() == 0) {
+    mesh.fields.clear();
+    for (const std::string& n : names) mesh.fields.push_back({n, {}});
+  }
+  return Result::success();
+}
+
+// Reads this rank's share: its files of a listing, or its slice of the tets of a single file.
+Result readShare(Comm& comm, const std::string& input, ReadOptions read, TetMesh& mesh, ReadReport& report) {
+  read.shareIndex = uint32_t(comm.rank());
+  read.shareCount = uint32_t(comm.size());
+  if (Result r = readMesh(input, mesh, report, read); !r) return r;
+  if (report.filesListed == 0 && comm.size() > 1) {
+    const uint64_t T = mesh.tetCount(), from = T * uint64_t(comm.rank()) / uint64_t(comm.size()),
+                   to = T * uint64_t(comm.rank() + 1) / uint64_t(comm.size());
+    mesh.tets = std::vector<uint32_t>(mesh.tets.begin() + ptrdiff_t(4 * from), mesh.tets.begin() + ptrdiff_t(4 * to));
+  }
+  for (float x : mesh.positions)
+    if (!std::isfinite(x)) return fail(Status::NonFinite, input + ": a point has a coordinate that is not finite");
+  return Result::success();
+}
+
+// The manifest's header fields, agreed: bounds and field ranges over the owned points, counts
+// (each tet counted by the owner of its first vertex).
+void describeWhole(Comm& comm, const PartMesh& p, const std::string& name, Manifest& m) {
+  const size_t F = p.mesh.fields.size();
+  std::vector<double> lo(3 + F, INFINITY), hi(3 + F, -INFINITY);
+  std::vector<uint64_t> counts(2, 0);
+  for (uint32_t v = 0; v < p.mesh.vertexCount(); ++v) {
+    if (!p.owned[v]) continue;
+    ++counts[0];
+    for (int k = 0; k < 3; ++k) {
+      lo[size_t(k)] = std::min<double>(lo[size_t(k)], p.mesh.positions[3 * size_t(v) + size_t(k)]);
+      hi[size_t(k)] = std::max<double>(hi[size_t(k)], p.mesh.positions[3 * size_t(v) + size_t(k)]);
+    }
+    for (size_t f = 0; f < F; ++f) {
+      const float x = p.mesh.fields[f].values[v];
+      if (!std::isfinite(x)) continue;
+      lo[3 + f] = std::min<double>(lo[3 + f], x);
+      hi[3 + f] = std::max<double>(hi[3 + f], x);
+    }
+  }
+  for (uint32_t t = 0; t < p.mesh.tetCount(); ++t) counts[1] += p.owned[p.mesh.tets[4 * size_t(t)]];
+  comm.minInPlace(lo);
+  comm.maxInPlace(hi);
+  comm.sumInPlace(counts);
+  m.name = name;
+  for (int k = 0; k < 3; ++k) m.bounds.min[k] = float(lo[size_t(k)]), m.bounds.max[k] = float(hi[size_t(k)]);
+  m.vertices = uint32_t(counts[0]);
+  m.tets = uint32_t(counts[1]);
+  m.fields.clear();
+  for (size_t f = 0; f < F; ++f) {
+    Range r{float(lo[3 + f]), float(hi[3 + f])};
+    if (!(r.min <= r.max)) r = {0, 0};
+    m.fields.push_back({p.mesh.fields[f].name, r});
+  }
+}
+
+// Re-orients negatively oriented tets (an odd permutation), as packMesh does; returns how many
+// of those this rank counts (those whose first vertex it owns).
+uint64_t orient(PartMesh& p) {
+  uint64_t flipped = 0;
+  for (uint32_t t = 0; t < p.mesh.tetCount(); ++t)
+    if (tetVolume(p.mesh, t) < 0) {
+      uint32_t* v = &p.mesh.tets[4 * size_t(t)];
+      std::swap(v[2], v[3]);
+      flipped += p.owned[v[0]];
+    }
+  return flipped;
+}
+
+// The quantization grid: 16 bits unless snapping to it would flatten or turn over a tet somewhere.
+void chooseGrid(Comm& comm, PartMesh& p, Manifest& m, bool nonFinite, const PackOptions& opt,
+                std::vector<std::string>& notes) {
+  m.lossless = opt.lossless || nonFinite;
+  if (nonFinite && !opt.lossless) notes.push_back("fields contain NaN or infinite values: stored lossless (float32)");
+  if (m.lossless) return;
+  std::vector<float> snapped(p.mesh.positions.size());
+  for (int bits : {16, 20, 24}) {
+    m.positionBits = bits;
+    const Quantizer q = makeQuantizer(m);
+    for (size_t k = 0; k < snapped.size(); ++k) snapped[k] = q.position[k % 3].snap(p.mesh.positions[k]);
+    std::vector<uint64_t> broken(1, 0);
+    for (uint32_t t = 0; t < p.mesh.tetCount(); ++t) {
+      const uint32_t* v = &p.mesh.tets[4 * size_t(t)];
+      if (!p.owned[v[0]]) continue;
+      auto volume = [v](const std::vector<float>& x) {
+        return tetVolume(&x[3 * size_t(v[0])], &x[3 * size_t(v[1])], &x[3 * size_t(v[2])], &x[3 * size_t(v[3])]);
+      };
+      broken[0] += volume(p.mesh.positions) > 0 && !(volume(snapped) > 0);
+    }
+    comm.sumInPlace(broken);
+    if (broken[0] == 0) break;
+    notes.push_back(std::to_string(broken[0]) + " tetrahedra are too small for a " + std::to_string(bits) +
+                    "-bit position grid" + (bits < 24 ? ": trying more bits" : ": storing lossless"));
+    if (bits == 24) m.lossless = true;
+  }
+  if (m.lossless) {
+    m.positionBits = 16;
+    return;
+  }
+  p.mesh.positions = std::move(snapped);
+  const Quantizer q = makeQuantizer(m);
+  for (size_t f = 0; f < p.mesh.fields.size(); ++f)
+    for (float& x : p.mesh.fields[f].values) x = q.field[f].snap(x);
+}
+
+// The mean volume of an interior vertex over the whole mesh (SimplifyPart::meanVertexVolume), as
+// the simplifier's set-up computes it: a quarter of each non-flat tet's volume to each vertex.
+double meanVertexVolume(Comm& comm, const PartMesh& p) {
+  FaceAdjacency adj;
+  buildFaceAdjacency(p.mesh.tets, p.mesh.vertexCount(), adj);
+  std::vector<uint8_t> boundary(p.mesh.vertexCount(), 0);
+  for (size_t h = 0; h < adj.opposite.size(); ++h)
+    if (adj.opposite[h] == kNoNeighbor)
+      for (int k = 0; k < 4; ++k)
+        if (k != int(h & 3)) boundary[p.mesh.tets[(h & ~size_t(3)) + size_t(k)]] = 1;
+  std::vector<double> volume(p.mesh.vertexCount(), 0);
+  for (uint32_t t = 0; t < p.mesh.tetCount(); ++t) {
+    const double q = std::abs(tetVolume(p.mesh, t)) / 4;
+    for (int k = 0; k < 4; ++k) volume[p.mesh.tets[4 * size_t(t) + size_t(k)]] += q;
+  }
+  std::vector<double> sums(4, 0);  // interior volume, interior count, all volume, all count
+  for (uint32_t v = 0; v < p.mesh.vertexCount(); ++v)
+    if (p.owned[v]) {
+      sums[0] += boundary[v] ? 0 : volume[v];
+      sums[1] += boundary[v] ? 0 : 1;
+      sums[2] += volume[v];
+      sums[3] += 1;
+    }
+  comm.sumInPlace(sums);
+  const double inside = sums[1] ? sums[0] / sums[1] : 0, all = sums[3] ? sums[2] / sums[3] : 0;
+  return inside > 0 ? inside : all > 0 ? all : INFINITY;
+}
+
+uint64_t ownedCount(const PartMesh& p) { return uint64_t(std::count(p.owned.begin(), p.owned.end(), 1)); }
+
+}  // namespace
+
+Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& read, const std::string& outDir,
+                       const PackOptions& opt, DistributedSummary& out) {
+  out = DistributedSummary{};
+  const int N = comm.size(), me = comm.rank();
+  auto t0 = std::chrono::steady_clock::now();
+  auto progress = [&](const char* phase) {
+    if (opt.progress && me == 0) opt.progress(phase, 0, 0);
+  };
+  progress("read");
+
+  // ---- read
+  TetMesh mesh;
+  ReadReport report;
+  Result r = readShare(comm, input, read, mesh, report);
+  if (r = comm.agree(r); !r) return r;
+  if (r = comm.agree(agreeOnFields(comm, mesh)); !r) return r;
+  out.inputFormat = report.format;
+  std::vector<std::string>& notes = out.pack.notes;
+  if (me == 0) notes = report.notes;
+  const int iso = opt.field.empty() ? 0 : mesh.findField(opt.field);
+  if (iso < 0) {
+    std::string names;
+    for (const ScalarField& f : mesh.fields) names += (names.empty() ? "" : ", ") + f.name;
+    return fail(Status::MissingField, "no field named '" + opt.field + "' (fields: " + names + ")");
+  }
+  if (mesh.fields.empty()) return fail(Status::MissingField, "the mesh has no point scalar field to show");
+  out.readMs = msSince(t0);
+
+  // ---- partition
+  t0 = std::chrono::steady_clock::now();
+  progress("partition");
+  std::vector<uint64_t> tetCounts(static_cast<size_t>(N), 0);
+  tetCounts[size_t(me)] = mesh.tetCount();
+  comm.sumInPlace(tetCounts);
+  uint64_t firstTet = 0;
+  for (int k = 0; k < me; ++k) firstTet += tetCounts[size_t(k)];
+  for (uint64_t c : tetCounts) out.inputTets += c;
+  const std::string name = opt.name.empty() ? mesh.name : opt.name;
+  const RankTree tree = cutRegions(comm, mesh);
+  PartMesh part;
+  DistributionReport joined;
+  r = distribute(comm, std::move(mesh), firstTet, tree, part, joined);
+  if (r = comm.agree(r); !r) return r;
+  {
+    std::vector<uint64_t> agreed = joined.disagreements;
+    agreed.push_back(joined.joinedPoints);
+    comm.sumInPlace(agreed);
+    if (me == 0 && N > 1) {
+      notes.push_back("joined " + std::to_string(agreed.back()) +
+                      " points that the pieces of several ranks hold (by exact coordinates)");
+      for (size_t f = 0; f < part.mesh.fields.size(); ++f)
+        if (agreed[f])
+          notes.push_back("field '" + part.mesh.fields[f].name + "': " + std::to_string(agreed[f]) +
+                          " joined points have different values in different pieces (the lowest rank's copy kept)");
+    }
+  }
+  {
+    double limit = opt.maxMemoryBytes;
+    if (!(limit > 0)) {
+      const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+      limit = pages > 0 && page > 0 ? 0.9 * double(pages) * double(page) / N : 0;  // (ranks share a node here)
+    }
+    const double need = kBytesPerPartTet * part.mesh.tetCount();
+    r = limit > 0 && need > limit
+            ? fail(Status::TooLarge, "its part (" + std::to_string(part.mesh.tetCount()) + " tetrahedra) needs about " +
+                                         std::to_string(int64_t(need / 1e6)) + " MB, more than the " +
+                                         std::to_string(int64_t(limit / 1e6)) +
+                                         " MB allowed per rank (--max-memory): use more ranks")
+            : Result::success();
+    if (r = comm.agree(r); !r) return r;
+  }
+  out.partitionMs = msSince(t0);
+
+  // ---- prepare
+  Manifest m;
+  m.generator = std::string("tetstream ") + kLibraryVersion;
+  describeWhole(comm, part, name.empty() ? "dataset" : name, m);
+  m.isoField = part.mesh.fields[size_t(iso)].name;
+  std::vector<uint64_t> prepared(2, 0);
+  prepared[0] = orient(part);
+  for (const ScalarField& f : part.mesh.fields)
+    for (float x : f.values) prepared[1] += !std::isfinite(x);
+  comm.sumInPlace(prepared);
+  if (prepared[0] && me == 0)
+    notes.push_back("re-oriented " + std::to_string(prepared[0]) + " negatively oriented tetrahedra");
+  chooseGrid(comm, part, m, prepared[1] > 0, opt, notes);
+  RegionFigures regions = regionFigures(comm, part, m);
+
+  // ---- simplify, then combine up the tree of ranks
+  t0 = std::chrono::steady_clock::now();
+  progress("simplify");
+  SimplifyPart shared;
+  shared.fieldMin = m.fields[size_t(iso)].range.min;
+  shared.fieldMax = m.fields[size_t(iso)].range.max;
+  shared.diagonal = m.bounds.diagonal() > 0 ? m.bounds.diagonal() : 1.0;
+  shared.meanVertexVolume = meanVertexVolume(comm, part);
+  uint64_t target = opt.baseVertices ? opt.baseVertices
+                                     : uint64_t(std::llround(std::clamp(opt.baseFraction, 0.0, 1.0) * m.vertices));
+  if (!opt.baseVertices && opt.baseFraction > 0)
+    target = std::max<uint64_t>(std::min<uint64_t>(target, opt.maxBaseVertices),
+                                std::min<uint64_t>(opt.minBaseVertices, m.vertices));
+  auto simplifyUnit = [&](Unit& u, const CarriedVertexState* carried) {
+    const RankTree::Group& g = tree.groups[size_t(u.group)];
+    SimplifyPart sp = shared;
+    sp.owned = &u.part.owned;
+    sp.carried = carried;
+    sp.topMin = regions.groupRange(g, size_t(iso)).min;
+    sp.topMax = regions.groupRange(g, size_t(iso)).max;
+    sp.topIsRegion = u.group != 0;
+    SimplifyOptions so;
+    so.weightGeometry = opt.weights[0];
+    so.weightField = opt.weights[1];
+    so.weightShape = opt.weights[2];
+    so.threads = opt.threads;
+    so.leafVertices = g.low < 0 ? opt.leafVertices : 0;  // (a combined part is one region: the cut)
+    so.fitValues = opt.fitValues;
+    so.field = iso;
+    so.maxError = opt.maxError;
+    const double share = m.vertices ? double(ownedCount(u.part)) / m.vertices : 1.0;
+    so.targetVertices = uint32_t(std::max<double>(4, std::llround(double(target) * share)));
+    so.targetTets = opt.baseTets ? uint32_t(std::llround(opt.baseTets * share)) : 0;
+    so.part = &sp;
+    Result res = simplifyMesh(u.part.mesh, so, u.s);
+    if (res) u.handoff = partAfter(u.part, u.s);
+    return res;
+  };
+  std::vector<Unit> units;  // bottom-up: this rank's leaf, then the groups it combines
+  std::vector<int> chain{tree.leafOf(me)};
+  while (tree.groups[size_t(chain.back())].parent >= 0 &&
+         tree.groups[size_t(tree.groups[size_t(chain.back())].parent)].first == me)
+    chain.push_back(tree.groups[size_t(chain.back())].parent);
+  RankFigures mine;
+  mine.ownedVertices = ownedCount(part);
+  mine.tets = part.mesh.tetCount();
+  units.reserve(chain.size());
+  Result status;
+  bool secondary = false;
+  for (size_t c = 0; c < chain.size(); ++c) {
+    Unit& u = units.emplace_back();
+    u.group = chain[c];
+    const RankTree::Group& g = tree.groups[size_t(u.group)];
+    if (c == 0) {
+      u.part = std::move(part);
+      if (status) status = simplifyUnit(u, nullptr);
+      continue;
+    }
+    // Combine: the low child's handoff is this rank's previous unit's; the high one comes from
+    // its first rank.
+    Bytes got;
+    const bool theirsOk = comm.receive(tree.groups[size_t(g.high)].first, g.high, got);
+    PartMesh high;
+    if (status && !theirsOk) {
+      status = fail(Status::Corrupt, "a rank below failed");
+      secondary = true;
+    }
+    if (status && !readPart(got, high)) status = fail(Status::Corrupt, "a part from a rank below is damaged");
+    if (!status) continue;
+    Unit& low = units[c - 1];
+    u.childVertexIds[0] = low.handoff.vertexId;
+    u.childTetIds[0] = low.handoff.tetId;
+    u.childVertexIds[1] = high.vertexId;
+    u.childTetIds[1] = high.tetId;
+    u.part = mergeParts(low.handoff, high);
+    high = PartMesh{};
+    CarriedVertexState carried = std::move(u.part.carried);
+    status = simplifyUnit(u, &carried);
+  }
+  if (const int up = tree.groups[size_t(chain.back())].parent; up >= 0) {
+    Bytes sent;
+    if (status) writePart(units.back().handoff, sent);
+    comm.send(tree.groups[size_t(up)].first, chain.back(), sent, !status);
+  }
+  mine.simplifyMs = msSince(t0);
+  if (r = comm.agree(status, secondary); !r) return r;
+  out.combineMs = msSince(t0);
+
+  // ---- encode, top-down
+  t0 = std::chrono::steady_clock::now();
+  progress("encode");
+  const UnitLayout layout = planUnits(comm, tree, units);
+  status = Result::success();
+  secondary = false;
+  for (size_t c = units.size(); c-- > 0;) {
+    Unit& u = units[c];
+    const RankTree::Group& g = tree.groups[size_t(u.group)];
+    UnitEncodeOptions uo;
+    uo.stream.firstChunkBytes = std::min<uint32_t>(opt.chunkKb << 10, 16u << 10);
+    uo.stream.chunkBytes = opt.chunkKb << 10;
+    uo.stream.zstdLevel = opt.zstdLevel;
+    uo.stream.ringWalk = opt.ringWalk;
+    uo.stream.threads = opt.threads;
+    uo.vertexBegin = layout.vertexBegin[size_t(u.group)];
+    uo.tetBegin = layout.tetBegin[size_t(u.group)];
+    std::vector<uint64_t> handVertex, handTet;  // stable ids of the handoff, in its order
+    if (u.group == 0) {
+      for (uint64_t k = 0; k < u.handoff.vertexId.size(); ++k) handVertex.push_back(k);
+      for (uint64_t k = 0; k < u.handoff.tetId.size(); ++k) handTet.push_back(k);
+    } else if (c + 1 < units.size()) {
+      handVertex = std::move(units[c + 1].childStable[0].vertices);
+      handTet = std::move(units[c + 1].childStable[0].tets);
+    } else {
+      Bytes got;
+      const bool ok = comm.receive(tree.groups[size_t(g.parent)].first, u.group, got);
+      if (status && !ok) {
+        status = fail(Status::Corrupt, "a rank above failed");
+        secondary = true;
+      }
+      Reader in(got);
+      handVertex = in.getVector<uint64_t>();
+      handTet = in.getVector<uint64_t>();
+      if (status && (!in.atEnd() || handVertex.size() != u.handoff.vertexId.size() ||
+                     handTet.size() != u.handoff.tetId.size()))
+        status = fail(Status::Corrupt, "stable ids from the rank above are damaged");
+    }
+    if (status) status = encodeOne(u, handVertex, handTet, m, uo);
+    for (int side = 0; side < 2 && g.low >= 0; ++side) {
+      const int child = side ? g.high : g.low;
+      StableIds ids;
+      if (status) ids = stableIdsOf(u, side);
+      if (side == 0) {
+        u.childStable[0] = std::move(ids);
+        continue;
+      }
+      Bytes sent;
+      Writer w(sent);
+      w.putVector(ids.vertices);
+      w.putVector(ids.tets);
+      comm.send(tree.groups[size_t(child)].first, child, sent, !status);
+    }
+  }
+  mine.encodeMs = msSince(t0);
+  if (r = comm.agree(status, secondary); !r) return r;
+
+  // ---- write
+  progress("write");
+  mine.peakMB = peakMB();
+  r = writeDistributed(comm, tree, layout, units, regions, m, outDir, opt, mine, out);
+  return comm.agree(r);
+}
+
+}  // namespace tetstream::dist

@@ -1,0 +1,58 @@
+// The units of a distributed pack (distributed_pack.h): one per group of the tree of ranks, on
+// the group's first rank. What each holds, the figures of each rank's region, and how the units'
+// stable ids are laid out before any is encoded.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "dist/comm.h"
+#include "dist/partition.h"
+#include "manifest.h"
+#include "pack/part.h"
+#include "pack/simplify.h"
+#include "pack/split_encode.h"
+
+namespace tetstream::dist {
+
+struct StableIds {
+  std::vector<uint64_t> vertices, tets;  // in the order of a handoff's vertices and tets
+};
+
+struct Unit {
+  int group = -1;
+  PartMesh part;     // the part as simplified (its mesh holds the tets at the start)
+  SimplifyResult s;  // its simplification
+  PartMesh handoff;  // what it left (partAfter)
+  // A group of two ranks or more: its children's handoffs by input id (the stable ids go down
+  // to them in their own order), and the low child's stable ids once encoded (it is on this rank).
+  std::vector<uint64_t> childVertexIds[2], childTetIds[2];
+  StableIds childStable[1];
+  UnitEncoded encoded;
+};
+
+// Every rank's region: the bounding box and each field's range over its owned points (on the
+// quantization grid, within the manifest's ranges).
+struct RegionFigures {
+  std::vector<Bounds> bounds;               // per rank
+  std::vector<std::vector<Range>> ranges;   // per rank, per field
+  Bounds groupBounds(const RankTree::Group& g) const;
+  Range groupRange(const RankTree::Group& g, size_t field) const;
+};
+RegionFigures regionFigures(Comm& comm, const PartMesh& part, const Manifest& m);
+
+// Stable ids per unit, from every unit's counts: the base first, then the units in preorder.
+struct UnitLayout {
+  uint64_t baseVertices = 0, baseTets = 0;
+  std::vector<uint64_t> vertexBegin, tetBegin;  // per group
+  std::vector<uint64_t> newVertices, newTets;   // per group
+};
+UnitLayout planUnits(Comm& comm, const RankTree& tree, const std::vector<Unit>& units);
+
+// Encodes unit u, its handoff's stable ids given in the handoff's order.
+Result encodeOne(Unit& u, const std::vector<uint64_t>& handVertex, const std::vector<uint64_t>& handTet,
+                 const Manifest& m, UnitEncodeOptions& options);
+
+// The stable ids of child `side` (0 low, 1 high) of encoded unit u, in its handoff's order.
+StableIds stableIdsOf(const Unit& u, int side);
+
+}  // namespace tetstream::dist

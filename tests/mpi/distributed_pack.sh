@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# The distributed pack (core/dist) under mpirun, as a user runs it: a mesh written as the pieces
+# of a parallel run by VTK's own writers (write_pieces.py), packed on 1, 2 and 4 ranks. Each pack
+# must pass every check of the patch hierarchy (tests/unit/test_partial.cpp, run on these packs:
+# any set of nodes with their parents is a valid mesh in any order, all nodes give the input,
+# the nodes an isovalue needs give its full-resolution surface exactly, the incremental surface
+# follows), be the same bytes when packed again, and give the serial pack's isosurface; a rank
+# that fails stops every rank with one message, never a hang.
+#   distributed_pack.sh TETSTREAM TETSTREAM_TESTS WORKDIR
+set -euo pipefail
+TETSTREAM=$1
+TESTS=$2
+WORK=$3
+HERE="$(cd "$(dirname "$0")" && pwd)"
+# Open MPI as root (CI) and in containers; more ranks than cores.
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_btl_vader_single_copy_mechanism=none
+MPIRUN=(mpirun --oversubscribe --bind-to none)
+rm -rf "$WORK" && mkdir -p "$WORK"
+"$TETSTREAM" gen harmonic --n 22 -o "$WORK/harmonic.vtu" >/dev/null
+/usr/bin/python3 "$HERE/write_pieces.py" "$WORK/harmonic.vtu" "$WORK/pieces" 4
+PACK=(pack --leaf-vertices 256 --chunk-kb 8 --json)
+
+checks=""
+for input in ghost.pvtu ids.pvtu multi.vtu; do
+  for np in 1 2 4; do
+    out="$WORK/${input%.*}-np$np"
+    timeout 300 "${MPIRUN[@]}" -np $np "$TETSTREAM" "${PACK[@]}" "$WORK/pieces/$input" -o "$out" >"$out.json"
+    echo "packed $input on $np ranks: $(grep -o '"nodes":[0-9]*' "$out.json"), $(grep -o '"bytes":[0-9]*' "$out.json")"
+    checks="$checks;$out=$WORK/pieces/$input"
+  done
+done
+
+# The same bytes on a second run.
+again="$WORK/again"
+timeout 300 "${MPIRUN[@]}" -np 4 "$TETSTREAM" "${PACK[@]}" "$WORK/pieces/ghost.pvtu" -o "$again" >/dev/null
+diff -r "$WORK/ghost-np4" "$again" >/dev/null || { echo "FAIL: two runs on 4 ranks differ"; exit 1; }
+echo "ok: a second run on 4 ranks wrote the same bytes"
+
+# Every check of the hierarchy, on every pack.
+TETSTREAM_CHECK_PACKS="${checks#;}" "$TESTS" --gtest_filter='Partial.AnySet*:Partial.AllNodes*:Partial.TheNodesAn*' \
+  --gtest_brief=1
+
+# The isosurface of a distributed pack is the serial one's, at three isovalues.
+for value in 0 0.25 0.5; do
+  serial=$("$TETSTREAM" iso "$WORK/harmonic.vtu" --value $value --json | grep -o '"triangles":[0-9]*')
+  for np in 2 4; do
+    mine=$("$TETSTREAM" iso "$WORK/ghost-np$np" --value $value --json | grep -o '"triangles":[0-9]*')
+    [ "$serial" = "$mine" ] || { echo "FAIL: iso $value on $np ranks: $mine, serial $serial"; exit 1; }
+  done
+done
+echo "ok: the isosurfaces equal the input's"
+
+# A missing piece: every rank stops, one message names the piece, no hang.
+set +e
+msg=$(timeout 120 "${MPIRUN[@]}" -np 4 "$TETSTREAM" pack "$WORK/pieces/broken.pvtu" -o "$WORK/broken" 2>&1)
+code=$?
+set -e
+[ $code -ne 0 ] && [ $code -ne 124 ] || { echo "FAIL: a missing piece gave exit $code"; exit 1; }
+echo "$msg" | grep -q "missing_3.vtu" || { echo "FAIL: the message does not name the piece: $msg"; exit 1; }
+[ "$(echo "$msg" | grep -c "error")" -eq 1 ] || { echo "FAIL: not one message: $msg"; exit 1; }
+[ ! -e "$WORK/broken/manifest.json" ] || { echo "FAIL: a manifest was written"; exit 1; }
+echo "ok: a missing piece stops every rank with one message: $(echo "$msg" | head -1)"
