@@ -22,17 +22,20 @@ struct PartMesh {
 };
 
 // The part as simplification `s` of `in` left it: the vertices and tets still alive (in the
-// same relative order), the current tets, and the carried state at the end.
+// same relative order), the current tets, and the carried state at the end (s.carried, which
+// simplifyMesh fills with SimplifyOptions::part; without it the result carries none). Positions
+// and every field keep the input's samples (the fitted values are in the carried state).
 PartMesh partAfter(const PartMesh& in, const SimplifyResult& s);
 
 // Two sibling parts as one: the union of their vertices and tets by input id (in ascending id
 // order); a vertex is owned when either part owns it, and takes the state of the part that owns
-// it (of `a` when neither does).
+// it (of `a` when neither does). Both parts carry state, or neither.
 PartMesh mergeParts(const PartMesh& a, const PartMesh& b);
 
 // Serialised for sending between ranks (native byte order: the ranks of one job share it).
 void writePart(const PartMesh& p, std::vector<uint8_t>& out);
-// False when `in` is not a whole serialised part (the sizes do not add up).
+// False when `in` is not a whole serialised part (the sizes do not add up, a tet names a vertex
+// past the end, ids are not ascending, flags are not 0 or 1); never reads past the end.
 bool readPart(const std::vector<uint8_t>& in, PartMesh& p);
 
 }  // namespace tetstream

@@ -400,15 +400,34 @@ class Simplifier {
   void runTree(uint32_t target);
   void runRegion(Queue& Q, float tau);
   void markInner(const std::vector<uint32_t>& region);
-  // The range fitted values keep to in `node` (fitted()); the field's whole range at the root.
-  double nodeLo(uint32_t node) const { return nodeRange_.empty() ? fieldMin_ : nodeRange_[node].min; }
-  double nodeHi(uint32_t node) const { return nodeRange_.empty() ? fieldMax_ : nodeRange_[node].max; }
+  bool levelTau(std::vector<float>& keys, uint32_t target, float& tau) const;
+  void markTopInner();
+  void runTop(Queue& Q, uint32_t target);
+  // The range fitted values keep to in `node` (fitted()); the top's range (topLo_, topHi_) when
+  // there is no tree.
+  double nodeLo(uint32_t node) const { return nodeRange_.empty() ? topLo_ : nodeRange_[node].min; }
+  double nodeHi(uint32_t node) const { return nodeRange_.empty() ? topHi_ : nodeRange_[node].max; }
   std::vector<Range> nodeRange_;  // per node (RegionTree numbering): the steering field's input range
   // Per vertex: the node of the last collapse onto it (1: the root, or none). The refit keeps its
   // value in that node's range: while the node's splits are not applied, its region shows
   // that value, and the node's range must bound it (simplify.h).
   std::vector<uint32_t> lastNode_;
   static constexpr uint32_t kTwoThreadScan = 200000;  // tets: markInner() on two threads from here
+
+  // ------------------------------------------------------------------ a part (SimplifyPart)
+  // Whether v is the part's own (every vertex of a whole mesh is): only those are ever
+  // collapsed or collapse targets, and only they count towards the target.
+  bool owned(uint32_t v) const { return !ownedMask_ || (*ownedMask_)[v]; }
+  // The alive vertices the target and the levels' cost τ go by: the owned ones (halo vertices
+  // are never collapsed here; their owners count them).
+  uint32_t countedAlive() const { return alive_ - haloAlive_; }
+  void takeCarried(const CarriedVertexState& c);
+  void fillCarried();
+  const std::vector<uint8_t>* ownedMask_ = nullptr;  // opt_.part's owned, or null (all owned)
+  uint32_t haloAlive_ = 0;                           // alive vertices not owned (constant)
+  // The range fitted values of node 1 keep to: the field's range of the whole mesh, or the
+  // part's top range (SimplifyPart::topMin/topMax).
+  double topLo_ = 0, topHi_ = 0;
 
   // ------------------------------------------------------------------ link condition
   void gatherLink(uint32_t v, std::vector<uint32_t>& verts, std::vector<uint64_t>& edges, std::vector<Tri>& tris);

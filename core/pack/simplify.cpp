@@ -48,26 +48,36 @@ CollapseVerdict Simplifier::check(uint32_t i, uint32_t j) {
 Result Simplifier::run() {
   init();
   const uint32_t target = std::max<uint32_t>(opt_.targetVertices, 4);
-  const uint32_t planned = alive_ > target ? alive_ - target : 0;
+  const uint32_t planned = countedAlive() > target ? countedAlive() - target : 0;
   out_.stopReason = "target reached";
   tetsAlive_ = T_;
   Queue& Q = main_;
   Q.log = &out_.log;
-  slack_ = V_ >= kSlackMinVertices ? kLargeMeshSlack : 1.0f;
+  const uint64_t size = opt_.part && opt_.part->inputVertices ? opt_.part->inputVertices : V_;
+  slack_ = size >= kSlackMinVertices ? kLargeMeshSlack : 1.0f;
   runTree(target);
-  for (uint32_t v = 0; v < V_; ++v)  // (after the regions: what they left queued)
-    if (out_.vertexAlive[v] && queued_[v]) Q.heap.push({queueKey(v), v});
+  // A part's top collapses only its inner vertices (markTopInner), as one more region of its
+  // tree or, with halo vertices left, as the root; a whole mesh's root collapses any.
+  const bool topIsRegion = opt_.part && opt_.part->topIsRegion;
+  if (topIsRegion || haloAlive_) {
+    markTopInner();
+    Q.region = true;
+  }
+  if (!topIsRegion)
+    for (uint32_t v = 0; v < V_; ++v)  // (after the regions: what they left queued)
+      if (out_.vertexAlive[v] && queued_[v] && (!Q.region || inner_[v])) Q.heap.push({queueKey(v), v});
   readyScratches();
-  const bool parallel = opt_.threads > 1 && V_ >= opt_.parallelMinVertices;
+  if (topIsRegion) runTop(Q, target);
+  const bool parallel = !topIsRegion && opt_.threads > 1 && V_ >= opt_.parallelMinVertices;
   const uint32_t roundSize = parallel ? kRoundSize : 1;
   trackChanges_ = roundSize > 1;  // (changedThisRound reads changed_ only then)
   if (trackChanges_) changed_.assign(V_, 0);
   WorkPool pool(parallel ? 1 : 0);
   auto evaluateTask = [this](uint32_t k) { evaluateVertex(scratches_[k], round_[k].vertex); };
   auto goOn = [&] {
-    return alive_ - Q.collapsed > target && tetsAlive_ - Q.tetsRemoved > opt_.targetTets && !Q.errorBound;
+    return countedAlive() - Q.collapsed > target && tetsAlive_ - Q.tetsRemoved > opt_.targetTets && !Q.errorBound;
   };
-  while (goOn()) {
+  while (!topIsRegion && goOn()) {
     round_.clear();
     Entry e;
     while (round_.size() < roundSize && peekValid(Q.heap, e)) {
@@ -125,12 +135,14 @@ Result Simplifier::run() {
     if (out_.tetAlive[t] && kappa_[t] >= kKappaCap) ++out_.flatTetsLeft;
   }
   out_.log.close(opt_.recordReadSets);
-  if (fitOn_ && opt_.refitValues) refitValues();
+  // (A part has not the whole input the refit fits against.)
+  if (fitOn_ && opt_.refitValues && !opt_.part) refitValues();
   if (fitOn_) {
     out_.values.resize(V_);
     for (uint32_t v = 0; v < V_; ++v) out_.values[v] = vert_[v].fit;
     out_.valuesField = opt_.field;
   }
+  if (opt_.part) fillCarried();
   return Result::success();
 }
 

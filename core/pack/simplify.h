@@ -102,7 +102,30 @@ struct SimplifyPart {
   // level's cost τ) and stops; false: it is the root, the queue of the whole mesh, which goes on
   // to the target (then nothing may be halo).
   bool topIsRegion = false;
+  // The whole input's vertex count: the queue's slack (tryCollapse) depends on the mesh's size,
+  // and every part should use the whole mesh's (0: this part's).
+  uint64_t inputVertices = 0;
 };
+// How a part is simplified (simplifyMesh with SimplifyOptions::part):
+//   - an owned vertex is collapsed, and is a collapse target, only when every alive tet around
+//     it has four owned vertices (and, in the part's tree, lies in its region); halo vertices
+//     never are;
+//   - the part's tree bisects its owned vertices alone (RegionTree::leafOf is ~0u for halo
+//     vertices); node 1 is the part's top; with topIsRegion it collapses up to its level's cost
+//     τ and its collapses are the section of node 1;
+//   - targetVertices and targetTets are the part's share, compared with its owned alive vertices
+//     (and its tets);
+//   - values are not refitted at the end (refitValues is ignored): SimplifyResult::values are the
+//     fitted values;
+//   - SimplifyResult::carried covers every vertex of the part's mesh, dead ones included (their
+//     state at their collapse); partAfter (part.h) keeps the alive ones. A halo vertex's state is
+//     what this part had of it (its boundary may be the part's cut): only its owner's counts.
+// Deterministic as the whole mesh's simplification: the same for any number of threads.
+
+// The whole mesh's normalisers for SimplifyPart (fieldMin, fieldMax, diagonal, meanVertexVolume
+// and inputVertices) as simplifyMesh computes them for `mesh` itself, with topMin/topMax the
+// field's range: for a caller that holds the whole mesh.
+SimplifyPart wholeMeshPart(const TetMesh& mesh, int field);
 
 struct SimplifyOptions {
   double weightGeometry = 100.0, weightField = 1.0, weightShape = 0.005;
@@ -174,7 +197,9 @@ struct SimplifyResult {
   uint32_t regionCollapses = 0;          // collapses made below the root, on two threads at once
   RegionTree tree;
   CarriedVertexState carried;  // with SimplifyOptions::part: the state at the end, per vertex
-  std::string stopReason;  // "target reached", "no legal collapse left", "error bound"
+  // "target reached", "no legal collapse left", "error bound reached", or (a part's top node
+  // as a region, SimplifyPart::topIsRegion) "level cost reached".
+  std::string stopReason;
 };
 
 // Why a single collapse is or is not allowed (for tests and diagnostics).

@@ -56,13 +56,15 @@ void appendCollapse(CollapseLog& dst, const CollapseLog& src, uint32_t c) {
 void Simplifier::buildTree() {
   RegionTree& tree = out_.tree;
   tree = RegionTree{};
-  if (opt_.leafVertices == 0 || alive_ < 2 * uint64_t(opt_.leafVertices)) return;
-  while ((uint64_t(alive_) >> tree.depth) > opt_.leafVertices) ++tree.depth;
+  // A part's tree cuts its owned vertices alone (countedAlive()); its halo is in no region.
+  const uint32_t count = countedAlive();
+  if (opt_.leafVertices == 0 || count < 2 * uint64_t(opt_.leafVertices)) return;
+  while ((uint64_t(count) >> tree.depth) > opt_.leafVertices) ++tree.depth;
   std::vector<uint32_t> order;
-  order.reserve(alive_);
+  order.reserve(count);
   for (uint32_t v = 0; v < V_; ++v)
-    if (out_.vertexAlive[v]) order.push_back(v);
-  tree.leafOf.assign(V_, ~0u);  // (vertices of no tet: in no region)
+    if (out_.vertexAlive[v] && owned(v)) order.push_back(v);
+  tree.leafOf.assign(V_, ~0u);  // (vertices of no tet, and halo vertices: in no region)
   struct Part {
     uint32_t begin, end, level, index;
   };
@@ -107,7 +109,10 @@ void Simplifier::buildTree() {
                        std::max(nodeRange_[2 * n].max, nodeRange_[2 * n + 1].max)};
   }
   for (Range& r : nodeRange_)
-    if (!(r.min <= r.max)) r = {float(fieldMin_), float(fieldMax_)};  // (no finite value: any)
+    if (!(r.min <= r.max)) r = {float(topLo_), float(topHi_)};  // (no finite value: any)
+  // A part's top keeps to the range its caller gives (that of the input over the part's region,
+  // which holds every owned sample here).
+  if (opt_.part) nodeRange_[1] = {float(opt_.part->topMin), float(opt_.part->topMax)};
   lastNode_.assign(V_, 1);
 }
 
@@ -121,25 +126,20 @@ void Simplifier::runTree(uint32_t target) {
   uint32_t collapsedAll = 0;
   for (uint32_t level = 0; level < tree.depth; ++level) {
     const uint32_t regions = 1u << (tree.depth - level);
+    // (A halo vertex's ~0u >> level lies above every region's index, 2^(depth − level) − 1 at
+    // most, as depth < 32: the halo is a region of its own, so no owned vertex next to it is inner.)
     for (uint32_t v = 0; v < V_; ++v)
       if (out_.vertexAlive[v]) region[v] = tree.leafOf[v] >> level;
     markInner(region);
     std::vector<std::vector<Entry>> entries(regions);
     std::vector<float> keys;
     for (uint32_t v = 0; v < V_; ++v) {
-      if (!out_.vertexAlive[v] || !queued_[v]) continue;
+      if (!out_.vertexAlive[v] || !queued_[v] || !owned(v)) continue;
       keys.push_back(queueKey(v));
       if (inner_[v]) entries[region[v]].push_back({queueKey(v), v});
     }
-    // The one queue of the whole mesh would stop, at the target, at about the cost that many of
-    // the queued vertices have now (an underestimate: costs rise as neighbours collapse).
-    const double goal =
-        std::max<double>(target, opt_.targetTets && tetsAlive_ ? double(alive_) * opt_.targetTets / tetsAlive_ : 0.0);
-    if (keys.empty() || alive_ <= goal + 1) continue;
-    const double share = std::min((double(alive_) - goal) / keys.size(), kLevelShareCap);
-    const size_t at = size_t(std::min<double>(double(keys.size() - 1), share * keys.size()));
-    std::nth_element(keys.begin(), keys.begin() + ptrdiff_t(at), keys.end());
-    const float tau = keys[at];
+    float tau;
+    if (!levelTau(keys, target, tau)) continue;
     // Regions go to the threads largest first, to the one with less work so far.
     std::vector<uint32_t> bySize(regions);
     for (uint32_t k = 0; k < regions; ++k) bySize[k] = k;
@@ -177,7 +177,7 @@ void Simplifier::runTree(uint32_t target) {
         if (t == 0 && opt_.progress) opt_.progress(collapsedAll + c.collapsed, alive_ + collapsedAll - target);
       }
     });
-    for (Scratch& sc : scratches_) sc.fitLo = fieldMin_, sc.fitHi = fieldMax_;
+    for (Scratch& sc : scratches_) sc.fitLo = topLo_, sc.fitHi = topHi_;
     // The regions' collapses, region after region, each a section of the log.
     for (uint32_t k = 0; k < regions; ++k) {
       if (logs[k].size() == 0) continue;
@@ -197,7 +197,54 @@ void Simplifier::runTree(uint32_t target) {
   out_.regionCollapses = collapsedAll;
 }
 
-// Collapses the region's queued inner vertices up to cost tau (simplify_tree.cpp's head).
+// The cost τ up to which a level collapses (this file's head), from the keys of the queued
+// vertices (reordered); false when the level has nothing to do: no key, or the target reached.
+bool Simplifier::levelTau(std::vector<float>& keys, uint32_t target, float& tau) const {
+  // The one queue of the whole mesh would stop, at the target, at about the cost that many of
+  // the queued vertices have now (an underestimate: costs rise as neighbours collapse).
+  const uint32_t alive = countedAlive();
+  const double goal =
+      std::max<double>(target, opt_.targetTets && tetsAlive_ ? double(alive) * opt_.targetTets / tetsAlive_ : 0.0);
+  if (keys.empty() || alive <= goal + 1) return false;
+  const double share = std::min((double(alive) - goal) / keys.size(), kLevelShareCap);
+  const size_t at = size_t(std::min<double>(double(keys.size() - 1), share * keys.size()));
+  std::nth_element(keys.begin(), keys.begin() + ptrdiff_t(at), keys.end());
+  tau = keys[at];
+  return true;
+}
+
+// inner_ for node 1 of a part (SimplifyPart): its region is every owned vertex, so an owned
+// vertex is inner when every alive tet around it has four owned vertices. No collapse changes
+// this: a tet with a halo vertex is around no inner vertex, so none ever moves or goes.
+void Simplifier::markTopInner() {
+  std::vector<uint32_t> region(V_);
+  for (uint32_t v = 0; v < V_; ++v) region[v] = owned(v) ? 0 : 1;
+  markInner(region);
+  for (uint32_t v = 0; v < V_; ++v) inner_[v] &= uint8_t(owned(v));
+}
+
+// A part's top node as one more level of its tree (SimplifyPart::topIsRegion): its inner
+// vertices up to the level's τ, in Q (the one queue, region = true; its log is out_.log).
+void Simplifier::runTop(Queue& Q, uint32_t target) {
+  std::vector<Entry> entries;
+  std::vector<float> keys;
+  for (uint32_t v = 0; v < V_; ++v) {
+    if (!out_.vertexAlive[v] || !queued_[v] || !owned(v)) continue;
+    keys.push_back(queueKey(v));
+    if (inner_[v]) entries.push_back({queueKey(v), v});
+  }
+  float tau;
+  if (!levelTau(keys, target, tau)) {
+    out_.stopReason = keys.empty() ? "no legal collapse left" : "target reached";
+    return;
+  }
+  Q.heap = Heap(EntryAfter(), std::move(entries));
+  runRegion(Q, tau);
+  Entry e;
+  out_.stopReason = peekValid(Q.heap, e) ? "level cost reached" : "no legal collapse left";
+}
+
+// Collapses the region's queued inner vertices up to cost tau (this file's head).
 void Simplifier::runRegion(Queue& Q, float tau) {
   Entry e, top;
   while (!Q.errorBound && peekValid(Q.heap, e) && e.cost <= tau) {
