@@ -5,7 +5,9 @@
 #include <cmath>
 #include <deque>
 #include <future>
+#include <string>
 
+#include "chunk.h"
 #include "pack/chunk_encode.h"
 #include "pack/level_error.h"
 #include "pack/region_stats.h"
@@ -60,7 +62,125 @@ class Encoder {
     return r ? b : r;
   }
 
+  // encodeUnit: the splits of a part's log from its handoff (split_encode.h). Nothing is
+  // compressed and no field error measured; the chunks are kept raw in `unit`.
+  Result runUnit(const UnitEncodeOptions& uo, UnitEncoded& unit) {
+    unit_ = &unit;
+    unitRoot_ = !uo.topIsRegion;
+    if (Result r = buildHandoff(uo); !r) return r;
+    planNodes();
+    if (Result r = encodeSplits(s_.log.size()); !r) return r;
+    // Every vertex and tet alive at the part's start is in pm_ now: its stable id, for the units
+    // whose handoffs are made of them.
+    unit.startVertex.assign(out_.streamVertexOf.size(), kNoStable);
+    for (size_t v = 0; v < out_.streamVertexOf.size(); ++v)
+      if (out_.streamVertexOf[v] != kNone) unit.startVertex[v] = stableVertex(out_.streamVertexOf[v]);
+    unit.startTet.assign(out_.streamTetOf.size(), kNoStable);
+    for (size_t t = 0; t < out_.streamTetOf.size(); ++t)
+      if (out_.streamTetOf[t] != kNone) unit.startTet[t] = stableTet(out_.streamTetOf[t]);
+    unit.handoff = std::move(out_.base);
+    return Result::success();
+  }
+
  private:
+  static constexpr uint64_t kNoStable = ~uint64_t(0);
+  // Counts and ids of the format stay below 2^31 (FORMAT.md §5); zz(j − j_prev) relies on it.
+  static constexpr uint64_t kMaxStable = (uint64_t(1) << 31) - 1;
+
+  // The stable id (FORMAT.md §1.1) of pm_'s vertex or tet. pm_ holds the handoff in ascending
+  // stable order, then the unit's new ones, whose stable ids follow vertexBegin_/tetBegin_ in
+  // creation order; all handoff ids lie below those, so the map is strictly increasing and every
+  // order the format takes by id is the same in pm_'s ids. Only ids written into records need
+  // it: the kept vertex and explicit new-tet vertices. In encodeStream the map is the identity
+  // (no handoff ids, begins 0).
+  uint32_t stableVertex(uint32_t v) const {
+    const size_t H = handoffVertexStable_.size();
+    return v < H ? handoffVertexStable_[v] : uint32_t(vertexBegin_ + (v - H));
+  }
+  uint32_t stableTet(uint32_t t) const {
+    const size_t H = handoffTetStable_.size();
+    return t < H ? handoffTetStable_[t] : uint32_t(tetBegin_ + (t - H));
+  }
+
+  // The handoff (the part's mesh at the end of its simplification) as pm_'s start: vertices and
+  // tets in ascending stable id order, values as the reader sees them (as buildBase).
+  Result buildHandoff(const UnitEncodeOptions& uo) {
+    const uint32_t V = mesh_.vertexCount(), T = uint32_t(s_.tetAlive.size());
+    if (uo.stableVertex.size() != V || uo.stableTet.size() != T || s_.vertexAlive.size() != V ||
+        s_.tets.size() != 4 * size_t(T))
+      return fail(Status::BadArgument, "encodeUnit: " + std::to_string(uo.stableVertex.size()) +
+                                           " stable vertex ids and " + std::to_string(uo.stableTet.size()) +
+                                           " stable tet ids for a part of " + std::to_string(V) + " vertices and " +
+                                           std::to_string(T) + " tets");
+    // Ascending by stable id; each below the unit's own, and distinct.
+    auto order = [](const std::vector<uint8_t>& alive, const std::vector<uint64_t>& stable, uint64_t begin,
+                    const char* what, const char* whats, std::vector<uint32_t>& ids,
+                    std::vector<uint32_t>& stableOf) -> Result {
+      ids.clear();
+      for (uint32_t x = 0; x < alive.size(); ++x)
+        if (alive[x]) ids.push_back(x);
+      std::sort(ids.begin(), ids.end(), [&](uint32_t a, uint32_t b) { return stable[a] < stable[b]; });
+      stableOf.resize(ids.size());
+      for (size_t k = 0; k < ids.size(); ++k) {
+        const uint64_t id = stable[ids[k]];
+        if (id >= begin)
+          return fail(Status::BadArgument, std::string("encodeUnit: ") + what + " " + std::to_string(ids[k]) +
+                                               " of the handoff has stable id " +
+                                               (id == kNoStable ? std::string("none") : std::to_string(id)) +
+                                               ", not below the unit's first, " + std::to_string(begin));
+        if (k && id == stableOf[k - 1])
+          return fail(Status::BadArgument,
+                      std::string("encodeUnit: two ") + whats + " of the handoff have stable id " + std::to_string(id));
+        stableOf[k] = uint32_t(id);
+      }
+      return Result::success();
+    };
+    std::vector<uint32_t> vertices, tets;
+    if (Result r = order(s_.vertexAlive, uo.stableVertex, uo.vertexBegin, "vertex", "vertices", vertices,
+                         handoffVertexStable_);
+        !r)
+      return r;
+    if (Result r = order(s_.tetAlive, uo.stableTet, uo.tetBegin, "tet", "tets", tets, handoffTetStable_); !r) return r;
+    // The splits create a vertex each and at most every tet not in the handoff.
+    if (uo.vertexBegin + s_.log.size() > kMaxStable || uo.tetBegin + (T - tets.size()) > kMaxStable)
+      return fail(Status::TooLarge, "encodeUnit: stable ids from vertex " + std::to_string(uo.vertexBegin) +
+                                        " and tet " + std::to_string(uo.tetBegin) +
+                                        " would pass the format's limit of 2^31 - 1 (FORMAT.md §5)");
+    vertexBegin_ = uo.vertexBegin;
+    tetBegin_ = uo.tetBegin;
+
+    out_.streamVertexOf.assign(V, kNone);
+    out_.streamTetOf.assign(T, kNone);
+    TetMesh& b = out_.base;
+    b = TetMesh{};
+    b.name = mesh_.name;
+    b.fields.resize(mesh_.fields.size());
+    for (size_t f = 0; f < mesh_.fields.size(); ++f) b.fields[f].name = mesh_.fields[f].name;
+    for (uint32_t v : vertices) {
+      out_.streamVertexOf[v] = b.vertexCount();
+      b.positions.insert(b.positions.end(), &mesh_.positions[3 * size_t(v)], &mesh_.positions[3 * size_t(v)] + 3);
+      for (size_t f = 0; f < mesh_.fields.size(); ++f) b.fields[f].values.push_back(valueAt(f, v));
+    }
+    for (uint32_t t : tets) {
+      out_.streamTetOf[t] = b.tetCount();
+      for (int k = 0; k < 4; ++k) {
+        const uint32_t v = out_.streamVertexOf[s_.tets[4 * size_t(t) + k]];
+        if (v == kNone)
+          return fail(Status::Corrupt, "encodeUnit: tet " + std::to_string(t) + " of the handoff has a dead vertex");
+        b.tets.push_back(v);
+      }
+    }
+    std::vector<uint32_t>().swap(s_.tets);  // (as buildBase)
+    initProgressive(pm_, b);
+    if (s_.valuesField >= 0) {
+      pm_.keptFirst = uint32_t(s_.valuesField);
+      pm_.keptCount = 1;
+      pm_.keptFixed = true;
+    }
+    reserveProgressive(pm_, V, T);
+    return Result::success();
+  }
+
   // In cost order: each split encoded and applied, a chunk flushed once it holds its share or
   // its node ends (a chunk holds the splits of one node: FORMAT.md §1.1).
   Result encodeSplits(uint32_t C) {
@@ -103,7 +223,7 @@ class Encoder {
     span_ = 0;
     if (C && (spans_.empty() || spans_.back().end != C))  // (a log in no section: one node, the root)
       spans_.assign(1, Span{1, 0, C});
-    stats_ = regionStats(mesh_, s_, m_);
+    if (!unit_) stats_ = regionStats(mesh_, s_, m_);  // (a unit's driver has the whole tree's)
     indexOf_.assign(std::max<uint32_t>(tree.nodes(), 2), -1);
   }
 
@@ -112,6 +232,15 @@ class Encoder {
   void beginNode() {
     const RegionTree& tree = s_.tree;
     const uint32_t n = spans_[span_].node;
+    if (unit_) {
+      unitNode_ = UnitNode{};
+      unitNode_.node = n;
+      unitNode_.firstChunk = uint32_t(unit_->chunks.size());
+      unitNode_.vertexBegin = stableVertexCount();
+      unitNode_.tetBegin = stableTetCount();
+      target_ = isRoot(n) ? opt_.firstChunkBytes : opt_.chunkBytes;
+      return;
+    }
     NodeInfo& info = node_;
     info = NodeInfo{};
     for (uint32_t up = n >> 1; up >= 1 && info.parent < 0; up >>= 1) info.parent = indexOf_[up];
@@ -141,10 +270,24 @@ class Encoder {
     }
     // The root's first chunk is small, for the first refinements to come soon after the base;
     // other nodes are fetched whole, chosen by what they show.
-    target_ = n == 1 ? opt_.firstChunkBytes : opt_.chunkBytes;
+    target_ = isRoot(n) ? opt_.firstChunkBytes : opt_.chunkBytes;
   }
 
+  // Node n of the tree is the whole mesh's root (a unit's top node is when its part is the root).
+  bool isRoot(uint32_t n) const { return n == 1 && (!unit_ || unitRoot_); }
+  // The whole stream's counts with pm_'s splits applied (a unit's: the ids its next split creates).
+  uint64_t stableVertexCount() const { return vertexBegin_ + (pm_.vertexCount() - handoffVertexStable_.size()); }
+  uint64_t stableTetCount() const { return tetBegin_ + (pm_.tetCount() - handoffTetStable_.size()); }
+
   void endNode() {
+    if (unit_) {
+      unitNode_.chunkCount = uint32_t(unit_->chunks.size()) - unitNode_.firstChunk;
+      unitNode_.vertexEnd = stableVertexCount();
+      unitNode_.tetEnd = stableTetCount();
+      unit_->nodes.push_back(unitNode_);
+      ++span_;
+      return;
+    }
     NodeInfo& info = node_;
     info.chunkCount = uint32_t(jobs_.size()) + 1 - info.firstChunk;
     info.vertexEnd = pm_.vertexCount();
@@ -160,7 +303,7 @@ class Encoder {
   // apply when the last byte arrives, instead of a whole large one. A rest smaller than that
   // stays in the chunk.
   bool tapers(uint32_t done, uint32_t left) const {
-    if (spans_[span_].node != 1) return false;
+    if (!isRoot(spans_[span_].node)) return false;
     const double least = opt_.firstChunkBytes * ratio_;
     const double rest = double(left) * double(flushedRaw_ + recordBytes()) / double(done);
     return double(recordBytes()) >= std::max(least, rest) && rest >= least;
@@ -286,6 +429,7 @@ class Encoder {
     flushedRaw_ += recordBytes();
     for (std::vector<uint8_t>& c : columns_) c.clear();
     inChunk_ = 0;
+    chunkError_ = 0;
     prevJ_ = 0;  // each chunk decodes on its own (FORMAT.md §4)
   }
 
@@ -300,7 +444,7 @@ class Encoder {
   uint32_t candidateIndex(uint32_t v) const {
     auto it = std::lower_bound(candidates_.begin(), candidates_.end(), v);
     if (it != candidates_.end() && *it == v) return uint32_t(it - candidates_.begin());
-    return uint32_t(candidates_.size()) + v;  // explicit id (FORMAT.md §4)
+    return uint32_t(candidates_.size()) + stableVertex(v);  // explicit id, stable (FORMAT.md §1.1, §4)
   }
 
   void putValue(std::vector<uint8_t>& out, float value, float predictor, const QuantAxis& axis) {
@@ -344,8 +488,10 @@ class Encoder {
     const uint32_t js = out_.streamVertexOf[j], is = pm_.vertexCount();
     assert(js != kNone && out_.streamVertexOf[i] == kNone);
     out_.streamVertexOf[i] = is;
-    putVarint(column(SplitColumn::KeptVertex), zigzag(int32_t(js) - int32_t(prevJ_)));
-    prevJ_ = js;
+    const uint32_t jStable = stableVertex(js);  // records name vertices by stable id (FORMAT.md §1.1)
+    putVarint(column(SplitColumn::KeptVertex), zigzag(int32_t(jStable) - int32_t(prevJ_)));
+    prevJ_ = jStable;
+    chunkError_ = std::max(chunkError_, log.fieldError[c]);
 
     // T_moved in stream tet ids, ascending (written by putMoved() once T_new is known).
     const CollapseTets& tets = tetsOf(c);
@@ -493,15 +639,36 @@ class Encoder {
     return cycle ? RingMode::Cycle : RingMode::Path;
   }
 
+  // The chunk's header (with `index`) and payload.
+  void writeChunk(std::vector<uint8_t>& raw, uint32_t index) const {
+    beginChunk(raw, ChunkKind::Splits, index);
+    putU32(raw, inChunk_);
+    putU32(raw, kSplitFlagColumns | kSplitFlagImpliedMoved | (opt_.ringWalk ? kSplitFlagRingWalk : 0) |
+                    (q_.lossless ? kSplitFlagLossless : 0) | (s_.valuesField >= 0 ? kSplitFlagKeptIsoValue : 0));
+    for (const std::vector<uint8_t>& c : columns_) putU32(raw, uint32_t(c.size()));
+    for (const std::vector<uint8_t>& c : columns_) raw.insert(raw.end(), c.begin(), c.end());
+  }
+
+  // A unit's chunk stays raw, its index 0 until the driver knows it (finishUnitChunk). Its size
+  // aimed at uses the assumed ratio_, never updated: the real one is known after compression.
+  void flushUnitChunk() {
+    UnitChunk& chunk = unit_->chunks.emplace_back();
+    writeChunk(chunk.raw, 0);
+    chunk.splits = inChunk_;
+    chunk.vertices = stableVertexCount();
+    chunk.tets = stableTetCount();
+    chunk.maxCollapseError = chunkError_;
+    target_ = std::min<uint64_t>(2 * target_, opt_.chunkBytes);
+    startChunk();
+  }
+
   Result flushChunk(uint32_t splitsApplied) {
+    if (unit_) {
+      flushUnitChunk();
+      return Result::success();
+    }
     Job& job = jobs_.emplace_back();
-    const uint32_t index = uint32_t(jobs_.size());
-    beginChunk(job.raw, ChunkKind::Splits, index);
-    putU32(job.raw, inChunk_);
-    putU32(job.raw, kSplitFlagColumns | kSplitFlagImpliedMoved | (opt_.ringWalk ? kSplitFlagRingWalk : 0) |
-                        (q_.lossless ? kSplitFlagLossless : 0) | (s_.valuesField >= 0 ? kSplitFlagKeptIsoValue : 0));
-    for (const std::vector<uint8_t>& c : columns_) putU32(job.raw, uint32_t(c.size()));
-    for (const std::vector<uint8_t>& c : columns_) job.raw.insert(job.raw.end(), c.begin(), c.end());
+    writeChunk(job.raw, uint32_t(jobs_.size()));
     job.info.kind = ChunkKind::Splits;
     job.info.vertices = pm_.vertexCount();
     job.info.tets = pm_.tetCount();
@@ -584,6 +751,14 @@ class Encoder {
   float range_ = 0;                      // the isoField's range (no estimate exceeds it)
   uint64_t flushedRaw_ = 0;              // record bytes of the chunks before the current one
   double ratio_ = 2.5;
+  // encodeUnit only: where the chunks go, and the stable ids of pm_'s handoff (by pm_ id) and of
+  // the unit's first new vertex and tet (stableVertex).
+  UnitEncoded* unit_ = nullptr;
+  bool unitRoot_ = false;  // the unit's top node is the whole mesh's root
+  UnitNode unitNode_;
+  std::vector<uint32_t> handoffVertexStable_, handoffTetStable_;
+  uint64_t vertexBegin_ = 0, tetBegin_ = 0;
+  float chunkError_ = 0;  // the largest CollapseLog::fieldError of the current chunk's splits
 };
 
 }  // namespace
@@ -596,6 +771,34 @@ Result encodeStream(const TetMesh& mesh, SimplifyResult& s, const Manifest& m, c
     return fail(Status::Unsupported, "fitted values of a field other than the manifest's isoField");
   Encoder e(mesh, s, m, opt, out);
   return e.run();
+}
+
+Result encodeUnit(const TetMesh& mesh, SimplifyResult& s, const Manifest& m, const UnitEncodeOptions& opt,
+                  UnitEncoded& out) {
+  out = UnitEncoded{};
+  if (s.valuesField >= 0 && m.findField(m.isoField) != s.valuesField)
+    return fail(Status::Unsupported, "fitted values of a field other than the manifest's isoField");
+  if (opt.stream.orderSplits) return fail(Status::Unsupported, "encodeUnit: splits in kept-vertex order");
+  EncodedStream scratch;  // the encoder's maps and the handoff while it is built
+  Encoder e(mesh, s, m, opt.stream, scratch);
+  return e.runUnit(opt, out);
+}
+
+Result finishUnitChunk(UnitChunk& chunk, uint32_t index, int zstdLevel, std::vector<uint8_t>& file, ChunkInfo& info) {
+  if (chunk.raw.size() < kChunkHeaderBytes)
+    return fail(Status::BadArgument, "finishUnitChunk: a chunk of " + std::to_string(chunk.raw.size()) + " bytes");
+  constexpr uint64_t kMaxCount = (uint64_t(1) << 31) - 1;  // FORMAT.md §5
+  if (chunk.vertices > kMaxCount || chunk.tets > kMaxCount)
+    return fail(Status::TooLarge, "chunk " + std::to_string(index) + ": " + std::to_string(chunk.vertices) +
+                                      " vertices and " + std::to_string(chunk.tets) +
+                                      " tets after it, past the format's limit of 2^31 - 1 (FORMAT.md §5)");
+  for (int k = 0; k < 4; ++k) chunk.raw[8 + size_t(k)] = uint8_t(index >> (8 * k));  // header: chunk index
+  if (Result r = finishChunk(chunk.raw, zstdLevel, file, info); !r) return r;
+  info.kind = ChunkKind::Splits;
+  info.splits = chunk.splits;
+  info.vertices = uint32_t(chunk.vertices);
+  info.tets = uint32_t(chunk.tets);
+  return Result::success();
 }
 
 }  // namespace tetstream

@@ -56,10 +56,13 @@ Result encodeStream(const TetMesh& mesh, SimplifyResult& s, const Manifest& m, c
 // stable ids of its handoff, which the unit above it hands down; the ids its own splits create
 // are a range known from the counts of the units before it in manifest order.
 struct UnitEncodeOptions {
-  StreamOptions stream;                // (orderSplits is not supported here; no progress needed)
-  std::vector<uint64_t> stableVertex;  // per vertex of the part's mesh alive at the end: its stable id (else ~0)
-  std::vector<uint64_t> stableTet;     // per tet of the part alive at the end: its stable id (else ~0)
+  StreamOptions stream;                    // (orderSplits is not supported here; no progress needed)
+  std::vector<uint64_t> stableVertex;      // per vertex of the part's mesh alive at the end: its stable id (else ~0)
+  std::vector<uint64_t> stableTet;         // per tet of the part alive at the end: its stable id (else ~0)
   uint64_t vertexBegin = 0, tetBegin = 0;  // the stable ids of the unit's first new vertex and tet
+  // As SimplifyPart::topIsRegion: false, the part is the root and its top node's chunks start at
+  // firstChunkBytes and taper like encodeStream's root; true, all its chunks aim at chunkBytes.
+  bool topIsRegion = false;
 };
 
 // One split chunk, not yet compressed: its index in the manifest is known only once every unit
@@ -68,23 +71,30 @@ struct UnitChunk {
   std::vector<uint8_t> raw;  // header (index 0 for now) and payload
   uint32_t splits = 0;
   uint64_t vertices = 0, tets = 0;  // the whole stream's counts after this chunk (stable ids)
-  float maxCollapseError = 0;       // the largest CollapseLog::fieldError of its splits
+  // The largest CollapseLog::fieldError of its splits, as logged (not yet capped at the field's
+  // range as encodeStream's chunk estimates are).
+  float maxCollapseError = 0;
 };
 
 // A node of the unit: the section of the part's log made by `node` (RegionTree numbering of the
 // part's own tree), in the unit's order (the part's top node first, leaves last).
 struct UnitNode {
   uint32_t node = 0;
-  uint32_t firstChunk = 0, chunkCount = 0;  // in UnitEncoded::chunks
+  uint32_t firstChunk = 0, chunkCount = 0;                            // in UnitEncoded::chunks
   uint64_t vertexBegin = 0, vertexEnd = 0, tetBegin = 0, tetEnd = 0;  // stable ids
 };
 
 struct UnitEncoded {
   std::vector<UnitChunk> chunks;
   std::vector<UnitNode> nodes;
-  TetMesh handoff;  // the handoff mesh in stable order (vertex k: the k-th smallest stable id): the base, for the root unit
+  // The handoff mesh in stable order (vertex k: the k-th smallest stable id; tets likewise, their
+  // vertices by that rank) with the values a reader decodes (fitted values snapped): the base,
+  // for the root unit.
+  TetMesh handoff;
   // After all splits: per vertex and tet of the part's mesh alive at its start (before any of
-  // its collapses), its stable id (~0 otherwise): the stable ids the units below need.
+  // its collapses), its stable id (~0 otherwise): the stable ids the units below need. A vertex
+  // or tet of the handoff keeps the id it was given; one the unit's m-th split creates has
+  // vertexBegin + m (tets: tetBegin plus its place among the recreated tets, in record order).
   std::vector<uint64_t> startVertex, startTet;
 };
 
@@ -93,10 +103,15 @@ struct UnitEncoded {
 // encodeStream (its nodes' sections from the last to the first, each newest collapse first), and
 // chunk sizes aim at the same bytes with an assumed compression ratio (the real one is known only
 // after compression). No field error is measured (the optional fieldRms/fieldMax keys).
+// Stable ids are read where s.vertexAlive/s.tetAlive hold; each must be below vertexBegin/tetBegin
+// and none taken twice (BadArgument otherwise), and the unit's ids must stay below 2^31 (TooLarge).
+// Like encodeStream, it releases s.tets.
 Result encodeUnit(const TetMesh& mesh, SimplifyResult& s, const Manifest& m, const UnitEncodeOptions& opt,
                   UnitEncoded& out);
 
-// Sets the chunk's manifest index in its header and compresses it (finishChunk).
+// Sets the chunk's manifest index in its header (bytes 8-11) and compresses it (finishChunk);
+// fills `info` except its file name and fieldError (the caller's: they span units). Counts of
+// 2^31 or more are refused (TooLarge), as readers would (FORMAT.md §5).
 Result finishUnitChunk(UnitChunk& chunk, uint32_t index, int zstdLevel, std::vector<uint8_t>& file, ChunkInfo& info);
 
 }  // namespace tetstream
