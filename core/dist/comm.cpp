@@ -132,7 +132,7 @@ void Comm::barrier() { MPI_Barrier(MPI_COMM_WORLD); }
 
 Result Comm::agree(const Result& mine, bool secondary) {
   // The lowest rank that failed first-hand, else the lowest that failed at all.
-  int key[2] = {!mine || secondary ? size_ : rank_, mine ? size_ : rank_};
+  int key[2] = {!mine && !secondary ? rank_ : size_, mine ? size_ : rank_};
   MPI_Allreduce(MPI_IN_PLACE, key, 2, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
   if (key[1] == size_) return Result::success();
   const int root = key[0] < size_ ? key[0] : key[1];

@@ -301,11 +301,15 @@ Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& 
   shared.fieldMax = m.fields[size_t(iso)].range.max;
   shared.diagonal = m.bounds.diagonal() > 0 ? m.bounds.diagonal() : 1.0;
   shared.meanVertexVolume = meanVertexVolume(comm, part);
-  uint64_t target = opt.baseVertices ? opt.baseVertices
-                                     : uint64_t(std::llround(std::clamp(opt.baseFraction, 0.0, 1.0) * m.vertices));
+  shared.inputVertices = m.vertices;
+  uint64_t target =
+      opt.baseVertices ? opt.baseVertices : uint64_t(std::llround(std::clamp(opt.baseFraction, 0.0, 1.0) * m.vertices));
   if (!opt.baseVertices && opt.baseFraction > 0)
     target = std::max<uint64_t>(std::min<uint64_t>(target, opt.maxBaseVertices),
                                 std::min<uint64_t>(opt.minBaseVertices, m.vertices));
+  std::vector<uint64_t> ownedPerRank(static_cast<size_t>(N), 0);
+  ownedPerRank[size_t(me)] = ownedCount(part);
+  comm.sumInPlace(ownedPerRank);
   auto simplifyUnit = [&](Unit& u, const CarriedVertexState* carried) {
     const RankTree::Group& g = tree.groups[size_t(u.group)];
     SimplifyPart sp = shared;
@@ -323,7 +327,10 @@ Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& 
     so.fitValues = opt.fitValues;
     so.field = iso;
     so.maxError = opt.maxError;
-    const double share = m.vertices ? double(ownedCount(u.part)) / m.vertices : 1.0;
+    // The part's share of the base: the input vertices its group's region holds.
+    uint64_t held = 0;
+    for (int k = g.first; k < g.first + g.count; ++k) held += ownedPerRank[size_t(k)];
+    const double share = m.vertices ? double(held) / m.vertices : 1.0;
     so.targetVertices = uint32_t(std::max<double>(4, std::llround(double(target) * share)));
     so.targetTets = opt.baseTets ? uint32_t(std::llround(opt.baseTets * share)) : 0;
     so.part = &sp;
@@ -396,6 +403,7 @@ Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& 
     uo.stream.zstdLevel = opt.zstdLevel;
     uo.stream.ringWalk = opt.ringWalk;
     uo.stream.threads = opt.threads;
+    uo.topIsRegion = u.group != 0;
     uo.vertexBegin = layout.vertexBegin[size_t(u.group)];
     uo.tetBegin = layout.tetBegin[size_t(u.group)];
     std::vector<uint64_t> handVertex, handTet;  // stable ids of the handoff, in its order
@@ -415,8 +423,8 @@ Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& 
       Reader in(got);
       handVertex = in.getVector<uint64_t>();
       handTet = in.getVector<uint64_t>();
-      if (status && (!in.atEnd() || handVertex.size() != u.handoff.vertexId.size() ||
-                     handTet.size() != u.handoff.tetId.size()))
+      if (status &&
+          (!in.atEnd() || handVertex.size() != u.handoff.vertexId.size() || handTet.size() != u.handoff.tetId.size()))
         status = fail(Status::Corrupt, "stable ids from the rank above are damaged");
     }
     if (status) status = encodeOne(u, handVertex, handTet, m, uo);

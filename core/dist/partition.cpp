@@ -149,8 +149,8 @@ Result distribute(Comm& comm, TetMesh&& mesh, uint64_t firstTetId, const RankTre
   const uint32_t V = mesh.vertexCount(), T = mesh.tetCount();
   std::vector<int> owner(V, -1);
   for (uint32_t v : mesh.tets) {
-    if (v >= V) return fail(Status::OutOfRange, "a tetrahedron names vertex " + std::to_string(v) + " of " +
-                                                    std::to_string(V));
+    if (v >= V)
+      return fail(Status::OutOfRange, "a tetrahedron names vertex " + std::to_string(v) + " of " + std::to_string(V));
     if (owner[v] < 0) owner[v] = tree.ownerOf(&mesh.positions[3 * size_t(v)]);
   }
   // (destination, tet) pairs, by destination.
@@ -211,14 +211,16 @@ Result distribute(Comm& comm, TetMesh&& mesh, uint64_t firstTetId, const RankTre
     Reader r(in[size_t(s)]);
     const uint64_t nv = r.get<uint64_t>();
     tableSize[size_t(s)] = nv;
-    if (!r.ok() || nv > in[size_t(s)].size()) return fail(Status::Corrupt, "a message from rank " + std::to_string(s) + " is damaged");
+    if (!r.ok() || nv > in[size_t(s)].size())
+      return fail(Status::Corrupt, "a message from rank " + std::to_string(s) + " is damaged");
     for (uint64_t k = 0; k < nv; ++k) {
       const uint64_t at = values.size();
       for (size_t x = 0; x < 3 + F; ++x) values.push_back(r.get<float>());
       copies.push_back({keyOf(&values[at]), uint32_t(s), uint32_t(k), at});
     }
     const uint64_t nt = r.get<uint64_t>();
-    if (!r.ok() || nt > in[size_t(s)].size()) return fail(Status::Corrupt, "a message from rank " + std::to_string(s) + " is damaged");
+    if (!r.ok() || nt > in[size_t(s)].size())
+      return fail(Status::Corrupt, "a message from rank " + std::to_string(s) + " is damaged");
     for (uint64_t k = 0; k < nt; ++k) {
       tetIds[size_t(s)].push_back(r.get<uint64_t>());
       for (int c = 0; c < 4; ++c) tetCorners[size_t(s)].push_back(r.get<uint32_t>());
@@ -226,9 +228,8 @@ Result distribute(Comm& comm, TetMesh&& mesh, uint64_t firstTetId, const RankTre
     if (!r.atEnd()) return fail(Status::Corrupt, "a message from rank " + std::to_string(s) + " is damaged");
     in[size_t(s)] = {};
   }
-  std::sort(copies.begin(), copies.end(), [](const Copy& a, const Copy& b) {
-    return a.key < b.key || (a.key == b.key && a.source < b.source);
-  });
+  std::sort(copies.begin(), copies.end(),
+            [](const Copy& a, const Copy& b) { return a.key < b.key || (a.key == b.key && a.source < b.source); });
   // Unique points (in key order) and where each sender's table entries went.
   std::vector<std::vector<uint32_t>> localOf(static_cast<size_t>(N));
   for (int s = 0; s < N; ++s) localOf[size_t(s)].assign(tableSize[size_t(s)], 0);

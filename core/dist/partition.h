@@ -30,7 +30,7 @@ struct RankTree {
     int first = 0, count = 1;  // ranks [first, first + count)
     int axis = 0;              // the cut (groups of two ranks or more): the low side's points have
     uint64_t cutKey = 0;       // orderKey(coordinate) < cutKey (partition.cpp)
-    int low = -1, high = -1;  // child groups (indices), -1 for a single rank
+    int low = -1, high = -1;   // child groups (indices), -1 for a single rank
     int parent = -1;
   };
   std::vector<Group> groups;  // groups[0] holds every rank; children after their parents
@@ -47,8 +47,8 @@ struct RankTree {
 RankTree cutRegions(Comm& comm, const TetMesh& mesh);
 
 struct DistributionReport {
-  uint64_t joinedPoints = 0;                     // points that several ranks' pieces held
-  std::vector<uint64_t> disagreements;           // per field: joined points whose copies differed
+  uint64_t joinedPoints = 0;            // points that several ranks' pieces held
+  std::vector<uint64_t> disagreements;  // per field: joined points whose copies differed
 };
 
 // Sends the tets of `mesh` (whose first tet has input id firstTetId) to their owners and builds

@@ -60,8 +60,9 @@ RegionFigures regionFigures(Comm& comm, const PartMesh& part, const Manifest& m)
     std::vector<Range> ranges(F);
     for (size_t f = 0; f < F; ++f) {
       const Range whole = m.fields[f].range;
-      ranges[f] = l[3 + f] <= h[3 + f] ? Range{std::max(float(l[3 + f]), whole.min), std::min(float(h[3 + f]), whole.max)}
-                                       : Range{whole.min, whole.min};
+      ranges[f] = l[3 + f] <= h[3 + f]
+                      ? Range{std::max(float(l[3 + f]), whole.min), std::min(float(h[3 + f]), whole.max)}
+                      : Range{whole.min, whole.min};
       if (!(ranges[f].min <= ranges[f].max)) ranges[f] = {whole.min, whole.min};
     }
     out.ranges.push_back(std::move(ranges));

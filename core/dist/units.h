@@ -33,8 +33,8 @@ struct Unit {
 // Every rank's region: the bounding box and each field's range over its owned points (on the
 // quantization grid, within the manifest's ranges).
 struct RegionFigures {
-  std::vector<Bounds> bounds;               // per rank
-  std::vector<std::vector<Range>> ranges;   // per rank, per field
+  std::vector<Bounds> bounds;              // per rank
+  std::vector<std::vector<Range>> ranges;  // per rank, per field
   Bounds groupBounds(const RankTree::Group& g) const;
   Range groupRange(const RankTree::Group& g, size_t field) const;
 };

@@ -65,7 +65,7 @@ NodeFigures nodeFigures(const Unit& u, const RankTree& tree, const RegionFigures
     for (size_t f = 0; f < F; ++f) {
       const Range gr = regions.groupRange(g, f);
       Range& x = out.ranges[n][f];
-      if (!(x.min <= x.max)) x = {gr.min, gr.min};
+      if (!(x.min <= x.max)) x = gr;
       x.min = std::clamp(x.min, gr.min, gr.max);
       x.max = std::clamp(x.max, x.min, gr.max);
     }
@@ -149,7 +149,7 @@ Result writeDistributed(Comm& comm, const RankTree& tree, const UnitLayout& layo
     }
     for (const Result& r : results)
       if (status && !r) status = r;
-    for (size_t k = 0; k < n; ++k) rep.chunkError[k] = u.encoded.chunks[k].maxCollapseError;
+    for (size_t k = 0; k < n; ++k) rep.chunkError[k] = u.encoded.chunks[k].maxCollapseError;  // (capped at assembly)
     rep.nodes = u.encoded.nodes;
     const NodeFigures figures = nodeFigures(u, tree, regions, F);
     for (const UnitNode& node : rep.nodes) {
@@ -264,7 +264,8 @@ Result writeDistributed(Comm& comm, const RankTree& tree, const UnitLayout& layo
   // A node's error: the largest of its collapses and those below it (in place while its splits
   // are not applied); a chunk's: the largest of the collapses in the chunks after it.
   for (size_t n = m.nodes.size(); n-- > 0;)
-    if (m.nodes[n].parent >= 0) nodeError[size_t(m.nodes[n].parent)] = std::max(nodeError[size_t(m.nodes[n].parent)], nodeError[n]);
+    if (m.nodes[n].parent >= 0)
+      nodeError[size_t(m.nodes[n].parent)] = std::max(nodeError[size_t(m.nodes[n].parent)], nodeError[n]);
   for (size_t n = 0; n < m.nodes.size(); ++n) m.nodes[n].fieldError = std::min(range, nodeError[n]);
   float after = 0;
   for (size_t c = m.chunks.size(); c-- > 0;) {

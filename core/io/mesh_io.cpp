@@ -335,7 +335,8 @@ Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const
   const bool listing = listingKind(head) != ListingKind::None;
   if (fmt == Format::Listing && !listing && !vtkio::vtkXmlFileType(head).empty()) fmt = Format::VtkXml;
   if (fmt == Format::Listing || (fmt == Format::VtkXml && listing))
-    return guarded(path, out, [&] { return readListing(bytes, path, pieceFiles(path), out, report, options.shareIndex, options.shareCount);
+    return guarded(path, out, [&] {
+      return readListing(bytes, path, pieceFiles(path), out, report, options.shareIndex, options.shareCount);
     });
   return guarded(path, out, [&] { return readOneFile(fmt, bytes, path, out, report); });
 }

@@ -10,8 +10,8 @@
 #include <utility>
 
 #include "chunk_encode.h"
-#include "pack/pack_output.h"
 #include "io/file_writer.h"
+#include "pack/pack_output.h"
 #include "pack/renumber.h"
 #include "pack/simplify.h"
 #include "pack/split_encode.h"
@@ -258,12 +258,15 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   fs::create_directories(fs::path(outDir) / "chunks", ec);
   if (ec) return fail(Status::IoError, outDir + ": cannot create folder: " + ec.message());
   base.file = chunkFileName(0, base.hash);
-  if (Result r = writeWholeFile((fs::path(outDir) / base.file).string(), baseFile.data(), baseFile.size()); !r) return r;
+  if (Result r = writeWholeFile((fs::path(outDir) / base.file).string(), baseFile.data(), baseFile.size()); !r)
+    return r;
   m.chunks.push_back(base);
   for (size_t c = 0; c < enc.files.size(); ++c) {
     ChunkInfo info = enc.chunks[c];
     info.file = chunkFileName(uint32_t(c + 1), info.hash);
-    if (Result r = writeWholeFile((fs::path(outDir) / info.file).string(), enc.files[c].data(), enc.files[c].size()); !r) return r;
+    if (Result r = writeWholeFile((fs::path(outDir) / info.file).string(), enc.files[c].data(), enc.files[c].size());
+        !r)
+      return r;
     m.chunks.push_back(info);
   }
   // One region alone (a small mesh, --leaf-vertices 0) is no hierarchy: one sequence of chunks.

@@ -398,7 +398,8 @@ class Simplifier {
   // How the tree is cut and how far each level goes: simplify_tree.cpp.
   void buildTree();
   void runTree(uint32_t target);
-  void runRegion(Queue& Q, float tau);
+  // (At most maxCollapses of them: a part's top keeps its share of the base, runTop.)
+  void runRegion(Queue& Q, float tau, uint32_t maxCollapses = ~0u);
   void markInner(const std::vector<uint32_t>& region);
   bool levelTau(std::vector<float>& keys, uint32_t target, float& tau) const;
   void markTopInner();

@@ -238,16 +238,22 @@ void Simplifier::runTop(Queue& Q, uint32_t target) {
     out_.stopReason = keys.empty() ? "no legal collapse left" : "target reached";
     return;
   }
+  // The top goes no further than its share of the base plus what it cannot collapse (the owned
+  // vertices next to the halo, which the parts above collapse): the root, not a part, decides
+  // what the base keeps, and a part that went below its share would leave the cuts to the base.
+  uint32_t fixed = 0;
+  for (uint32_t v = 0; v < V_; ++v) fixed += out_.vertexAlive[v] && owned(v) && !inner_[v];
+  const uint32_t alive = countedAlive(), keep = target + fixed;
   Q.heap = Heap(EntryAfter(), std::move(entries));
-  runRegion(Q, tau);
+  runRegion(Q, tau, alive > keep ? alive - keep : 0);
   Entry e;
   out_.stopReason = peekValid(Q.heap, e) ? "level cost reached" : "no legal collapse left";
 }
 
 // Collapses the region's queued inner vertices up to cost tau (this file's head).
-void Simplifier::runRegion(Queue& Q, float tau) {
+void Simplifier::runRegion(Queue& Q, float tau, uint32_t maxCollapses) {
   Entry e, top;
-  while (!Q.errorBound && peekValid(Q.heap, e) && e.cost <= tau) {
+  while (!Q.errorBound && Q.collapsed < maxCollapses && peekValid(Q.heap, e) && e.cost <= tau) {
     Q.heap.pop();
     queued_[e.vertex] = 0;
     if (!Q.heap.empty()) prefetchStar(Q.heap.top().vertex);
