@@ -341,11 +341,12 @@ Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const
   return guarded(path, out, [&] { return readOneFile(fmt, bytes, path, out, report); });
 }
 
-Result writeMesh(const std::string& path, const TetMesh& mesh) {
+Result writeMesh(const std::string& path, const TetMesh& mesh, uint32_t pieces) {
   std::string ext = lowerExtension(path);
-  if (ext != ".vtu") return fail(Status::Unsupported, path + ": can only write .vtu, not '" + ext + "'");
+  if (ext != ".vtu" && ext != ".pvtu")
+    return fail(Status::Unsupported, path + ": can only write .vtu or .pvtu, not '" + ext + "'");
   try {
-    return writeVtu(path, mesh);
+    return ext == ".pvtu" ? writePvtu(path, mesh, pieces) : writeVtu(path, mesh);
   } catch (const std::bad_alloc&) {
     return fail(Status::TooLarge, path + ": out of memory while writing");
   }

@@ -109,6 +109,6 @@ Result readMeshBytes(std::string_view bytes, const std::string& name, TetMesh& o
 // BadArgument when the mesh's arrays disagree in size (e.g. a field with the wrong length),
 // IoError when the file cannot be written. Writes to PATH.tmp and renames, so a failed write never
 // leaves a half file under PATH.
-Result writeMesh(const std::string& path, const TetMesh& mesh);
+Result writeMesh(const std::string& path, const TetMesh& mesh, uint32_t pieces = 1);
 
 }  // namespace tetstream

@@ -106,6 +106,11 @@ Result readListing(std::string_view listing, const std::string& label, const Pie
 // point data. One fwrite per array; writes PATH.tmp, then renames.
 Result writeVtu(const std::string& path, const TetMesh& mesh);
 
+// The mesh as the partitioned output of a parallel run: PATH.pvtu listing `pieces` .vtu files
+// in the folder PATH (without .pvtu) beside it, piece k holding the k-th of `pieces` equal runs
+// of tets and the points they use (interface points repeated), no ghost cells.
+Result writePvtu(const std::string& path, const TetMesh& mesh, uint32_t pieces);
+
 // ------------------------------------------------------------------ shared by the readers
 namespace vtkio {
 

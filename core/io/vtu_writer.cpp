@@ -2,10 +2,12 @@
 // by default, so VTK, ParaView and meshio read it without base64 or compression overhead.
 // Each appended array is [UInt64 byte count][little-endian values]; one fwrite per array keeps a
 // 1.5M-tet mesh (~100 MB of ids) to a handful of large writes.
+#include <algorithm>
 #include <bit>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -92,6 +94,55 @@ Result writeVtu(const std::string& path, const TetMesh& mesh) {
   }
   const char tail[] = "\n  </AppendedData>\n</VTKFile>\n";
   out.write(tail, sizeof tail - 1);
+  return out.commit();
+}
+
+Result writePvtu(const std::string& path, const TetMesh& mesh, uint32_t pieces) {
+  namespace fs = std::filesystem;
+  const fs::path listing(path);
+  const std::string stem = listing.stem().string();
+  std::error_code ec;
+  fs::create_directories(listing.parent_path() / stem, ec);
+  if (ec)
+    return fail(Status::IoError, (listing.parent_path() / stem).string() + ": cannot create folder: " + ec.message());
+  const uint64_t T = mesh.tetCount();
+  pieces = uint32_t(std::clamp<uint64_t>(pieces, 1, std::max<uint64_t>(T, 1)));
+  std::string text =
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"PUnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\" "
+      "header_type=\"UInt64\">\n  <PUnstructuredGrid GhostLevel=\"0\">\n    <PPointData>\n";
+  for (const ScalarField& f : mesh.fields)
+    text += "      <PDataArray type=\"Float32\" Name=\"" + xmlEscape(f.name) + "\"/>\n";
+  text +=
+      "    </PPointData>\n    <PPoints>\n      <PDataArray type=\"Float32\" NumberOfComponents=\"3\"/>\n    "
+      "</PPoints>\n";
+  std::vector<uint32_t> local(mesh.vertexCount(), ~0u);
+  for (uint32_t k = 0; k < pieces; ++k) {
+    // Piece k: the tets of its range and the points they use (a point on an interface is in
+    // every piece that uses it, as parallel writers do).
+    TetMesh piece;
+    piece.name = mesh.name;
+    for (const ScalarField& f : mesh.fields) piece.fields.push_back({f.name, {}});
+    std::vector<uint32_t> used;
+    for (uint64_t t = T * k / pieces; t < T * (k + 1) / pieces; ++t)
+      for (int c = 0; c < 4; ++c) {
+        const uint32_t v = mesh.tets[4 * t + size_t(c)];
+        if (local[v] == ~0u) {
+          local[v] = uint32_t(used.size());
+          used.push_back(v);
+          piece.positions.insert(piece.positions.end(), &mesh.positions[3 * size_t(v)],
+                                 &mesh.positions[3 * size_t(v)] + 3);
+          for (size_t f = 0; f < mesh.fields.size(); ++f) piece.fields[f].values.push_back(mesh.fields[f].values[v]);
+        }
+        piece.tets.push_back(local[v]);
+      }
+    for (uint32_t v : used) local[v] = ~0u;
+    const std::string name = stem + "/" + stem + "_" + std::to_string(k) + ".vtu";
+    if (Result r = writeVtu((listing.parent_path() / name).string(), piece); !r) return r;
+    text += "    <Piece Source=\"" + xmlEscape(name) + "\"/>\n";
+  }
+  text += "  </PUnstructuredGrid>\n</VTKFile>\n";
+  FileWriter out(path);
+  out.write(text.data(), text.size());
   return out.commit();
 }
 

@@ -52,6 +52,15 @@ for value in 0 0.25 0.5; do
 done
 echo "ok: the isosurfaces equal the serial pack's"
 
+# --max-memory is per rank: too little for the whole mesh on one rank is enough for a quarter.
+set +e
+one=$(timeout 120 "${MPIRUN[@]}" -np 1 "$TETSTREAM" pack "$WORK/pieces/ghost.pvtu" -o "$WORK/small1" --max-memory 0.006 2>&1)
+code=$?
+set -e
+[ $code -ne 0 ] && echo "$one" | grep -q "use more ranks" || { echo "FAIL: 1 rank within 6 MB: $one"; exit 1; }
+timeout 120 "${MPIRUN[@]}" -np 4 "$TETSTREAM" pack "$WORK/pieces/ghost.pvtu" -o "$WORK/small4" --max-memory 0.006 >/dev/null
+echo "ok: --max-memory 0.006 refuses 1 rank ($(echo "$one" | grep -o 'needs about [0-9]* MB')) and packs on 4"
+
 # A missing piece: every rank stops, one message names the piece, no hang.
 set +e
 msg=$(timeout 120 "${MPIRUN[@]}" -np 4 "$TETSTREAM" pack "$WORK/pieces/broken.pvtu" -o "$WORK/broken" 2>&1)

@@ -10,6 +10,7 @@
 #include "io/generators.h"
 #include "io/mesh_io.h"
 #include "io/ply_writer.h"
+#include "quantize.h"
 #include "test_helpers.h"
 
 namespace tetstream {
@@ -67,6 +68,31 @@ TEST(VtuWriter, RejectsInconsistentMeshAndOtherExtensions) {
   EXPECT_NE(r.message.find("'short'"), std::string::npos) << r.message;
   EXPECT_EQ(writeMesh(dir + "/a.obj", makeGridMesh(2)).status, Status::Unsupported);
   EXPECT_EQ(writeMesh(dir + "/no/such/dir/a.vtu", makeGridMesh(2)).status, Status::IoError);
+}
+
+// The mesh as the pieces of a parallel run: read back (pieces welded at their shared points) it
+// is the same mesh; every piece is a .vtu of its own.
+TEST(VtuWriter, PiecesOfAParallelRunReadBackAsTheMesh) {
+  test::ScratchDir scratch("pvtu-pieces");
+  TetMesh m = makeGridMesh(9);
+  addHarmonicField(m);
+  ASSERT_TRUE(writeMesh(scratch.path + "/h.pvtu", m, 3));
+  TetMesh back;
+  ReadReport r;
+  ASSERT_TRUE(readMesh(scratch.path + "/h.pvtu", back, r));
+  EXPECT_NE(r.format.find("3 pieces"), std::string::npos) << r.format;
+  Manifest q;
+  q.bounds = computeBounds(m.positions);
+  q.fields.push_back({"harmonic", computeRange(m.fields[0].values)});
+  test::expectSameMesh(m, back, makeQuantizer(q), true);
+  for (int k = 0; k < 3; ++k) {
+    TetMesh piece;
+    ReadReport pr;
+    ASSERT_TRUE(readMesh(scratch.path + "/h/h_" + std::to_string(k) + ".vtu", piece, pr));
+    EXPECT_GT(piece.tetCount(), m.tetCount() / 4);
+    EXPECT_LT(piece.tetCount(), m.tetCount() / 2);
+  }
+  EXPECT_EQ(writeMesh(scratch.path + "/a.obj", m, 3).status, Status::Unsupported);
 }
 
 // Independent readers (meshio, VTK) see what we wrote.
