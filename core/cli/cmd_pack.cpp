@@ -135,7 +135,10 @@ int packOnRanks(const Opts& o, bool maxErrorSet, bool baseVerticesSet, bool base
                      {"tets", f.tets},
                      {"peakMemoryMB", f.peakMB},
                      {"simplifyMs", f.simplifyMs},
-                     {"encodeMs", f.encodeMs}});
+                     {"partMs", f.partMs},
+                     {"combineMs", f.combineMs},
+                     {"encodeMs", f.encodeMs},
+                     {"cpuSeconds", f.cpuSeconds}});
   }
   if (o.json) {
     printJson({{"output", o.out},
@@ -175,10 +178,11 @@ int packOnRanks(const Opts& o, bool maxErrorSet, bool baseVerticesSet, bool base
   std::printf("  time      read %.0f ms, partition %.0f ms, simplify %.0f ms, all %.0f ms\n", s.readMs, s.partitionMs,
               s.combineMs, total.ms());
   for (size_t k = 0; k < s.ranks.size(); ++k)
-    std::printf("  rank %-4zu %llu vertices, %llu tets; simplify %.0f ms, encode %.0f ms; peak memory %.0f MB\n", k,
-                static_cast<unsigned long long>(s.ranks[k].ownedVertices),
-                static_cast<unsigned long long>(s.ranks[k].tets), s.ranks[k].simplifyMs, s.ranks[k].encodeMs,
-                s.ranks[k].peakMB);
+    std::printf(
+        "  rank %-4zu %llu vertices, %llu tets; its part %.0f ms, combining %.0f ms, encode %.0f ms; %.1f s of "
+        "processor; peak memory %.0f MB\n",
+        k, static_cast<unsigned long long>(s.ranks[k].ownedVertices), static_cast<unsigned long long>(s.ranks[k].tets),
+        s.ranks[k].partMs, s.ranks[k].combineMs, s.ranks[k].encodeMs, s.ranks[k].cpuSeconds, s.ranks[k].peakMB);
   return 0;
 }
 

@@ -36,6 +36,8 @@ double peakMB() {
 // kPackBytesPerTet, with the halo and the parts it combines).
 constexpr double kBytesPerPartTet = 220;
 
+uint64_t ownedCount(const PartMesh& p) { return uint64_t(std::count(p.owned.begin(), p.owned.end(), 1)); }
+
 // The fields every rank read, compared (ranks without tets take them).
 Result agreeOnFields(Comm& comm, TetMesh& mesh) {
   Bytes mine;
@@ -92,22 +94,10 @@ Result readShare(Comm& comm, const std::string& input, ReadOptions read, TetMesh
 // (each tet counted by the owner of its first vertex).
 void describeWhole(Comm& comm, const PartMesh& p, const std::string& name, Manifest& m) {
   const size_t F = p.mesh.fields.size();
-  std::vector<double> lo(3 + F, INFINITY), hi(3 + F, -INFINITY);
+  std::vector<double> lo, hi;
+  ownedExtent(p, lo, hi);
   std::vector<uint64_t> counts(2, 0);
-  for (uint32_t v = 0; v < p.mesh.vertexCount(); ++v) {
-    if (!p.owned[v]) continue;
-    ++counts[0];
-    for (int k = 0; k < 3; ++k) {
-      lo[size_t(k)] = std::min<double>(lo[size_t(k)], p.mesh.positions[3 * size_t(v) + size_t(k)]);
-      hi[size_t(k)] = std::max<double>(hi[size_t(k)], p.mesh.positions[3 * size_t(v) + size_t(k)]);
-    }
-    for (size_t f = 0; f < F; ++f) {
-      const float x = p.mesh.fields[f].values[v];
-      if (!std::isfinite(x)) continue;
-      lo[3 + f] = std::min<double>(lo[3 + f], x);
-      hi[3 + f] = std::max<double>(hi[3 + f], x);
-    }
-  }
+  counts[0] = ownedCount(p);
   for (uint32_t t = 0; t < p.mesh.tetCount(); ++t) counts[1] += p.owned[p.mesh.tets[4 * size_t(t)]];
   comm.minInPlace(lo);
   comm.maxInPlace(hi);
@@ -200,8 +190,6 @@ double meanVertexVolume(Comm& comm, const PartMesh& p) {
   const double inside = sums[1] ? sums[0] / sums[1] : 0, all = sums[3] ? sums[2] / sums[3] : 0;
   return inside > 0 ? inside : all > 0 ? all : INFINITY;
 }
-
-uint64_t ownedCount(const PartMesh& p) { return uint64_t(std::count(p.owned.begin(), p.owned.end(), 1)); }
 
 }  // namespace
 
@@ -356,6 +344,7 @@ Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& 
     if (c == 0) {
       u.part = std::move(part);
       if (status) status = simplifyUnit(u, nullptr);
+      mine.partMs = msSince(t0);
       continue;
     }
     // Combine: the low child's handoff is this rank's previous unit's; the high one comes from
@@ -377,7 +366,9 @@ Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& 
     u.part = mergeParts(low.handoff, high);
     high = PartMesh{};
     CarriedVertexState carried = std::move(u.part.carried);
+    const auto c0 = std::chrono::steady_clock::now();
     status = simplifyUnit(u, &carried);
+    mine.combineMs += msSince(c0);
   }
   if (const int up = tree.groups[size_t(chain.back())].parent; up >= 0) {
     Bytes sent;
@@ -449,6 +440,12 @@ Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& 
   // ---- write
   progress("write");
   mine.peakMB = peakMB();
+  {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    mine.cpuSeconds =
+        double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+  }
   r = writeDistributed(comm, tree, layout, units, regions, m, outDir, opt, mine, out);
   return comm.agree(r);
 }

@@ -33,7 +33,10 @@ namespace tetstream::dist {
 struct RankFigures {
   uint64_t ownedVertices = 0, tets = 0;  // of its first part (halo tets included)
   double peakMB = 0;                     // peak resident memory
-  double simplifyMs = 0, encodeMs = 0;   // its own work in those phases
+  double simplifyMs = 0, encodeMs = 0;   // wall time in those phases (waits for other ranks included)
+  double partMs = 0;                     // simplifying its own part
+  double combineMs = 0;                  // simplifying the parts it combines (the top of the tree)
+  double cpuSeconds = 0;                 // processor time of the whole run, all its threads
 };
 
 struct DistributedSummary {

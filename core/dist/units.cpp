@@ -24,22 +24,29 @@ Range RegionFigures::groupRange(const RankTree::Group& g, size_t field) const {
   return x;
 }
 
-RegionFigures regionFigures(Comm& comm, const PartMesh& part, const Manifest& m) {
-  const size_t F = m.fields.size();
-  std::vector<double> lo(3 + F, INFINITY), hi(3 + F, -INFINITY);
-  for (uint32_t v = 0; v < part.mesh.vertexCount(); ++v) {
-    if (!part.owned[v]) continue;
+void ownedExtent(const PartMesh& p, std::vector<double>& lo, std::vector<double>& hi) {
+  const size_t F = p.mesh.fields.size();
+  lo.assign(3 + F, INFINITY);
+  hi.assign(3 + F, -INFINITY);
+  for (uint32_t v = 0; v < p.mesh.vertexCount(); ++v) {
+    if (!p.owned[v]) continue;
     for (int k = 0; k < 3; ++k) {
-      lo[size_t(k)] = std::min<double>(lo[size_t(k)], part.mesh.positions[3 * size_t(v) + size_t(k)]);
-      hi[size_t(k)] = std::max<double>(hi[size_t(k)], part.mesh.positions[3 * size_t(v) + size_t(k)]);
+      lo[size_t(k)] = std::min<double>(lo[size_t(k)], p.mesh.positions[3 * size_t(v) + size_t(k)]);
+      hi[size_t(k)] = std::max<double>(hi[size_t(k)], p.mesh.positions[3 * size_t(v) + size_t(k)]);
     }
     for (size_t f = 0; f < F; ++f) {
-      const float x = part.mesh.fields[f].values[v];
+      const float x = p.mesh.fields[f].values[v];
       if (!std::isfinite(x)) continue;
       lo[3 + f] = std::min<double>(lo[3 + f], x);
       hi[3 + f] = std::max<double>(hi[3 + f], x);
     }
   }
+}
+
+RegionFigures regionFigures(Comm& comm, const PartMesh& part, const Manifest& m) {
+  const size_t F = m.fields.size();
+  std::vector<double> lo, hi;
+  ownedExtent(part, lo, hi);
   Bytes mine;
   Writer w(mine);
   w.putVector(lo);

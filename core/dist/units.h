@@ -40,6 +40,10 @@ struct RegionFigures {
 };
 RegionFigures regionFigures(Comm& comm, const PartMesh& part, const Manifest& m);
 
+// The extent of the owned points of `p`: lo/hi [0, 3) of their positions, [3, 3 + F) of each
+// field's finite values (±infinity where there are none).
+void ownedExtent(const PartMesh& p, std::vector<double>& lo, std::vector<double>& hi);
+
 // Stable ids per unit, from every unit's counts: the base first, then the units in preorder.
 struct UnitLayout {
   uint64_t baseVertices = 0, baseTets = 0;

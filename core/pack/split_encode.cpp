@@ -149,13 +149,7 @@ class Encoder {
     vertexBegin_ = uo.vertexBegin;
     tetBegin_ = uo.tetBegin;
 
-    out_.streamVertexOf.assign(V, kNone);
-    out_.streamTetOf.assign(T, kNone);
-    TetMesh& b = out_.base;
-    b = TetMesh{};
-    b.name = mesh_.name;
-    b.fields.resize(mesh_.fields.size());
-    for (size_t f = 0; f < mesh_.fields.size(); ++f) b.fields[f].name = mesh_.fields[f].name;
+    TetMesh& b = emptyBase(V, T);
     for (uint32_t v : vertices) {
       out_.streamVertexOf[v] = b.vertexCount();
       b.positions.insert(b.positions.end(), &mesh_.positions[3 * size_t(v)], &mesh_.positions[3 * size_t(v)] + 3);
@@ -387,8 +381,8 @@ class Encoder {
     info.fieldMax = e.max;
   }
 
-  void buildBase() {
-    const uint32_t V = mesh_.vertexCount(), T = uint32_t(s_.tetAlive.size());  // (mesh_.tets may be gone: simplify.h)
+  // No vertex or tet in the stream yet; the base mesh empty, with the fields' names.
+  TetMesh& emptyBase(uint32_t V, uint32_t T) {
     out_.streamVertexOf.assign(V, kNone);
     out_.streamTetOf.assign(T, kNone);
     TetMesh& b = out_.base;
@@ -396,6 +390,12 @@ class Encoder {
     b.name = mesh_.name;
     b.fields.resize(mesh_.fields.size());
     for (size_t f = 0; f < mesh_.fields.size(); ++f) b.fields[f].name = mesh_.fields[f].name;
+    return b;
+  }
+
+  void buildBase() {
+    const uint32_t V = mesh_.vertexCount(), T = uint32_t(s_.tetAlive.size());  // (mesh_.tets may be gone: simplify.h)
+    TetMesh& b = emptyBase(V, T);
     for (uint32_t v = 0; v < V; ++v) {
       if (!s_.vertexAlive[v]) continue;
       out_.streamVertexOf[v] = b.vertexCount();

@@ -30,6 +30,20 @@ for input in ghost.pvtu ids.pvtu multi.vtu; do
   done
 done
 
+# Pieces that meshio wrote (a listing written by hand, as deal.II and FEniCS write theirs), on 2
+# ranks: the same surface as one process's pack.
+FIXTURES="$HERE/../fixtures/partitioned"
+timeout 300 "${MPIRUN[@]}" -np 2 "$TETSTREAM" pack "$FIXTURES/meshio.pvtu" -o "$WORK/meshio-np2" >/dev/null
+"$TETSTREAM" pack "$FIXTURES/meshio.pvtu" -o "$WORK/meshio-serial" >/dev/null
+for value in 2 3.5; do
+  a=$("$TETSTREAM" iso "$WORK/meshio-np2" --value $value --json | tr -d ' \n' | grep -o '"triangles":[0-9]*,"vertices":[0-9]*')
+  b=$("$TETSTREAM" iso "$WORK/meshio-serial" --value $value --json | tr -d ' \n' | grep -o '"triangles":[0-9]*,"vertices":[0-9]*')
+  [ -n "$a" ] && [ "$a" = "$b" ] || { echo "FAIL: meshio pieces, iso $value: $a on 2 ranks, $b on one process"; exit 1; }
+done
+echo "ok: meshio's pieces on 2 ranks give one process's surfaces"
+# (Not in the checks below: its cell data 'region' becomes point data per rank, so at the points
+# two ranks share it differs from one process's average: docs/scaling.md, "Not yet distributed".)
+
 # The same bytes on a second run.
 again="$WORK/again"
 timeout 300 "${MPIRUN[@]}" -np 4 "$TETSTREAM" "${PACK[@]}" "$WORK/pieces/ghost.pvtu" -o "$again" >/dev/null
