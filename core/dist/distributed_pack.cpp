@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <future>
 
@@ -193,6 +194,15 @@ double meanVertexVolume(Comm& comm, const PartMesh& p) {
 
 }  // namespace
 
+// A failure on purpose, for the tests of what the other ranks do when one fails in a phase:
+// TETSTREAM_FAULT="RANK:PHASE" (read, simplify, combine, encode, write) makes that rank fail
+// there as a real failure would.
+Result injectedFault(int rank, const char* phase) {
+  const char* fault = std::getenv("TETSTREAM_FAULT");
+  if (!fault || std::string(fault) != std::to_string(rank) + ":" + phase) return Result::success();
+  return fail(Status::IoError, std::string("a fault injected in phase '") + phase + "' (TETSTREAM_FAULT)");
+}
+
 Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& read, const std::string& outDir,
                        const PackOptions& opt, DistributedSummary& out) {
   out = DistributedSummary{};
@@ -207,8 +217,9 @@ Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& 
   TetMesh mesh;
   ReadReport report;
   Result r = readShare(comm, input, read, mesh, report);
+  if (r) r = injectedFault(me, "read");
   if (r = comm.agree(r); !r) return r;
-  if (r = comm.agree(agreeOnFields(comm, mesh)); !r) return r;
+  if (r = agreeOnFields(comm, mesh); !r) return r;  // (the same on every rank)
   out.inputFormat = report.format;
   std::vector<std::string>& notes = out.pack.notes;
   if (me == 0) notes = report.notes;
@@ -343,6 +354,7 @@ Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& 
     const RankTree::Group& g = tree.groups[size_t(u.group)];
     if (c == 0) {
       u.part = std::move(part);
+      if (status) status = injectedFault(me, "simplify");
       if (status) status = simplifyUnit(u, nullptr);
       mine.partMs = msSince(t0);
       continue;
@@ -367,7 +379,8 @@ Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& 
     high = PartMesh{};
     CarriedVertexState carried = std::move(u.part.carried);
     const auto c0 = std::chrono::steady_clock::now();
-    status = simplifyUnit(u, &carried);
+    status = injectedFault(me, "combine");
+    if (status) status = simplifyUnit(u, &carried);
     mine.combineMs += msSince(c0);
   }
   if (const int up = tree.groups[size_t(chain.back())].parent; up >= 0) {
@@ -418,6 +431,7 @@ Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& 
           (!in.atEnd() || handVertex.size() != u.handoff.vertexId.size() || handTet.size() != u.handoff.tetId.size()))
         status = fail(Status::Corrupt, "stable ids from the rank above are damaged");
     }
+    if (status) status = injectedFault(me, "encode");
     if (status) status = encodeOne(u, handVertex, handTet, m, uo);
     for (int side = 0; side < 2 && g.low >= 0; ++side) {
       const int child = side ? g.high : g.low;
@@ -446,8 +460,7 @@ Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& 
     mine.cpuSeconds =
         double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
   }
-  r = writeDistributed(comm, tree, layout, units, regions, m, outDir, opt, mine, out);
-  return comm.agree(r);
+  return writeDistributed(comm, tree, layout, units, regions, m, outDir, opt, mine, out);  // (agreed)
 }
 
 }  // namespace tetstream::dist

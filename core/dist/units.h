@@ -44,6 +44,9 @@ RegionFigures regionFigures(Comm& comm, const PartMesh& part, const Manifest& m)
 // field's finite values (±infinity where there are none).
 void ownedExtent(const PartMesh& p, std::vector<double>& lo, std::vector<double>& hi);
 
+// TETSTREAM_FAULT="RANK:PHASE": rank RANK fails in PHASE (distributed_pack.cpp; for tests).
+Result injectedFault(int rank, const char* phase);
+
 // Stable ids per unit, from every unit's counts: the base first, then the units in preorder.
 struct UnitLayout {
   uint64_t baseVertices = 0, baseTets = 0;

@@ -111,8 +111,8 @@ Result writeDistributed(Comm& comm, const RankTree& tree, const UnitLayout& layo
   }
   if (next > UINT32_MAX) return comm.agree(fail(Status::TooLarge, "more chunks than the format numbers"));
 
-  Result status;
-  if (me == 0) {
+  Result status = injectedFault(me, "write");
+  if (status && me == 0) {
     std::error_code ec;
     fs::create_directories(fs::path(outDir) / "chunks", ec);
     if (ec) status = fail(Status::IoError, outDir + ": cannot create folder: " + ec.message());

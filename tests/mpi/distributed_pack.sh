@@ -85,3 +85,19 @@ echo "$msg" | grep -q "missing_3.vtu" || { echo "FAIL: the message does not name
 [ "$(echo "$msg" | grep -c "tetstream: error")" -eq 1 ] || { echo "FAIL: not one message: $msg"; exit 1; }
 [ ! -e "$WORK/broken/manifest.json" ] || { echo "FAIL: a manifest was written"; exit 1; }
 echo "ok: a missing piece stops every rank with one message: $(echo "$msg" | head -1)"
+
+# A rank that fails in any phase, whatever its role (a leaf that sends up, a rank that combines,
+# one that hands stable ids down), stops every rank with one message naming it: no hang.
+for fault in 1:read 3:simplify 2:combine 2:encode 1:write; do
+  rm -rf "$WORK/fault"
+  set +e
+  msg=$(TETSTREAM_FAULT=$fault timeout 120 "${MPIRUN[@]}" -x TETSTREAM_FAULT -np 4 "$TETSTREAM" pack \
+    "$WORK/pieces/ghost.pvtu" -o "$WORK/fault" 2>&1)
+  code=$?
+  set -e
+  [ $code -ne 0 ] && [ $code -ne 124 ] || { echo "FAIL: fault $fault gave exit $code"; exit 1; }
+  [ "$(echo "$msg" | grep -c "tetstream: error: rank ${fault%%:*}: a fault injected in phase '${fault#*:}'")" -eq 1 ] ||
+    { echo "FAIL: fault $fault: not one message naming the rank: $msg"; exit 1; }
+  [ ! -e "$WORK/fault/manifest.json" ] || { echo "FAIL: fault $fault: a manifest was written"; exit 1; }
+done
+echo "ok: a rank failing in each phase stops every rank with one message"
