@@ -245,7 +245,12 @@ Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& 
   const RankTree tree = cutRegions(comm, mesh);
   PartMesh part;
   DistributionReport joined;
-  r = distribute(comm, std::move(mesh), firstTet, tree, part, joined);
+  std::vector<std::vector<double>> cellWeight(mesh.fields.size());
+  for (ReadReport::CellAverage& a : report.cellAverages)
+    if (const int f = mesh.findField(a.field); f >= 0) cellWeight[size_t(f)] = std::move(a.weight);
+  report.cellAverages.clear();
+  r = distribute(comm, std::move(mesh), firstTet, tree, cellWeight, part, joined);
+  cellWeight.clear();
   if (r = comm.agree(r); !r) return r;
   {
     std::vector<uint64_t> agreed = joined.disagreements;

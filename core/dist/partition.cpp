@@ -142,10 +142,23 @@ RankTree cutRegions(Comm& comm, const TetMesh& mesh) {
   return tree;
 }
 
-Result distribute(Comm& comm, TetMesh&& mesh, uint64_t firstTetId, const RankTree& tree, PartMesh& part,
-                  DistributionReport& report) {
+Result distribute(Comm& comm, TetMesh&& mesh, uint64_t firstTetId, const RankTree& tree,
+                  const std::vector<std::vector<double>>& cellWeight, PartMesh& part, DistributionReport& report) {
   const int N = comm.size(), me = comm.rank();
   const size_t F = mesh.fields.size();
+  // The fields that are cell data on any rank (a rank that read no cells of its own sends zero
+  // weights, which count only where no copy has any).
+  std::vector<uint64_t> anyCell(F, 0);
+  for (size_t f = 0; f < F; ++f) anyCell[f] = f < cellWeight.size() && cellWeight[f].size() == mesh.vertexCount();
+  comm.sumInPlace(anyCell);
+  std::vector<size_t> cellFields;
+  std::vector<uint8_t> isCell(F, 0);
+  for (size_t f = 0; f < F; ++f)
+    if (anyCell[f]) cellFields.push_back(f), isCell[f] = 1;
+  auto weightOf = [&](size_t f, uint32_t v) {
+    return f < cellWeight.size() && v < cellWeight[f].size() ? cellWeight[f][v] : 0.0;
+  };
+  const size_t C = cellFields.size();
   const uint32_t V = mesh.vertexCount(), T = mesh.tetCount();
   std::vector<int> owner(V, -1);
   for (uint32_t v : mesh.tets) {
@@ -181,6 +194,7 @@ Result distribute(Comm& comm, TetMesh&& mesh, uint64_t firstTetId, const RankTre
     for (uint32_t v : table) {
       for (int k = 0; k < 3; ++k) w.put(mesh.positions[3 * size_t(v) + size_t(k)]);
       for (size_t f = 0; f < F; ++f) w.put(mesh.fields[f].values[v]);
+      for (size_t f : cellFields) w.put(weightOf(f, v));
     }
     w.put<uint64_t>(tetsTo[size_t(d)].size());
     for (uint32_t t : tetsTo[size_t(d)]) {
@@ -203,7 +217,8 @@ Result distribute(Comm& comm, TetMesh&& mesh, uint64_t firstTetId, const RankTre
     uint64_t at;             // the copy's values: float offset into `values`
   };
   std::vector<Copy> copies;
-  std::vector<float> values;  // 3 + F per copy
+  std::vector<float> values;    // 3 + F per copy
+  std::vector<double> weights;  // C per copy: the volume behind each cell field's average
   std::vector<std::vector<uint64_t>> tetIds(static_cast<size_t>(N));
   std::vector<std::vector<uint32_t>> tetCorners(static_cast<size_t>(N));
   std::vector<uint64_t> tableSize(static_cast<size_t>(N), 0);
@@ -216,6 +231,7 @@ Result distribute(Comm& comm, TetMesh&& mesh, uint64_t firstTetId, const RankTre
     for (uint64_t k = 0; k < nv; ++k) {
       const uint64_t at = values.size();
       for (size_t x = 0; x < 3 + F; ++x) values.push_back(r.get<float>());
+      for (size_t c = 0; c < C; ++c) weights.push_back(r.get<double>());
       copies.push_back({keyOf(&values[at]), uint32_t(s), uint32_t(k), at});
     }
     const uint64_t nt = r.get<uint64_t>();
@@ -234,6 +250,7 @@ Result distribute(Comm& comm, TetMesh&& mesh, uint64_t firstTetId, const RankTre
   std::vector<std::vector<uint32_t>> localOf(static_cast<size_t>(N));
   for (int s = 0; s < N; ++s) localOf[size_t(s)].assign(tableSize[size_t(s)], 0);
   std::vector<uint32_t> firstCopy;
+  std::vector<float> joined;  // C per unique point: its cell fields joined over the copies here
   report.disagreements.assign(F, 0);
   std::vector<uint8_t> differs(F);
   for (size_t c = 0; c < copies.size();) {
@@ -241,12 +258,20 @@ Result distribute(Comm& comm, TetMesh&& mesh, uint64_t firstTetId, const RankTre
     while (e < copies.size() && copies[e].key == copies[c].key) ++e;
     const uint32_t local = uint32_t(firstCopy.size());
     firstCopy.push_back(uint32_t(c));
+    for (size_t k = 0; k < C; ++k) {
+      double num = 0, den = 0;
+      for (size_t x = c; x < e; ++x) {
+        const double w = weights[(copies[x].at / (3 + F)) * C + k], v = values[copies[x].at + 3 + cellFields[k]];
+        if (w > 0 && std::isfinite(v)) num += w * v, den += w;
+      }
+      joined.push_back(den > 0 ? float(num / den) : values[copies[c].at + 3 + cellFields[k]]);
+    }
     if (e - c > 1) {
       ++report.joinedPoints;
       std::fill(differs.begin(), differs.end(), 0);
       for (size_t x = c + 1; x < e; ++x)
         for (size_t f = 0; f < F; ++f)
-          differs[f] |= !sameValue(values[copies[x].at + 3 + f], values[copies[c].at + 3 + f]);
+          differs[f] |= !isCell[f] && !sameValue(values[copies[x].at + 3 + f], values[copies[c].at + 3 + f]);
       for (size_t f = 0; f < F; ++f) report.disagreements[f] += differs[f];
     }
     for (size_t x = c; x < e; ++x) localOf[copies[x].source][copies[x].index] = local;
@@ -296,12 +321,16 @@ Result distribute(Comm& comm, TetMesh&& mesh, uint64_t firstTetId, const RankTre
       const bool found = it != ownedList.end() && keys[*it] == k;
       unknown |= !found;
       w.put<uint64_t>(found ? offset + uint64_t(it - ownedList.begin()) : ~uint64_t(0));
+      for (size_t k = 0; k < C; ++k) w.put(found ? joined[size_t(*it) * C + k] : 0.0f);
     }
   }
   std::vector<Bytes> answers = comm.allToAll(answer);
   for (int o = 0; o < N; ++o) {
     Reader r(answers[size_t(o)]);
-    for (uint32_t v : asked[size_t(o)]) id[v] = r.get<uint64_t>();
+    for (uint32_t v : asked[size_t(o)]) {
+      id[v] = r.get<uint64_t>();
+      for (size_t k = 0; k < C; ++k) joined[size_t(v) * C + k] = r.get<float>();  // (the owner's, everywhere)
+    }
     unknown |= !r.atEnd();
   }
   for (uint64_t x : id) unknown |= x == ~uint64_t(0);
@@ -324,6 +353,7 @@ Result distribute(Comm& comm, TetMesh&& mesh, uint64_t firstTetId, const RankTre
     const float* x = &values[copies[firstCopy[v]].at];
     for (int k = 0; k < 3; ++k) part.mesh.positions[3 * size_t(n) + size_t(k)] = x[k];
     for (size_t f = 0; f < F; ++f) part.mesh.fields[f].values[n] = x[3 + f];
+    for (size_t k = 0; k < C; ++k) part.mesh.fields[cellFields[k]].values[n] = joined[size_t(v) * C + k];
   }
   struct Tet {
     uint64_t id;

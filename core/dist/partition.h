@@ -53,7 +53,11 @@ struct DistributionReport {
 
 // Sends the tets of `mesh` (whose first tet has input id firstTetId) to their owners and builds
 // this rank's part. Fields must be the same on every rank (checked before). `mesh` is consumed.
-Result distribute(Comm& comm, TetMesh&& mesh, uint64_t firstTetId, const RankTree& tree, PartMesh& part,
-                  DistributionReport& report);
+// `cellWeight[f]`, when not empty, says that field f is cell data averaged at the points over
+// the cells this rank read, with those cells' volume per point (ReadReport::cellAverages): the
+// owner of a point joins its copies' averages by these weights (the average over all its cells,
+// as one process reads it) and every rank takes the owner's value.
+Result distribute(Comm& comm, TetMesh&& mesh, uint64_t firstTetId, const RankTree& tree,
+                  const std::vector<std::vector<double>>& cellWeight, PartMesh& part, DistributionReport& report);
 
 }  // namespace tetstream::dist

@@ -577,6 +577,7 @@ Result finishMesh(const std::string& label, TetMesh& mesh, CellSoup& soup, std::
                       : cnt[v] > 0 ? float(plain[v] / cnt[v])
                                    : std::numeric_limits<float>::quiet_NaN();
       names += (names.empty() ? "'" : ", '") + f.name + "'";
+      report.cellAverages.push_back({f.name, den});
       mesh.fields.push_back(std::move(f));
     }
     report.notes.push_back("converted cell data " + names +
@@ -607,6 +608,7 @@ Result finishMesh(const std::string& label, TetMesh& mesh, CellSoup& soup, std::
       if (newId[v] != 0xFFFFFFFFu && newId[v] != v) {
         std::copy_n(&mesh.positions[3 * size_t(v)], 3, &mesh.positions[3 * size_t(newId[v])]);
         for (ScalarField& f : mesh.fields) f.values[newId[v]] = f.values[v];
+        for (ReadReport::CellAverage& a : report.cellAverages) a.weight[newId[v]] = a.weight[v];
       }
     mesh.positions.resize(3 * size_t(kept));
     mesh.positions.shrink_to_fit();
@@ -614,6 +616,7 @@ Result finishMesh(const std::string& label, TetMesh& mesh, CellSoup& soup, std::
       f.values.resize(kept);
       f.values.shrink_to_fit();
     }
+    for (ReadReport::CellAverage& a : report.cellAverages) a.weight.resize(kept);
     if (higherOrder + noCell) {
       std::string why;
       if (higherOrder) why = std::to_string(higherOrder) + " only higher-order nodes or nodes of skipped cells";

@@ -70,6 +70,14 @@ struct ReadReport {
   std::vector<TimeStep> steps;             // every time step of the file; empty for a single state
   uint64_t stepRead = 0;                   // the index of the step that was read (when steps is not empty)
   uint64_t filesListed = 0;                // of a listing of pieces: the files it lists (0: not a listing)
+  // Cell data made point data: per such field, the volume of the cells its average at each
+  // vertex was taken over (the distributed pack joins the averages ranks took over their own
+  // cells at the points they share, weighted by these). Empty when no cell data was read.
+  struct CellAverage {
+    std::string field;
+    std::vector<double> weight;  // per vertex of the mesh read
+  };
+  std::vector<CellAverage> cellAverages;
 };
 
 struct ReadOptions {

@@ -588,15 +588,21 @@ TEST(EncodeUnit, ShuffledStableIdsDecodeToTheInput) {
   }
 }
 
-// finishUnitChunk writes the manifest index into the header (bytes 8-11, little endian) and
-// nothing else, fills the manifest entry, and the file opens as that chunk and no other.
-TEST(EncodeUnit, FinishUnitChunkSetsTheIndexInTheHeader) {
-  Handmade h = handmade();
+// The handmade unit's handoff: its 8 vertices and 2 tets as the first stable ids.
+UnitEncodeOptions handmadeIds() {
   UnitEncodeOptions o;
   o.stableVertex = {0, 1, 2, 3, 4, 5, 6, 7, kNoId};
   o.stableTet = {0, 1, kNoId};
   o.vertexBegin = 8;
   o.tetBegin = 2;
+  return o;
+}
+
+// finishUnitChunk writes the manifest index into the header (bytes 8-11, little endian) and
+// nothing else, fills the manifest entry, and the file opens as that chunk and no other.
+TEST(EncodeUnit, FinishUnitChunkSetsTheIndexInTheHeader) {
+  Handmade h = handmade();
+  UnitEncodeOptions o = handmadeIds();
   UnitEncoded u;
   ASSERT_TRUE(encodeUnit(h.mesh, h.s, h.m, o, u));
   ASSERT_EQ(u.chunks.size(), 1u);
@@ -639,11 +645,7 @@ TEST(EncodeUnit, FinishUnitChunkSetsTheIndexInTheHeader) {
 TEST(EncodeUnit, RefusesStableIdsNoHandoffCanHave) {
   auto encode = [](void (*change)(UnitEncodeOptions&)) {
     Handmade h = handmade();
-    UnitEncodeOptions o;
-    o.stableVertex = {0, 1, 2, 3, 4, 5, 6, 7, kNoId};
-    o.stableTet = {0, 1, kNoId};
-    o.vertexBegin = 8;
-    o.tetBegin = 2;
+    UnitEncodeOptions o = handmadeIds();
     change(o);
     UnitEncoded u;
     return encodeUnit(h.mesh, h.s, h.m, o, u);
