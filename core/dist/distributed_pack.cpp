@@ -81,7 +81,7 @@ Result readShare(Comm& comm, const std::string& input, ReadOptions read, TetMesh
   read.shareIndex = uint32_t(comm.rank());
   read.shareCount = uint32_t(comm.size());
   if (Result r = readMesh(input, mesh, report, read); !r) return r;
-  if (report.filesListed == 0 && comm.size() > 1) {
+  if (!report.shared && comm.size() > 1) {
     const uint64_t T = mesh.tetCount(), from = T * uint64_t(comm.rank()) / uint64_t(comm.size()),
                    to = T * uint64_t(comm.rank() + 1) / uint64_t(comm.size());
     mesh.tets = std::vector<uint32_t>(mesh.tets.begin() + ptrdiff_t(4 * from), mesh.tets.begin() + ptrdiff_t(4 * to));

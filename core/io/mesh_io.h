@@ -70,6 +70,7 @@ struct ReadReport {
   std::vector<TimeStep> steps;             // every time step of the file; empty for a single state
   uint64_t stepRead = 0;                   // the index of the step that was read (when steps is not empty)
   uint64_t filesListed = 0;                // of a listing of pieces: the files it lists (0: not a listing)
+  bool shared = false;                     // only share ReadOptions::shareIndex of the pieces or partitions was read
   // Cell data made point data: per such field, the volume of the cells its average at each
   // vertex was taken over (the distributed pack joins the averages ranks took over their own
   // cells at the points they share, weighted by these). Empty when no cell data was read.
@@ -93,7 +94,8 @@ struct ReadOptions {
   // Of a listing of pieces (.pvtu, .vtm, .pvtk), read only share `shareIndex` of `shareCount`:
   // the listed files from shareIndex·n/shareCount up to (shareIndex + 1)·n/shareCount, n the
   // files listed (each process of a distributed pack reads its own; every path is still
-  // checked). A share with no file gives an empty mesh. Other formats ignore it.
+  // checked). A share with no file gives an empty mesh. A VTKHDF file of at least shareCount
+  // partitions: the partitions likewise. Other files ignore it (ReadReport::shared says).
   uint32_t shareIndex = 0, shareCount = 1;
 };
 

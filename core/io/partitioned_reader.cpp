@@ -239,6 +239,7 @@ Result readListing(std::string_view listing, const std::string& label, const Pie
   if (shareCount > 1) {
     const uint64_t n = listed.size(), from = shareIndex * n / shareCount, to = (shareIndex + 1ull) * n / shareCount;
     listed = std::vector<Listed>(listed.begin() + ptrdiff_t(from), listed.begin() + ptrdiff_t(to));
+    report.shared = true;
     if (listed.empty()) return Result::success();  // (more processes than files)
   }
 

@@ -141,6 +141,27 @@ Result readVtkHdf(const std::string& path, const ReadOptions& options, TetMesh& 
     if (Result r = readRows(f, kRoot + "/" + name, uint64_t(partOffset), uint64_t(parts), *v, columns); !r) return r;
     if (Result r = sumCounts(f, kRoot + "/" + name, *v, *total); !r) return r;
   }
+  // A share of the partitions (ReadOptions): their rows start after those of the partitions
+  // before them, and each partition before adds one row to Offsets.
+  int64_t pointSkip = 0, cellSkip = 0;
+  const uint64_t partitionsInFile = uint64_t(parts);
+  if (options.shareCount > 1 && partitionsInFile >= options.shareCount) {
+    const size_t from = size_t(partitionsInFile * options.shareIndex / options.shareCount),
+                 to = size_t(partitionsInFile * (options.shareIndex + 1ull) / options.shareCount);
+    for (size_t p = 0; p < from; ++p) {
+      pointSkip += np[p], cellSkip += nc[p], connOffset += nconn[p];
+      ++partOffset;
+    }
+    pointOffset += pointSkip;
+    cellOffset += cellSkip;
+    for (std::vector<int64_t>* v : {&np, &nc, &nconn})
+      *v = std::vector<int64_t>(v->begin() + ptrdiff_t(from), v->begin() + ptrdiff_t(to));
+    parts = int64_t(to - from);
+    totalPoints = totalCells = totalConn = 0;
+    for (size_t p = 0; p < np.size(); ++p)
+      totalPoints += uint64_t(np[p]), totalCells += uint64_t(nc[p]), totalConn += uint64_t(nconn[p]);
+    report.shared = true;
+  }
   if (totalPoints > kMaxVertices)
     return fail(Status::TooLarge,
                 path + ": " + std::to_string(totalPoints) + " points; tetstream indexes vertices with 32 bits");
@@ -202,6 +223,7 @@ Result readVtkHdf(const std::string& path, const ReadOptions& options, TetMesh& 
         }
         if (Result r = stepValue(f, offsetsSet, step, first); !r) return r;
       }
+      first += cells ? cellSkip : pointSkip;
       std::vector<double> values;
       if (Result r = readRows(f, dataset, uint64_t(first), cells ? totalCells : totalPoints, values, columns); !r)
         return r;
@@ -214,8 +236,8 @@ Result readVtkHdf(const std::string& path, const ReadOptions& options, TetMesh& 
     }
   }
   if (parts > 1) report.notes.push_back("concatenated " + std::to_string(parts) + " partitions");
-  report.format = "VTKHDF" + versionText + " UnstructuredGrid, " + std::to_string(parts) +
-                  (parts == 1 ? " partition" : " partitions") + stepText(report);
+  report.format = "VTKHDF" + versionText + " UnstructuredGrid, " + std::to_string(partitionsInFile) +
+                  (partitionsInFile == 1 ? " partition" : " partitions") + stepText(report);
   if (Result r = finishMesh(path, mesh, soup, std::move(cellArrays), report); !r) return r;
   out = std::move(mesh);
   return Result::success();

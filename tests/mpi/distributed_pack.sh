@@ -44,6 +44,19 @@ done
 echo "ok: meshio's pieces on 2 ranks give one process's surfaces"
 checks="$checks;$WORK/meshio-np2=$FIXTURES/meshio.pvtu"  # (its cell data 'region' as one process reads it)
 
+# A VTKHDF file of partitions (each rank reads its own rows), on 3 ranks (a group of three splits
+# one to two), and a time series of two partitions a step, on 2 ranks.
+HPC="$HERE/../fixtures/hpc"
+for input in vtkhdf_parts.vtkhdf:3 vtkhdf_series.vtkhdf:2; do
+  file=${input%:*} np=${input#*:}
+  out="$WORK/${file%.*}-np$np"
+  timeout 300 "${MPIRUN[@]}" -np $np "$TETSTREAM" pack "$HPC/$file" -o "$out" --base-vertices 8 --leaf-vertices 4 \
+    --json >"$out.json"
+  grep -q '"ranks": *'$np "$out.json" || { echo "FAIL: $file on $np ranks"; cat "$out.json"; exit 1; }
+  checks="$checks;$out=$HPC/$file"
+done
+echo "ok: VTKHDF partitions packed on 3 and 2 ranks"
+
 # The same bytes on a second run.
 again="$WORK/again"
 timeout 300 "${MPIRUN[@]}" -np 4 "$TETSTREAM" "${PACK[@]}" "$WORK/pieces/ghost.pvtu" -o "$again" >/dev/null

@@ -217,6 +217,38 @@ TEST(PartitionedFixtures, EveryListingIsTested) {
 }
 
 // ------------------------------------------------------------------ the rules, one at a time
+// A share of the pieces or partitions (what each process of a distributed pack reads): the shares
+// together hold every tet once; a file that cannot be shared says so.
+TEST(PartitionedReaders, SharesOfPiecesAndPartitionsHoldEveryTetOnce) {
+  for (const std::string& path :
+       {partitioned("ghost.pvtu"), partitioned("ids.pvtu"), fixturePath("hpc/vtkhdf_parts.vtkhdf")}) {
+    TetMesh whole;
+    ReadReport wr;
+    ASSERT_TRUE(readMesh(path, whole, wr)) << path;
+    EXPECT_FALSE(wr.shared);
+    uint64_t tets = 0;
+    for (uint32_t k = 0; k < 3; ++k) {
+      ReadOptions o;
+      o.shareIndex = k;
+      o.shareCount = 3;
+      TetMesh part;
+      ReadReport r;
+      ASSERT_TRUE(readMesh(path, part, r, o)) << path << " share " << k;
+      EXPECT_TRUE(r.shared) << path;
+      EXPECT_GT(part.tetCount(), 0u) << path << " share " << k;
+      tets += part.tetCount();
+    }
+    EXPECT_EQ(tets, whole.tetCount()) << path;
+  }
+  ReadOptions o;
+  o.shareIndex = 1;
+  o.shareCount = 2;
+  TetMesh m;
+  ReadReport r;
+  ASSERT_TRUE(readMesh(partitioned("box.vtu"), m, r, o));
+  EXPECT_FALSE(r.shared) << "one piece: read whole";
+}
+
 TEST(PartitionedReaders, GhostCellsAreDroppedAndTheirFlagsAreNoField) {
   TetMesh m;
   ReadReport r;
