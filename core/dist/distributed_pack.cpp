@@ -338,8 +338,10 @@ Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& 
     so.targetVertices = uint32_t(std::max<double>(4, std::llround(double(target) * share)));
     so.targetTets = opt.baseTets ? uint32_t(std::llround(opt.baseTets * share)) : 0;
     so.part = &sp;
-    Result res = simplifyMesh(u.part.mesh, so, u.s);
+    // (The part's tets are taken over, not copied: 16 bytes a tet of the peak, as packMesh does.)
+    Result res = simplifyMesh(u.part.mesh, so, u.s, nullptr, &u.part.mesh.tets);
     if (res) u.handoff = partAfter(u.part, u.s);
+    if (g.low < 0) std::vector<uint64_t>().swap(u.part.tetId);  // (only a combined part hands ids down)
     return res;
   };
   std::vector<Unit> units;  // bottom-up: this rank's leaf, then the groups it combines

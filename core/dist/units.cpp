@@ -82,7 +82,7 @@ UnitLayout planUnits(Comm& comm, const RankTree& tree, const std::vector<Unit>& 
   std::vector<uint64_t> counts(2 * G + 2, 0);
   for (const Unit& u : units) {
     counts[2 * size_t(u.group)] = u.part.mesh.vertexCount() - u.handoff.mesh.vertexCount();
-    counts[2 * size_t(u.group) + 1] = u.part.mesh.tetCount() - u.handoff.mesh.tetCount();
+    counts[2 * size_t(u.group) + 1] = u.s.tetAlive.size() - u.handoff.mesh.tetCount();
     if (u.group == 0) {
       counts[2 * G] = u.handoff.mesh.vertexCount();
       counts[2 * G + 1] = u.handoff.mesh.tetCount();
@@ -112,7 +112,7 @@ Result encodeOne(Unit& u, const std::vector<uint64_t>& handVertex, const std::ve
                  const Manifest& m, UnitEncodeOptions& options) {
   const SimplifyResult& s = u.s;
   options.stableVertex.assign(u.part.mesh.vertexCount(), ~uint64_t(0));
-  options.stableTet.assign(u.part.mesh.tetCount(), ~uint64_t(0));
+  options.stableTet.assign(s.tetAlive.size(), ~uint64_t(0));
   size_t k = 0;
   for (uint32_t v = 0; v < s.vertexAlive.size(); ++v)
     if (s.vertexAlive[v]) {

@@ -39,9 +39,9 @@ void copyFieldNames(const TetMesh& from, TetMesh& to) {
 }  // namespace
 
 PartMesh partAfter(const PartMesh& in, const SimplifyResult& s) {
-  const uint32_t V = in.mesh.vertexCount(), T = in.mesh.tetCount();
-  assert(s.vertexAlive.size() == V && s.tetAlive.size() == T && in.vertexId.size() == V && in.tetId.size() == T &&
-         in.owned.size() == V);
+  // (The tets are s's: in.mesh.tets may have been taken over by the simplification.)
+  const uint32_t V = in.mesh.vertexCount(), T = uint32_t(s.tetAlive.size());
+  assert(s.vertexAlive.size() == V && in.vertexId.size() == V && in.tetId.size() == T && in.owned.size() == V);
   PartMesh out;
   out.mesh.name = in.mesh.name;
   copyFieldNames(in.mesh, out.mesh);

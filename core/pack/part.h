@@ -24,7 +24,8 @@ struct PartMesh {
 // The part as simplification `s` of `in` left it: the vertices and tets still alive (in the
 // same relative order), the current tets, and the carried state at the end (s.carried, which
 // simplifyMesh fills with SimplifyOptions::part; without it the result carries none). Positions
-// and every field keep the input's samples (the fitted values are in the carried state).
+// and every field keep the input's samples (the fitted values are in the carried state). The
+// tets are read from s.tets, not in.mesh.tets (which simplifyMesh may have taken over).
 PartMesh partAfter(const PartMesh& in, const SimplifyResult& s);
 
 // Two sibling parts as one: the union of their vertices and tets by input id (in ascending id
