@@ -79,6 +79,16 @@ for value in 0 0.25 0.5; do
 done
 echo "ok: the isosurfaces equal the serial pack's"
 
+# A piece without an array its listing declares: every rank stops, the message names the piece.
+set +e
+msg=$(timeout 120 "${MPIRUN[@]}" -np 4 "$TETSTREAM" pack "$WORK/pieces/lacking.pvtu" -o "$WORK/lacking" 2>&1)
+code=$?
+set -e
+[ $code -ne 0 ] && [ $code -ne 124 ] && [ "$(echo "$msg" | grep -c "tetstream: error")" -eq 1 ] &&
+  echo "$msg" | grep "tetstream: error" | grep -q "lacking_3.vtu" ||
+  { echo "FAIL: a piece lacking an array gave exit $code: $msg"; exit 1; }
+echo "ok: a piece lacking an array stops every rank: $(echo "$msg" | grep "tetstream: error")"
+
 # --max-memory is per rank: too little for the whole mesh on one rank is enough for a quarter.
 set +e
 one=$(timeout 120 "${MPIRUN[@]}" -np 1 "$TETSTREAM" pack "$WORK/pieces/ghost.pvtu" -o "$WORK/small1" --max-memory 0.006 2>&1)

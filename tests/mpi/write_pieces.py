@@ -7,6 +7,7 @@
 #   ids.pvtu       PIECES pieces, no ghosts, a GlobalIds point array
 #   multi.vtu      one file with PIECES <Piece>s (as PETSc writes), no ghosts
 #   broken.pvtu    ghost.pvtu's listing with one piece file that does not exist
+#   lacking.pvtu   ghost.pvtu's listing whose last piece has its field under another name
 import os
 import sys
 
@@ -63,6 +64,19 @@ def main():
         text = f.read()
     with open("broken.pvtu", "w") as f:
         f.write(text.replace("ghost_%d.vtu" % (pieces - 1), "missing_%d.vtu" % (pieces - 1)))
+
+    last = vtk.vtkXMLUnstructuredGridReader()
+    last.SetFileName("ghost/ghost_%d.vtu" % (pieces - 1))
+    last.Update()
+    renamed = vtk.vtkUnstructuredGrid()
+    renamed.DeepCopy(last.GetOutput())
+    renamed.GetPointData().GetArray(0).SetName("renamed")
+    w = vtk.vtkXMLUnstructuredGridWriter()
+    w.SetInputData(renamed)
+    w.SetFileName("ghost/lacking_%d.vtu" % (pieces - 1))
+    w.Write()
+    with open("lacking.pvtu", "w") as f:
+        f.write(text.replace("ghost_%d.vtu" % (pieces - 1), "lacking_%d.vtu" % (pieces - 1)))
 
 
 main()
