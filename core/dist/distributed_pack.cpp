@@ -76,6 +76,43 @@ Result agreeOnFields(Comm& comm, TetMesh& mesh) {
   return Result::success();
 }
 
+// What every rank's reader said: the format as the first rank that read anything saw it (said
+// to be its share when ranks read shares), and every note once, with the ranks that made it
+// unless every rank that read anything did.
+void gatherReadReports(Comm& comm, const ReadReport& report, std::string& format, std::vector<std::string>& notes) {
+  Bytes mine;
+  Writer w(mine);
+  w.putString(report.format);
+  w.put<uint8_t>(report.shared);
+  w.put<uint64_t>(report.notes.size());
+  for (const std::string& n : report.notes) w.putString(n);
+  const std::vector<Bytes> all = comm.allGather(mine);
+  std::vector<std::pair<std::string, std::vector<int>>> said;
+  int readers = 0;
+  for (int r = 0; r < comm.size(); ++r) {
+    Reader in(all[size_t(r)]);
+    const std::string f = in.getString();
+    const bool shared = in.get<uint8_t>();
+    readers += !f.empty();
+    if (format.empty() && !f.empty()) format = shared ? "rank " + std::to_string(r) + "'s share: " + f : f;
+    for (uint64_t k = in.get<uint64_t>(); k-- > 0 && in.ok();) {
+      std::string n = in.getString();
+      auto it = std::find_if(said.begin(), said.end(), [&](const auto& x) { return x.first == n; });
+      if (it == said.end()) it = said.insert(said.end(), {std::move(n), {}});
+      it->second.push_back(r);
+    }
+  }
+  for (const auto& [text, ranks] : said) {
+    if (int(ranks.size()) >= readers || comm.size() == 1) {
+      notes.push_back(text);
+      continue;
+    }
+    std::string who;
+    for (int r : ranks) who += (who.empty() ? "" : ", ") + std::to_string(r);
+    notes.push_back((ranks.size() == 1 ? "rank " : "ranks ") + who + ": " + text);
+  }
+}
+
 // Reads this rank's share: its files of a listing, or its slice of the tets of a single file.
 Result readShare(Comm& comm, const std::string& input, ReadOptions read, TetMesh& mesh, ReadReport& report) {
   read.shareIndex = uint32_t(comm.rank());
@@ -220,9 +257,8 @@ Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& 
   if (r) r = injectedFault(me, "read");
   if (r = comm.agree(r); !r) return r;
   if (r = agreeOnFields(comm, mesh); !r) return r;  // (the same on every rank)
-  out.inputFormat = report.format;
+  gatherReadReports(comm, report, out.inputFormat, out.pack.notes);
   std::vector<std::string>& notes = out.pack.notes;
-  if (me == 0) notes = report.notes;
   const int iso = opt.field.empty() ? 0 : mesh.findField(opt.field);
   if (iso < 0) {
     std::string names;
