@@ -158,6 +158,8 @@ int packOnRanks(const Opts& o, bool maxErrorSet, bool baseVerticesSet, bool base
                {"nodes", m.nodes.size()},
                {"bytes", bytes},
                {"baseBytes", m.chunks[0].bytes},
+               {"baseFieldRms", m.chunks[0].fieldRms},
+               {"baseFieldMax", m.chunks[0].fieldMax},
                {"readMs", s.readMs},
                {"partitionMs", s.partitionMs},
                {"simplifyMs", s.combineMs},
@@ -173,6 +175,9 @@ int packOnRanks(const Opts& o, bool maxErrorSet, bool baseVerticesSet, bool base
   std::printf("  input     %u vertices, %u tets, field '%s'\n", m.vertices, m.tets, m.isoField.c_str());
   std::printf("  base      %u vertices, %u tets, %.1f KB\n", s.pack.baseVertices, s.pack.baseTets,
               m.chunks[0].bytes / 1024.0);
+  if (const ChunkInfo& b = m.chunks[0]; b.fieldRms >= 0)
+    std::printf("  error     base field error at the input's vertices: RMS %.3g, largest %.3g\n", b.fieldRms,
+                b.fieldMax);
   std::printf("  stream    %u splits in %zu chunks, %zu nodes, %.2f MB in all\n", s.pack.splits, m.chunks.size() - 1,
               m.nodes.size(), bytes / 1e6);
   std::printf("  time      read %.0f ms, partition %.0f ms, simplify %.0f ms, all %.0f ms\n", s.readMs, s.partitionMs,

@@ -10,6 +10,7 @@
 // reports "secondary" failures, which agree() passes over), its rank named in the message.
 #pragma once
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
@@ -69,21 +70,25 @@ class Writer {
   explicit Writer(Bytes& out) : out_(out) {}
   template <typename T>
   void put(const T& x) {
-    const auto* p = reinterpret_cast<const uint8_t*>(&x);
-    out_.insert(out_.end(), p, p + sizeof(T));
+    append(&x, sizeof(T));
   }
   template <typename T>
   void putVector(const std::vector<T>& v) {
     put<uint64_t>(v.size());
-    const auto* p = reinterpret_cast<const uint8_t*>(v.data());
-    out_.insert(out_.end(), p, p + v.size() * sizeof(T));
+    append(v.data(), v.size() * sizeof(T));
   }
   void putString(const std::string& s) {
     put<uint64_t>(s.size());
-    out_.insert(out_.end(), s.begin(), s.end());
+    append(s.data(), s.size());
   }
 
  private:
+  void append(const void* data, size_t bytes) {
+    if (bytes == 0) return;
+    const size_t at = out_.size();
+    out_.resize(at + bytes);
+    std::memcpy(out_.data() + at, data, bytes);
+  }
   Bytes& out_;
 };
 

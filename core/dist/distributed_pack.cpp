@@ -11,6 +11,7 @@
 #include <future>
 
 #include "adjacency.h"
+#include "dist/base_error.h"
 #include "dist/partition.h"
 #include "dist/units.h"
 #include "dist/write_pack.h"
@@ -503,7 +504,13 @@ Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& 
     mine.cpuSeconds =
         double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
   }
-  return writeDistributed(comm, tree, layout, units, regions, m, outDir, opt, mine, out);  // (agreed)
+  // The base's error at the input's vertices (none at the full level: the input on the grid).
+  const Unit* root = nullptr;
+  for (const Unit& u : units) root = u.group == 0 ? &u : root;
+  MeasuredError measured;
+  measureBaseError(comm, root ? &root->encoded.handoff : nullptr, units.front().part, iso, measured.baseRms,
+                   measured.baseMax);
+  return writeDistributed(comm, tree, layout, units, regions, m, outDir, opt, mine, measured, out);  // (agreed)
 }
 
 }  // namespace tetstream::dist

@@ -96,7 +96,7 @@ struct UnitReport {
 
 Result writeDistributed(Comm& comm, const RankTree& tree, const UnitLayout& layout, std::vector<Unit>& units,
                         const RegionFigures& regions, Manifest& m, const std::string& outDir, const PackOptions& opt,
-                        const RankFigures& mine, DistributedSummary& out) {
+                        const RankFigures& mine, const MeasuredError& measured, DistributedSummary& out) {
   const int me = comm.rank();
   const size_t G = tree.groups.size(), F = m.fields.size();
   // Every unit's first chunk index, in preorder after the base.
@@ -273,6 +273,9 @@ Result writeDistributed(Comm& comm, const RankTree& tree, const UnitLayout& layo
     after = std::max(after, chunkError[c]);
   }
   if (m.nodes.size() <= 1) m.nodes.clear();  // (one region: one sequence, as packMesh writes it)
+  m.chunks[0].fieldRms = measured.baseRms;
+  m.chunks[0].fieldMax = measured.baseMax;
+  if (m.chunks.size() > 1) m.chunks.back().fieldRms = m.chunks.back().fieldMax = 0;  // (the input on the grid)
   m.vertices = m.chunks.back().vertices;
   m.tets = m.chunks.back().tets;
   Result r = writeManifestFiles(outDir, m);

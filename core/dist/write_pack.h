@@ -11,8 +11,13 @@
 
 namespace tetstream::dist {
 
+// The field error measured at the input's vertices (base_error.h), for the manifest.
+struct MeasuredError {
+  double baseRms = -1, baseMax = -1;
+};
+
 Result writeDistributed(Comm& comm, const RankTree& tree, const UnitLayout& layout, std::vector<Unit>& units,
                         const RegionFigures& regions, Manifest& m, const std::string& outDir, const PackOptions& opt,
-                        const RankFigures& mine, DistributedSummary& out);
+                        const RankFigures& mine, const MeasuredError& measured, DistributedSummary& out);
 
 }  // namespace tetstream::dist

@@ -25,7 +25,9 @@ for input in ghost.pvtu ids.pvtu multi.vtu; do
   for np in 1 2 4; do
     out="$WORK/${input%.*}-np$np"
     timeout 300 "${MPIRUN[@]}" -np $np "$TETSTREAM" "${PACK[@]}" "$WORK/pieces/$input" -o "$out" >"$out.json"
-    echo "packed $input on $np ranks: $(tr -d ' \n' <"$out.json" | grep -o '"nodes":[0-9]*,"bytes":[0-9]*')"
+    echo "packed $input on $np ranks: $(tr -d ' \n' <"$out.json" | grep -o '"nodes":[0-9]*,"bytes":[0-9]*'),"\
+      "$(tr -d ' \n' <"$out.json" | grep -o '"baseFieldRms":[0-9.e-]*')"
+    tr -d ' \n' <"$out.json" | grep -q '"baseFieldRms":[0-9]' || { echo "FAIL: no measured base error"; exit 1; }
     checks="$checks;$out=$WORK/pieces/$input"
   done
 done
