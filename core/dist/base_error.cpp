@@ -112,8 +112,8 @@ void measureBaseError(Comm& comm, const TetMesh* base, const PartMesh& input, in
     const std::vector<float>& samples = input.mesh.fields[size_t(field)].values;
     for (uint32_t v = 0; v < input.mesh.vertexCount(); ++v) {
       double at;
-      if (!input.owned[v] || !std::isfinite(samples[v]) || !grid.interpolate(&input.mesh.positions[3 * size_t(v)], values, at) ||
-          !std::isfinite(at))
+      if (!input.owned[v] || !std::isfinite(samples[v]) ||
+          !grid.interpolate(&input.mesh.positions[3 * size_t(v)], values, at) || !std::isfinite(at))
         continue;
       const double e = std::abs(at - samples[v]);
       sums[0] += e * e;

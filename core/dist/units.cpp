@@ -24,6 +24,8 @@ Range RegionFigures::groupRange(const RankTree::Group& g, size_t field) const {
   return x;
 }
 
+uint64_t ownedCount(const PartMesh& p) { return uint64_t(std::count(p.owned.begin(), p.owned.end(), 1)); }
+
 void ownedExtent(const PartMesh& p, std::vector<double>& lo, std::vector<double>& hi) {
   const size_t F = p.mesh.fields.size();
   lo.assign(3 + F, INFINITY);

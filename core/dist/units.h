@@ -40,6 +40,9 @@ struct RegionFigures {
 };
 RegionFigures regionFigures(Comm& comm, const PartMesh& part, const Manifest& m);
 
+// How many vertices `p` owns.
+uint64_t ownedCount(const PartMesh& p);
+
 // The extent of the owned points of `p`: lo/hi [0, 3) of their positions, [3, 3 + F) of each
 // field's finite values (±infinity where there are none).
 void ownedExtent(const PartMesh& p, std::vector<double>& lo, std::vector<double>& hi);
