@@ -12,6 +12,7 @@
 #include "dist/base_error.h"
 #include "dist/partition.h"
 #include "dist/prepare.h"
+#include "dist/refit.h"
 #include "dist/units.h"
 #include "dist/write_pack.h"
 #include "pack/part.h"
@@ -241,6 +242,11 @@ Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& 
   if (r = comm.agree(status, secondary); !r) return r;
   out.combineMs = msSince(t0);
 
+  // ---- the base's values fitted again against the whole input
+  Unit* root = nullptr;
+  for (Unit& u : units) root = u.group == 0 ? &u : root;
+  refitBase(comm, root, units.front().part, iso);
+
   // ---- encode, top-down
   t0 = std::chrono::steady_clock::now();
   progress("encode");
@@ -259,13 +265,12 @@ Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& 
     uo.topIsRegion = u.group != 0;
     uo.vertexBegin = layout.vertexBegin[size_t(u.group)];
     uo.tetBegin = layout.tetBegin[size_t(u.group)];
-    std::vector<uint64_t> handVertex, handTet;  // stable ids of the handoff, in its order
+    StableIds hand;  // stable ids of the handoff (and the values it starts from), in its order
     if (u.group == 0) {
-      for (uint64_t k = 0; k < u.handoff.vertexId.size(); ++k) handVertex.push_back(k);
-      for (uint64_t k = 0; k < u.handoff.tetId.size(); ++k) handTet.push_back(k);
+      for (uint64_t k = 0; k < u.handoff.vertexId.size(); ++k) hand.vertices.push_back(k);
+      for (uint64_t k = 0; k < u.handoff.tetId.size(); ++k) hand.tets.push_back(k);
     } else if (c + 1 < units.size()) {
-      handVertex = std::move(units[c + 1].childStable[0].vertices);
-      handTet = std::move(units[c + 1].childStable[0].tets);
+      hand = std::move(units[c + 1].childStable[0]);
     } else {
       Bytes got;
       const bool ok = comm.receive(tree.groups[size_t(g.parent)].first, u.group, got);
@@ -274,14 +279,15 @@ Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& 
         secondary = true;
       }
       Reader in(got);
-      handVertex = in.getVector<uint64_t>();
-      handTet = in.getVector<uint64_t>();
-      if (status &&
-          (!in.atEnd() || handVertex.size() != u.handoff.vertexId.size() || handTet.size() != u.handoff.tetId.size()))
+      hand.vertices = in.getVector<uint64_t>();
+      hand.tets = in.getVector<uint64_t>();
+      hand.values = in.getVector<float>();
+      if (status && (!in.atEnd() || hand.vertices.size() != u.handoff.vertexId.size() ||
+                     hand.tets.size() != u.handoff.tetId.size()))
         status = fail(Status::Corrupt, "stable ids from the rank above are damaged");
     }
     if (status) status = injectedFault(me, "encode");
-    if (status) status = encodeOne(u, handVertex, handTet, m, uo);
+    if (status) status = encodeOne(u, hand, m, uo);
     for (int side = 0; side < 2 && g.low >= 0; ++side) {
       const int child = side ? g.high : g.low;
       StableIds ids;
@@ -294,6 +300,7 @@ Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& 
       Writer w(sent);
       w.putVector(ids.vertices);
       w.putVector(ids.tets);
+      w.putVector(ids.values);
       comm.send(tree.groups[size_t(child)].first, child, sent, !status);
     }
   }
@@ -310,8 +317,6 @@ Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& 
         double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
   }
   // The base's error at the input's vertices (none at the full level: the input on the grid).
-  const Unit* root = nullptr;
-  for (const Unit& u : units) root = u.group == 0 ? &u : root;
   MeasuredError measured;
   measureBaseError(comm, root ? &root->encoded.handoff : nullptr, units.front().part, iso, measured.baseRms,
                    measured.baseMax);

@@ -110,9 +110,17 @@ UnitLayout planUnits(Comm& comm, const RankTree& tree, const std::vector<Unit>& 
   return l;
 }
 
-Result encodeOne(Unit& u, const std::vector<uint64_t>& handVertex, const std::vector<uint64_t>& handTet,
-                 const Manifest& m, UnitEncodeOptions& options) {
-  const SimplifyResult& s = u.s;
+Result encodeOne(Unit& u, const StableIds& hand, const Manifest& m, UnitEncodeOptions& options) {
+  const std::vector<uint64_t>& handVertex = hand.vertices;
+  const std::vector<uint64_t>& handTet = hand.tets;
+  SimplifyResult& s = u.s;
+  if (!hand.values.empty()) {  // (the values the unit above leaves: its values at the end)
+    if (hand.values.size() != handVertex.size() || s.values.size() != s.vertexAlive.size())
+      return fail(Status::Corrupt, "a handoff's values do not match (internal error)");
+    size_t k = 0;
+    for (uint32_t v = 0; v < s.vertexAlive.size(); ++v)
+      if (s.vertexAlive[v]) s.values[v] = hand.values[k++];
+  }
   options.stableVertex.assign(u.part.mesh.vertexCount(), ~uint64_t(0));
   options.stableTet.assign(s.tetAlive.size(), ~uint64_t(0));
   size_t k = 0;
@@ -145,6 +153,14 @@ StableIds stableIdsOf(const Unit& u, int side) {
   };
   look(u.childVertexIds[side], u.part.vertexId, u.encoded.startVertex, out.vertices);
   look(u.childTetIds[side], u.part.tetId, u.encoded.startTet, out.tets);
+  if (!u.encoded.startValue.empty()) {
+    out.values.reserve(u.childVertexIds[side].size());
+    for (uint64_t id : u.childVertexIds[side]) {
+      auto it = std::lower_bound(u.part.vertexId.begin(), u.part.vertexId.end(), id);
+      const size_t at = size_t(it - u.part.vertexId.begin());
+      out.values.push_back(at < u.encoded.startValue.size() ? u.encoded.startValue[at] : NAN);
+    }
+  }
   return out;
 }
 

@@ -16,6 +16,9 @@ namespace tetstream::dist {
 
 struct StableIds {
   std::vector<uint64_t> vertices, tets;  // in the order of a handoff's vertices and tets
+  // The fitted field's value at each vertex as a reader has it when the unit starts (the unit
+  // above may have changed a value its own splits do not give back: the refit base); empty: its own.
+  std::vector<float> values;
 };
 
 struct Unit {
@@ -58,9 +61,9 @@ struct UnitLayout {
 };
 UnitLayout planUnits(Comm& comm, const RankTree& tree, const std::vector<Unit>& units);
 
-// Encodes unit u, its handoff's stable ids given in the handoff's order.
-Result encodeOne(Unit& u, const std::vector<uint64_t>& handVertex, const std::vector<uint64_t>& handTet,
-                 const Manifest& m, UnitEncodeOptions& options);
+// Encodes unit u, its handoff's stable ids (and the values the unit starts from) given in the
+// handoff's order.
+Result encodeOne(Unit& u, const StableIds& hand, const Manifest& m, UnitEncodeOptions& options);
 
 // The stable ids of child `side` (0 low, 1 high) of encoded unit u, in its handoff's order.
 StableIds stableIdsOf(const Unit& u, int side);

@@ -28,6 +28,7 @@ void appendVertex(PartMesh& dst, const PartMesh& src, uint32_t from) {
   d.boundary.push_back(s.boundary[from]);
   d.boundaryQuadric.push_back(s.boundaryQuadric[from]);
   d.fieldQuadric.push_back(s.fieldQuadric[from]);
+  d.fitRange.push_back(s.fitRange[from]);
 }
 
 // The fields' names, without values.
@@ -63,6 +64,7 @@ PartMesh partAfter(const PartMesh& in, const SimplifyResult& s) {
     d.boundary.push_back(s.carried.boundary[v]);
     d.boundaryQuadric.push_back(s.carried.boundaryQuadric[v]);
     d.fieldQuadric.push_back(s.carried.fieldQuadric[v]);
+    d.fitRange.push_back(s.carried.fitRange[v]);
   }
   for (uint32_t t = 0; t < T; ++t) {
     if (!s.tetAlive[t]) continue;
@@ -187,9 +189,9 @@ void writePart(const PartMesh& p, std::vector<uint8_t>& out) {
   const uint32_t V = p.mesh.vertexCount(), T = p.mesh.tetCount();
   const bool carried = hasCarried(p.carried);
   assert(p.vertexId.size() == V && p.tetId.size() == T && p.owned.size() == V);
-  assert(!carried ||
-         (p.carried.fit.size() == V && p.carried.represented.size() == V && p.carried.boundary.size() == V &&
-          p.carried.boundaryQuadric.size() == V && p.carried.fieldQuadric.size() == V));
+  assert(!carried || (p.carried.fit.size() == V && p.carried.represented.size() == V &&
+                      p.carried.boundary.size() == V && p.carried.boundaryQuadric.size() == V &&
+                      p.carried.fieldQuadric.size() == V && p.carried.fitRange.size() == V));
   out.clear();
   Writer w{out};
   w.bytes(kMagic, 4);
@@ -214,6 +216,7 @@ void writePart(const PartMesh& p, std::vector<uint8_t>& out) {
   w.array(p.carried.boundary);
   w.array(p.carried.boundaryQuadric);
   w.array(p.carried.fieldQuadric);
+  w.array(p.carried.fitRange);
 }
 
 bool readPart(const std::vector<uint8_t>& in, PartMesh& p) {
@@ -234,7 +237,7 @@ bool readPart(const std::vector<uint8_t>& in, PartMesh& p) {
   if (carried) {
     CarriedVertexState& c = p.carried;
     if (!r.array(c.fit, V) || !r.array(c.represented, V) || !r.array(c.boundary, V) || !r.array(c.boundaryQuadric, V) ||
-        !r.array(c.fieldQuadric, V) || !zeroOrOne(c.boundary))
+        !r.array(c.fieldQuadric, V) || !r.array(c.fitRange, V) || !zeroOrOne(c.boundary))
       return false;
   }
   if (r.at != in.size()) return false;

@@ -511,6 +511,7 @@ class Simplifier {
     return quadricOf_[v] == kNoQuadric ? zero : quadrics_[quadricOf_[v]];
   }
   std::vector<float> kappa_, lastCost_;
+  std::vector<Range> fitRange_;             // with SimplifyOptions::part: CarriedVertexState::fitRange
   std::vector<FieldQuadric> fieldQuadric_;  // (its weight: the input volume a vertex stands for, a quarter of each tet)
   double meanVertexVolume_ = 1;             // the unit of the volume measure (init(), boundTerms())
   std::vector<double> qualitySum_;          // per vertex: Σ 3/κ over its star

@@ -85,6 +85,10 @@ struct CarriedVertexState {
   std::vector<uint8_t> boundary;         // on the input's boundary (its boundary quadric counts)
   std::vector<Quadric> boundaryQuadric;  // per vertex (zero when not on the boundary)
   std::vector<FieldQuadric> fieldQuadric;
+  // The range each fitted value keeps to: the input field's range over the region whose collapse
+  // fitted it last (a refit of the base keeps to it, so a region left out still shows no surface
+  // of a value outside its range; FORMAT.md §1.1).
+  std::vector<Range> fitRange;
 };
 
 struct SimplifyPart {

@@ -105,6 +105,7 @@ void Simplifier::collapse(Queue& Q, uint32_t i, uint32_t j, float fieldErr) {
   if (fitsRegion(represented_[j]))
     vert_[j].fit = float(fitted(fieldQuadric_[j], p(j), vert_[j].fit, nodeLo(Q.node), nodeHi(Q.node)));
   if (!lastNode_.empty()) lastNode_[j] = Q.node;
+  if (!fitRange_.empty()) fitRange_[j] = {float(nodeLo(Q.node)), float(nodeHi(Q.node))};
 
   // Everything around j changed. j and its neighbours are re-evaluated lazily, when they reach
   // the top: those already queued keep their entry; a blocked one (no legal collapse last

@@ -1,4 +1,5 @@
 // The last level's values, fitted again at the end (simplifier.h).
+#include "pack/bounded_cg.h"
 #include "pack/simplifier.h"
 
 namespace tetstream::simplify_detail {
@@ -89,60 +90,15 @@ void Simplifier::refitValues() {
       }
     }
   });
-  // Conjugate gradients with a Jacobi preconditioner, from the values the collapses fitted.
-  // The values must stay inside the field's range (the stream's grid covers just that): one
-  // that ends up outside is held at the bound it crossed and the others are solved again.
-  std::vector<double> x(n), res(n), z(n), d(n), q(n), inverse(n);
-  std::vector<uint8_t> held(n, 0);
+  // From the values the collapses fitted, each kept to its region's range (bounded_cg.h).
+  std::vector<double> x(n), lower(n), upper(n);
+  std::vector<uint8_t> held;
   for (uint32_t r = 0; r < n; ++r) {
     x[r] = std::isfinite(vert_[free[r]].fit) ? vert_[free[r]].fit : 0.0;
-    const double diagonal = at(r, r);
-    inverse[r] = diagonal > 0 ? 1 / diagonal : 0.0;
-    if (!(diagonal > 0)) held[r] = 2;  // no usable sample around it: it keeps its value
+    lower[r] = lo(r);
+    upper[r] = hi(r);
   }
-  auto multiply = [&](const std::vector<double>& in, std::vector<double>& out) {
-    for (uint32_t r = 0; r < n; ++r) {
-      double sum = 0;
-      for (uint32_t k = rowStart[r]; k < rowStart[r + 1]; ++k) sum += a[k] * in[cols[k]];
-      out[r] = held[r] ? 0.0 : sum;
-    }
-  };
-  for (int round = 0; round < kRefitRounds; ++round) {
-    multiply(x, q);
-    double rz = 0, norm = 0;
-    for (uint32_t r = 0; r < n; ++r) {
-      res[r] = held[r] ? 0.0 : rhs[r] - q[r];
-      z[r] = res[r] * inverse[r];
-      d[r] = z[r];
-      rz += res[r] * z[r];
-      norm += held[r] ? 0.0 : rhs[r] * rhs[r];
-    }
-    for (int iter = 0; iter < kRefitIterations && rz > 1e-24 * norm; ++iter) {
-      multiply(d, q);
-      double dq = 0;
-      for (uint32_t r = 0; r < n; ++r) dq += d[r] * q[r];
-      if (!(dq > 0)) break;
-      const double alpha = rz / dq;
-      double rzNext = 0;
-      for (uint32_t r = 0; r < n; ++r) {
-        x[r] += alpha * d[r];
-        res[r] -= alpha * q[r];
-        z[r] = res[r] * inverse[r];
-        rzNext += res[r] * z[r];
-      }
-      const double beta = rzNext / rz;
-      rz = rzNext;
-      for (uint32_t r = 0; r < n; ++r) d[r] = z[r] + beta * d[r];
-    }
-    bool crossed = false;
-    for (uint32_t r = 0; r < n; ++r) {
-      if (held[r] || (x[r] >= lo(r) && x[r] <= hi(r))) continue;
-      x[r] = std::clamp(x[r], lo(r), hi(r));
-      held[r] = 1;
-      crossed = true;
-    }
-    if (!crossed) break;
-  }
+  solveBoundedLeastSquares(rowStart, cols, a, rhs, lower, upper, kRefitRounds, kRefitIterations, x, held);
   for (uint32_t r = 0; r < n; ++r)
     if (held[r] != 2 && std::isfinite(x[r])) vert_[free[r]].fit = float(std::clamp(x[r], lo(r), hi(r)));
 }
@@ -181,3 +137,66 @@ bool Simplifier::locate(uint32_t x, uint32_t t, uint32_t* vertices, double* w) c
 }
 
 }  // namespace tetstream::simplify_detail
+
+namespace tetstream {
+
+void solveBoundedLeastSquares(const std::vector<uint32_t>& rowStart, const std::vector<uint32_t>& cols,
+                              const std::vector<double>& a, const std::vector<double>& rhs,
+                              const std::vector<double>& lo, const std::vector<double>& hi, int rounds, int iterations,
+                              std::vector<double>& x, std::vector<uint8_t>& held) {
+  const uint32_t n = uint32_t(rhs.size());
+  std::vector<double> res(n), z(n), d(n), q(n), inverse(n);
+  held.assign(n, 0);
+  for (uint32_t r = 0; r < n; ++r) {
+    double diagonal = 0;
+    for (uint32_t k = rowStart[r]; k < rowStart[r + 1]; ++k)
+      if (cols[k] == r) diagonal = a[k];
+    inverse[r] = diagonal > 0 ? 1 / diagonal : 0.0;
+    if (!(diagonal > 0)) held[r] = 2;  // no usable sample around it: it keeps its value
+  }
+  auto multiply = [&](const std::vector<double>& in, std::vector<double>& out) {
+    for (uint32_t r = 0; r < n; ++r) {
+      double sum = 0;
+      for (uint32_t k = rowStart[r]; k < rowStart[r + 1]; ++k) sum += a[k] * in[cols[k]];
+      out[r] = held[r] ? 0.0 : sum;
+    }
+  };
+  for (int round = 0; round < rounds; ++round) {
+    multiply(x, q);
+    double rz = 0, norm = 0;
+    for (uint32_t r = 0; r < n; ++r) {
+      res[r] = held[r] ? 0.0 : rhs[r] - q[r];
+      z[r] = res[r] * inverse[r];
+      d[r] = z[r];
+      rz += res[r] * z[r];
+      norm += held[r] ? 0.0 : rhs[r] * rhs[r];
+    }
+    for (int iter = 0; iter < iterations && rz > 1e-24 * norm; ++iter) {
+      multiply(d, q);
+      double dq = 0;
+      for (uint32_t r = 0; r < n; ++r) dq += d[r] * q[r];
+      if (!(dq > 0)) break;
+      const double alpha = rz / dq;
+      double rzNext = 0;
+      for (uint32_t r = 0; r < n; ++r) {
+        x[r] += alpha * d[r];
+        res[r] -= alpha * q[r];
+        z[r] = res[r] * inverse[r];
+        rzNext += res[r] * z[r];
+      }
+      const double beta = rzNext / rz;
+      rz = rzNext;
+      for (uint32_t r = 0; r < n; ++r) d[r] = z[r] + beta * d[r];
+    }
+    bool crossed = false;
+    for (uint32_t r = 0; r < n; ++r) {
+      if (held[r] || (x[r] >= lo[r] && x[r] <= hi[r])) continue;
+      x[r] = std::clamp(x[r], lo[r], hi[r]);
+      held[r] = 1;
+      crossed = true;
+    }
+    if (!crossed) break;
+  }
+}
+
+}  // namespace tetstream

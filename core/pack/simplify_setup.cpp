@@ -95,6 +95,7 @@ void Simplifier::init() {
   // 88 bytes each, stored for those alone.
   quadricOf_.assign(V_, kNoQuadric);
   quadrics_.clear();
+  if (part) fitRange_.assign(V_, Range{float(fieldMin_), float(fieldMax_)});  // (until a collapse fits it)
   if (carried)
     takeCarried(*carried);
   else
@@ -228,6 +229,7 @@ void Simplifier::takeCarried(const CarriedVertexState& c) {
     }
   fieldQuadric_ = c.fieldQuadric;
   represented_ = c.represented;
+  if (c.fitRange.size() == V_) fitRange_ = c.fitRange;
 }
 
 // out_.carried: the state at the end, for every vertex of the mesh (those collapsed keep what
@@ -241,6 +243,7 @@ void Simplifier::fillCarried() {
   c.boundaryQuadric.resize(V_);
   for (uint32_t v = 0; v < V_; ++v) c.boundaryQuadric[v] = boundaryQuadric(v);
   c.fieldQuadric = fieldQuadric_;
+  c.fitRange = fitRange_;
 }
 
 }  // namespace tetstream::simplify_detail

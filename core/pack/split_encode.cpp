@@ -78,6 +78,13 @@ class Encoder {
     unit.startTet.assign(out_.streamTetOf.size(), kNoStable);
     for (size_t t = 0; t < out_.streamTetOf.size(); ++t)
       if (out_.streamTetOf[t] != kNone) unit.startTet[t] = stableTet(out_.streamTetOf[t]);
+    unit.startValue.clear();
+    if (s_.valuesField >= 0) {
+      const std::vector<float>& now = pm_.mesh.fields[size_t(s_.valuesField)].values;
+      unit.startValue.assign(out_.streamVertexOf.size(), std::numeric_limits<float>::quiet_NaN());
+      for (size_t v = 0; v < out_.streamVertexOf.size(); ++v)
+        if (out_.streamVertexOf[v] != kNone) unit.startValue[v] = now[out_.streamVertexOf[v]];
+    }
     unit.handoff = std::move(out_.base);
     return Result::success();
   }

@@ -96,6 +96,9 @@ struct UnitEncoded {
   // or tet of the handoff keeps the id it was given; one the unit's m-th split creates has
   // vertexBegin + m (tets: tetBegin plus its place among the recreated tets, in record order).
   std::vector<uint64_t> startVertex, startTet;
+  // ... and, with fitted values, the fitted field's value there as a reader has it after all of the
+  // unit's splits (the value the units below start from; NaN otherwise).
+  std::vector<float> startValue;
 };
 
 // Encodes the splits of part `s` (simplifyMesh with SimplifyOptions::part) on `mesh` (the part's
