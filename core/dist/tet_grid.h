@@ -99,5 +99,4 @@ class TetGrid {
   std::vector<uint32_t> start_, items_;
 };
 
-
 }  // namespace tetstream::dist

@@ -13,7 +13,7 @@ namespace tetstream {
 
 void solveBoundedLeastSquares(const std::vector<uint32_t>& rowStart, const std::vector<uint32_t>& cols,
                               const std::vector<double>& a, const std::vector<double>& rhs,
-                              const std::vector<double>& lo, const std::vector<double>& hi, int rounds,
-                              int iterations, std::vector<double>& x, std::vector<uint8_t>& held);
+                              const std::vector<double>& lo, const std::vector<double>& hi, int rounds, int iterations,
+                              std::vector<double>& x, std::vector<uint8_t>& held);
 
 }  // namespace tetstream
