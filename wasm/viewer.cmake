@@ -31,6 +31,7 @@ add_executable(tetstream_viewer
   ${CMAKE_CURRENT_LIST_DIR}/platform.cpp
   ${CMAKE_CURRENT_LIST_DIR}/api.cpp
   ${CMAKE_CURRENT_LIST_DIR}/viewer_state.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/geometry_sync.cpp
   ${CMAKE_CURRENT_LIST_DIR}/telemetry.cpp
   ${CMAKE_CURRENT_LIST_DIR}/fetch_plan.cpp
   ${CMAKE_CURRENT_LIST_DIR}/colourmap.cpp
@@ -54,7 +55,7 @@ target_link_options(tetstream_viewer PRIVATE
   -sGL_SUPPORT_AUTOMATIC_ENABLE_EXTENSIONS=0
   -sALLOW_MEMORY_GROWTH=1 -sMAXIMUM_MEMORY=4GB
   -sMODULARIZE=1 -sEXPORT_NAME=createTetstream -sINVOKE_RUN=0
-  -sENVIRONMENT=web -sFILESYSTEM=0
+  -sENVIRONMENT=web,worker -sFILESYSTEM=0
   # The ts_* functions are exported by EMSCRIPTEN_KEEPALIVE (api.cpp); these are the rest.
   -sEXPORTED_FUNCTIONS=_main,_malloc,_free
   # The program's calls into the page, written in JavaScript (platform_calls.h).

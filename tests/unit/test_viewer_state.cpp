@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -18,6 +19,7 @@
 #include "adjacency.h"
 #include "camera.h"
 #include "frame_policy.h"
+#include "geometry_sync.h"
 #include "io/generators.h"
 #include "pack/chunk_encode.h"
 #include "pack/packer.h"
@@ -745,4 +747,138 @@ TEST(ViewerState, FitColourRangeCoversWhatIsShown) {
   ASSERT_TRUE(fitColourRange(s));
   EXPECT_EQ(s.colour.min, lo);
   EXPECT_EQ(s.colour.max, hi);
+}
+
+namespace {
+
+// The mirror holds the tracker's live surface: the same triangles in the same slots, and at
+// every vertex a triangle uses the same position, normal and colour.
+void expectMirrors(const IncrementalIsosurface& s, const SurfaceMirror& m, const char* where) {
+  SCOPED_TRACE(where);
+  ASSERT_EQ(m.triangleCount(), s.triangleCount());
+  ASSERT_EQ(m.vertexSlotCount(), s.vertexSlotCount());
+  EXPECT_EQ(m.vertexCount(), s.vertexCount());
+  EXPECT_EQ(m.area(), s.area());
+  ASSERT_TRUE(std::equal(s.indices().begin(), s.indices().end(), m.indices().begin()));
+  for (uint32_t v : s.indices()) {
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_EQ(m.positions()[3 * v + k], s.positions()[3 * v + k]);
+      ASSERT_EQ(m.normals()[3 * v + k], s.normals()[3 * v + k]);
+    }
+    ASSERT_EQ(m.colours()[v], s.colours()[v]);
+  }
+}
+
+void expectMirrors(const HullTracker& h, const HullMirror& m) {
+  ASSERT_EQ(m.triangleCount(), h.triangleCount());
+  ASSERT_EQ(m.lineCount(), h.lineCount());
+  EXPECT_TRUE(std::ranges::equal(m.trianglePositions(), h.trianglePositions()));
+  EXPECT_TRUE(std::ranges::equal(m.triangleNormals(), h.triangleNormals()));
+  EXPECT_TRUE(std::ranges::equal(m.lineVertices(), h.lineVertices()));
+}
+
+// One delta from the model's trackers into the mirrors, as the worker and the page do it.
+void sync(ViewerState& s, SurfaceMirror& surface, SurfaceMirror& slice, HullMirror& hull, size_t* bytes = nullptr) {
+  std::vector<uint8_t> delta;
+  writeDelta(&s.surface, &s.slice.surface(), &s.hull, delta);
+  s.surface.clearChanges();
+  s.slice.surface().clearChanges();
+  s.hull.clearChanges();
+  DeltaApplied applied;
+  std::string error;
+  ASSERT_TRUE(applyDelta(delta, surface, slice, hull, applied, error)) << error;
+  EXPECT_TRUE(applied.surface && applied.slice && applied.hull);
+  if (bytes) *bytes = delta.size();
+}
+
+}  // namespace
+
+// The page draws mirrors of the worker's surface, slice and hull, kept by deltas: after every
+// slice of splits, undo, new isovalue and colour, the mirrors hold what the model holds, and a
+// delta while splits stream is a small part of a full copy.
+TEST(GeometrySync, MirrorsFollowTheModelThroughSplitsUndoAndNewValues) {
+  const Packed& p = packedStream();
+  ViewerState s;
+  ASSERT_TRUE(openManifest(s, p.manifest).ok());
+  ASSERT_TRUE(setField(s, "harmonic"));
+  setIsovalue(s, 0.1f);
+  ASSERT_TRUE(setColourField(s, "distance"));
+  ASSERT_TRUE(addChunk(s, 0, p.chunks[0]).ok());
+  setSliceEnabled(s, true);
+  ASSERT_TRUE(setSlicePlane(s, {0, 0, 1}, 0.3f));
+  SurfaceMirror surface, slice;
+  HullMirror hull;
+  size_t fullBytes = 0, partialBytes = 0;
+  sync(s, surface, slice, hull, &fullBytes);
+  expectMirrors(s.surface, surface, "base");
+  EXPECT_TRUE(surface.fullUploadNeeded());
+  surface.clearChanges();
+  for (uint32_t c = 1; c < p.chunks.size(); ++c) {
+    ASSERT_TRUE(addChunk(s, c, p.chunks[c]).ok()) << c;
+    advance(s, g_ticks + 2, fakeNow);
+    size_t bytes = 0;
+    sync(s, surface, slice, hull, &bytes);
+    partialBytes = std::max(partialBytes, bytes);
+    EXPECT_FALSE(surface.fullUploadNeeded());
+    expectMirrors(s.surface, surface, "streaming");
+    expectMirrors(s.slice.surface(), slice, "slice streaming");
+    expectMirrors(s.hull, hull);
+    surface.clearChanges();
+    slice.clearChanges();
+    hull.clearChanges();
+  }
+  settle(s);
+  sync(s, surface, slice, hull);
+  expectMirrors(s.surface, surface, "complete");
+  EXPECT_LT(partialBytes, fullBytes) << "a slice of splits sends what it changed";
+
+  setLevel(s, s.dataset.splitsReceived() / 3);  // undo
+  while (advance(s, g_ticks + 2, fakeNow)) {
+    sync(s, surface, slice, hull);
+    expectMirrors(s.surface, surface, "undoing");
+    expectMirrors(s.hull, hull);
+  }
+  sync(s, surface, slice, hull);
+  setIsovalue(s, 0.6f);
+  ASSERT_TRUE(setColourField(s, -1));
+  setSliceEnabled(s, false);
+  sync(s, surface, slice, hull);
+  expectMirrors(s.surface, surface, "new isovalue");
+  expectMirrors(s.slice.surface(), slice, "slice off");
+  EXPECT_EQ(slice.triangleCount(), 0u);
+  expectMirrors(s.hull, hull);
+}
+
+// A damaged delta (cut short anywhere, or a corner past the vertices) is refused with a reason
+// and changes nothing.
+TEST(GeometrySync, ADamagedDeltaChangesNothing) {
+  const Packed& p = packedBase();
+  ViewerState s;
+  ASSERT_TRUE(openManifest(s, p.manifest).ok());
+  ASSERT_TRUE(addChunk(s, 0, p.chunks[0]).ok());
+  std::vector<uint8_t> delta;
+  writeDelta(&s.surface, nullptr, &s.hull, delta);
+  SurfaceMirror surface, slice;
+  HullMirror hull;
+  DeltaApplied applied;
+  std::string error;
+  for (size_t cut : {size_t(0), size_t(1), size_t(9), delta.size() / 2, delta.size() - 1}) {
+    ASSERT_FALSE(applyDelta(std::span(delta).first(cut), surface, slice, hull, applied, error)) << cut;
+    EXPECT_NE(error.find("malformed"), std::string::npos);
+    EXPECT_EQ(surface.triangleCount(), 0u);
+    EXPECT_EQ(hull.triangleCount(), 0u);
+  }
+  std::vector<uint8_t> bad = delta;
+  bad.push_back(0);
+  EXPECT_FALSE(applyDelta(bad, surface, slice, hull, applied, error));
+  // The first triangle's first corner (after the part mask, the header and the vertex arrays).
+  const uint32_t slots = s.surface.vertexSlotCount();
+  const size_t corner = 1 + 4 + 4 + 4 + 8 + 1 + size_t(slots) * 28;
+  bad = delta;
+  std::memcpy(&bad[corner], &slots, 4);
+  EXPECT_FALSE(applyDelta(bad, surface, slice, hull, applied, error));
+  EXPECT_NE(error.find("past the vertices"), std::string::npos);
+  EXPECT_EQ(surface.triangleCount(), 0u);
+  ASSERT_TRUE(applyDelta(delta, surface, slice, hull, applied, error)) << error;
+  expectMirrors(s.surface, surface, "whole");
 }
