@@ -5,12 +5,17 @@
 
 namespace tetstream {
 
-bool SliceTracker::setPlane(std::array<float, 3> normal, float offset) {
+bool SliceTracker::normalise(std::array<float, 3>& normal) {
   const double len =
       std::sqrt(double(normal[0]) * normal[0] + double(normal[1]) * normal[1] + double(normal[2]) * normal[2]);
-  if (!(len > 0) || !std::isfinite(len) || !std::isfinite(offset)) return false;
-  std::array<float, 3> n;
-  for (int k = 0; k < 3; ++k) n[size_t(k)] = float(normal[size_t(k)] / len);
+  if (!(len > 0) || !std::isfinite(len)) return false;
+  for (int k = 0; k < 3; ++k) normal[size_t(k)] = float(normal[size_t(k)] / len);
+  return true;
+}
+
+bool SliceTracker::setPlane(std::array<float, 3> normal, float offset) {
+  std::array<float, 3> n = normal;
+  if (!normalise(n) || !std::isfinite(offset)) return false;
   if (n == normal_ && offset == offset_) return false;
   normal_ = n;
   offset_ = offset;

@@ -25,6 +25,8 @@ class SliceTracker {
   // The plane n·p = offset; n is normalised here (a zero or non-finite normal is refused).
   // Returns false when nothing changed. The slice is stale until rebuild().
   bool setPlane(std::array<float, 3> normal, float offset);
+  // Scales `normal` to unit length; false for a zero or non-finite one.
+  static bool normalise(std::array<float, 3>& normal);
   std::array<float, 3> normal() const { return normal_; }
   float offset() const { return offset_; }
 

@@ -1,14 +1,15 @@
-// The viewer program's state, shared by the Emscripten platform (platform.cpp: canvas, input,
-// frames, work slices) and the exported functions (api.cpp; docs/js-api.md). Neither the model
-// (viewer_state.h) nor this header includes Emscripten.
+// The page's viewer program: its state, shared by the Emscripten platform (platform.cpp: canvas,
+// input, frames) and the exported functions (api.cpp; docs/js-api.md). The dataset and its model
+// live in the refinement worker (worker_api.cpp); the page holds what it shows (page_state.h).
+// Neither this header nor page_state.h includes Emscripten.
 #pragma once
 #include <GLES3/gl3.h>
 
 #include <string>
 
 #include "camera.h"
+#include "page_state.h"
 #include "renderer.h"
-#include "viewer_state.h"
 
 struct GLFWwindow;
 
@@ -47,14 +48,12 @@ struct FramePacing {
   double lastDrawStart = -1;      // ... of the previous frame that drew
   bool captureRequested = false;  // the page wants the next drawn frame (screenshot)
   bool reducedShown = false;      // the last drawn frame's scene was drawn at reduced resolution
-  bool workQueued = false;        // a refinement slice is queued (ts_work)
 };
 
 struct App {
-  ViewerState state;
-  uint32_t planVersionSent = 0;  // the fetch plan's version the page was last told of (fetch_plan.h)
-  OrbitCamera plannedCamera;     // the camera when the plan last changed for it (replanForCamera)
-  double cameraReplanMs = -1e9;
+  PageState page;
+  OrbitCamera cameraSent;  // the camera the worker last heard of (sendCamera)
+  double cameraSentMs = -1e9;
   Renderer renderer;
   Canvas canvas;
   CameraControl view;
@@ -66,8 +65,8 @@ extern App g_app;
 
 // Draws the next `frames` frames (something changed).
 void requestRedraw(int frames = 2);
-// New work (a chunk, a level, resuming) starts at once rather than at the next frame.
-void workOnChange();
+// Tells the page's script that a command for the worker is waiting (takeCommand), when one is.
+void sendCommands();
 // Passes a pause or resume asked for in the panel on to the page (Module.onPauseChange).
 void notifyPause();
 

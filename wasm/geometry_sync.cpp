@@ -125,9 +125,7 @@ void SurfaceMirror::clearChanges() {
   changedTriangles_.clear();
 }
 
-void SurfaceMirror::clear() {
-  *this = SurfaceMirror{};
-}
+void SurfaceMirror::clear() { *this = SurfaceMirror{}; }
 
 size_t SurfaceMirror::memoryBytes() const {
   return (positions_.capacity() + normals_.capacity() + colours_.capacity()) * sizeof(float) +

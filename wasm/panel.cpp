@@ -58,22 +58,22 @@ void section(const char* title) {
 
 // With a patch hierarchy (FORMAT.md §1.1): whether the surface is exact, what was fetched of
 // the whole, and the choice to fetch everything.
-void selectionLines(ViewerState& s) {
-  const Dataset& ds = s.dataset;
-  const Manifest& m = ds.manifest;
-  if (m.nodes.empty() || ds.chunksReceived == 0) return;
+void selectionLines(PageState& s) {
+  const ModelReport& r = s.model;
+  const Manifest& m = s.manifest;
+  if (m.nodes.empty() || r.chunksReceived == 0) return;
   char line[160];
-  const char* field = s.field >= 0 ? m.fields[size_t(s.field)].name.c_str() : "";
-  if (exactSurface(s))
-    std::snprintf(line, sizeof line, "exact for %s = %.4g", field, s.isovalue);
+  const char* field = s.settings.field >= 0 ? m.fields[size_t(s.settings.field)].name.c_str() : "";
+  if (shownExact(s))
+    std::snprintf(line, sizeof line, "exact for %s = %.4g", field, s.settings.isovalue);
   else
-    std::snprintf(line, sizeof line, "refining towards the exact surface for %.4g", s.isovalue);
+    std::snprintf(line, sizeof line, "refining towards the exact surface for %.4g", s.settings.isovalue);
   ImGui::TextUnformatted(line);
-  std::snprintf(line, sizeof line, "%u of %zu regions, %s of %s", nodesLoaded(s), m.nodes.size(),
-                formatBytes(ds.bytesReceived).c_str(), formatBytes(m.totalBytes()).c_str());
+  std::snprintf(line, sizeof line, "%u of %zu regions, %s of %s", r.nodesLoaded, m.nodes.size(),
+                formatBytes(r.bytesReceived).c_str(), formatBytes(m.totalBytes()).c_str());
   ImGui::TextDisabled("%s", line);
-  if (!s.unavailable.empty()) coloredWrapped(kWarning, s.unavailable);
-  bool everything = s.fetch.mode == FetchMode::Everything;
+  if (!r.unavailable.empty()) coloredWrapped(kWarning, r.unavailable);
+  bool everything = s.settings.fetch == FetchMode::Everything;
   if (ImGui::Checkbox("load everything", &everything))
     setFetchMode(s, everything ? FetchMode::Everything : FetchMode::Needed);
   if (ImGui::IsItemHovered())
@@ -81,31 +81,34 @@ void selectionLines(ViewerState& s) {
                                  : "Only the regions the isovalue (and the slice) need are fetched.");
 }
 
-void downloadSection(ViewerState& s, float width, float pixelsPerCssPixel) {
-  const Dataset& ds = s.dataset;
-  const bool selective = !ds.manifest.nodes.empty();
-  const uint64_t total = selective ? neededBytes(s) : ds.manifest.totalBytes();
-  const bool allReceived = selective ? s.fetch.missing == 0 : ds.chunksReceived == s.chunksTotal;
+void downloadSection(PageState& s, float width, float pixelsPerCssPixel) {
+  const ModelReport& r = s.model;
+  const Manifest& m = s.manifest;
+  const uint32_t chunksTotal = uint32_t(m.chunks.size());
+  const LoadState state = shownState(s);
+  const bool selective = !m.nodes.empty();
+  const uint64_t total = selective ? r.bytesNeeded : m.totalBytes();
+  const bool allReceived = selective ? r.chunksMissing == 0 : r.chunksReceived == chunksTotal;
   section("download");
   const NetworkStatus& net = s.network;
-  if (s.state == LoadState::Loading && !net.paused)
+  if (state == LoadState::Loading && !net.paused)
     ImGui::TextUnformatted("loading the base mesh...");
   else if (allReceived && !selective)
-    ImGui::Text("all %u parts received", s.chunksTotal);
+    ImGui::Text("all %u parts received", chunksTotal);
   else if (allReceived)
-    ImGui::Text("all %u parts this view needs received", ds.chunksReceived);
+    ImGui::Text("all %u parts this view needs received", r.chunksReceived);
   else
-    ImGui::Text("%u of %u parts received", ds.chunksReceived,
-                selective ? ds.chunksReceived + s.fetch.missing : s.chunksTotal);
+    ImGui::Text("%u of %u parts received", r.chunksReceived,
+                selective ? r.chunksReceived + r.chunksMissing : chunksTotal);
   selectionLines(s);
 
-  const uint64_t have = allReceived ? ds.bytesReceived : std::max(net.receivedBytes, ds.bytesReceived);
+  const uint64_t have = allReceived ? r.bytesReceived : std::max(net.receivedBytes, r.bytesReceived);
   std::string label = formatBytes(have) + " of " + formatBytes(std::max(total, have));
   ImGui::ProgressBar(total ? float(double(have) / double(total)) : 0.f, ImVec2(width, 0), label.c_str());
 
   s.telemetry.screen.pauseButton = {};
-  if (!net.notice.empty() && s.state != LoadState::Error) coloredWrapped(kWarning, net.notice);
-  if (allReceived || s.state == LoadState::Error) return;
+  if (!net.notice.empty() && state != LoadState::Error) coloredWrapped(kWarning, net.notice);
+  if (allReceived || state == LoadState::Error) return;
   // One line that is always there, so the button below does not move under the mouse.
   if (net.paused) {
     ImGui::TextUnformatted("download paused");
@@ -129,15 +132,16 @@ void downloadSection(ViewerState& s, float width, float pixelsPerCssPixel) {
                                    "up to the level chosen below.");
 }
 
-void levelSection(ViewerState& s, float width, float pixelsPerCssPixel) {
-  const Dataset& ds = s.dataset;
-  const Manifest& m = ds.manifest;
+void levelSection(PageState& s, float width, float pixelsPerCssPixel) {
+  const ModelReport& r = s.model;
+  const Manifest& m = s.manifest;
+  const LoadState state = shownState(s);
   section("level of detail");
   // The slider sets the target in splits, from the base (0) to the newest split received.
-  const uint32_t received = ds.splitsReceived();
-  uint32_t target = std::min(s.level.targetSplits, received);
+  const uint32_t received = r.splitsReceived;
+  uint32_t target = shownTargetSplits(s);
   const uint32_t zero = 0;
-  const double targetFraction = m.vertices ? double(ds.pm.baseVertices + target) / m.vertices : 0;
+  const double targetFraction = m.vertices ? double(r.baseVertices + target) / m.vertices : 0;
   char format[64];
   std::snprintf(format, sizeof format, "%.1f%%%% of the vertices%s", 100 * targetFraction,
                 received && target == received ? " (newest)" : "");
@@ -145,53 +149,53 @@ void levelSection(ViewerState& s, float width, float pixelsPerCssPixel) {
   ImGui::BeginDisabled(received == 0);
   if (ImGui::SliderScalar("level", ImGuiDataType_U32, &target, &zero, &received, format,
                           ImGuiSliderFlags_AlwaysClamp | ImGuiSliderFlags_NoInput))
-    setLevel(s, target);
+    setLevelSplits(s, target);
   ImGui::EndDisabled();
   s.telemetry.screen.levelSlider = cssRect(pixelsPerCssPixel);
   ImGui::PopItemWidth();
 
-  const uint32_t applied = ds.splitsApplied();
-  if (applied < std::min(s.level.targetSplits, received))
-    ImGui::Text("refining: %s splits to go", grouped(std::min(s.level.targetSplits, received) - applied).c_str());
-  else if (applied > s.level.targetSplits)
-    ImGui::Text("coarsening: %s splits to undo", grouped(applied - s.level.targetSplits).c_str());
-  else if (!s.level.live && s.fetch.missing > 0 && s.state != LoadState::Error)
+  const uint32_t applied = r.splitsApplied;
+  const bool live = viewCurrent(s) ? r.live : target == received;
+  if (applied < target)
+    ImGui::Text("refining: %s splits to go", grouped(target - applied).c_str());
+  else if (applied > target)
+    ImGui::Text("coarsening: %s splits to undo", grouped(applied - target).c_str());
+  else if (!live && r.chunksMissing > 0 && state != LoadState::Error)
     ImGui::TextDisabled("held here; move to the right end to follow new data");
-  else if (!s.level.live)
+  else if (!live)
     ImGui::TextDisabled("held here");
-  else if (s.fetch.missing > 0 && s.state != LoadState::Error)
+  else if (r.chunksMissing > 0 && state != LoadState::Error)
     ImGui::TextDisabled(s.network.paused ? "follows new data once the download resumes"
                                          : "follows new data as it arrives");
 
-  const uint32_t nv = ds.pm.mesh.vertexCount(), nt = ds.pm.mesh.tetCount();
+  const uint32_t nv = r.vertices, nt = r.tets;
   char pct[32];
-  std::snprintf(pct, sizeof pct, " (%.1f%%)", 100 * levelFraction(s));
+  std::snprintf(pct, sizeof pct, " (%.1f%%)", 100 * r.level);
   row("vertices", grouped(nv) + (nv != m.vertices ? " of " + grouped(m.vertices) + pct : ""));
   row("tets", grouped(nt) + (nt != m.tets ? " of " + grouped(m.tets) : ""));
   // The error of the field that steered the simplification: measured at the input's vertices
   // when the manifest has it, the simplifier's estimate otherwise.
-  const ChunkInfo* level = levelChunk(s);
   const int iso = m.findField(m.isoField);
-  double err = fieldErrorBound(s);
-  if (level && level->fieldRms >= 0 && iso >= 0) {
-    const Range r = m.fields[size_t(iso)].range;
+  const double err = r.fieldError;
+  if (r.fieldRms >= 0 && r.fieldMax >= 0 && iso >= 0) {
+    const Range range = m.fields[size_t(iso)].range;
     char buf[96];
-    const double span = r.max - r.min;
-    if (level->fieldMax == 0)
+    const double span = range.max - range.min;
+    if (r.fieldMax == 0)
       std::snprintf(buf, sizeof buf, "none (full mesh)");
     else if (span > 0)
-      std::snprintf(buf, sizeof buf, "RMS %.2g%%, max %.2g%% of range", 100 * level->fieldRms / span,
-                    100 * level->fieldMax / span);
+      std::snprintf(buf, sizeof buf, "RMS %.2g%%, max %.2g%% of range", 100 * r.fieldRms / span,
+                    100 * r.fieldMax / span);
     else
-      std::snprintf(buf, sizeof buf, "RMS %.3g, max %.3g", level->fieldRms, level->fieldMax);
+      std::snprintf(buf, sizeof buf, "RMS %.3g, max %.3g", r.fieldRms, r.fieldMax);
     row("field error", buf);
-  } else if (err >= 0 && s.field >= 0) {
-    const Range r = m.fields[size_t(s.field)].range;
+  } else if (err >= 0 && s.settings.field >= 0) {
+    const Range range = m.fields[size_t(s.settings.field)].range;
     char buf[64];
     if (err == 0)
       std::snprintf(buf, sizeof buf, "none (full mesh)");
-    else if (r.max > r.min)
-      std::snprintf(buf, sizeof buf, "up to %.3g (%.2g%% of range)", err, 100 * err / (r.max - r.min));
+    else if (range.max > range.min)
+      std::snprintf(buf, sizeof buf, "up to %.3g (%.2g%% of range)", err, 100 * err / (range.max - range.min));
     else
       std::snprintf(buf, sizeof buf, "up to %.3g", err);
     row("field error", buf);
@@ -199,32 +203,33 @@ void levelSection(ViewerState& s, float width, float pixelsPerCssPixel) {
 }
 
 // What the viewer holds now and what the dataset will need, against the limit.
-void memorySection(const ViewerState& s) {
+void memorySection(const PageState& s) {
+  const ModelReport& r = s.model;
+  const Manifest& m = s.manifest;
+  const uint32_t chunksTotal = uint32_t(m.chunks.size());
   // Folds away while the slice is on, like the timings (the panel would outgrow the screen).
   static int lastSliceOn = -1;
-  if (int(s.sliceOn) != lastSliceOn) ImGui::SetNextItemOpen(!s.sliceOn);
-  lastSliceOn = int(s.sliceOn);
+  if (int(s.settings.sliceOn) != lastSliceOn) ImGui::SetNextItemOpen(!s.settings.sliceOn);
+  lastSliceOn = int(s.settings.sliceOn);
   ImGui::Spacing();
   if (!ImGui::TreeNodeEx("memory", ImGuiTreeNodeFlags_NoTreePushOnOpen)) return;
-  row("in use", formatBytes(memoryInUse(s)) + " (page heap " + formatBytes(s.memory.heapBytes) + ")");
-  row("on the GPU", formatBytes(s.memory.gpuBytes));
-  if (s.chunksTotal == 0) return;
-  std::string need = "about " + formatBytes(s.memory.neededBytes);
-  if (s.memory.limitBytes) need += ", limit " + formatBytes(s.memory.limitBytes);
+  row("in use", formatBytes(r.dataBytes) + " (heaps " + formatBytes(r.heapBytes + s.pageHeapBytes) + ")");
+  row("on the GPU", formatBytes(s.gpuBytes));
+  if (chunksTotal == 0) return;
+  std::string need = "about " + formatBytes(r.neededBytes);
+  if (r.limitBytes) need += ", limit " + formatBytes(r.limitBytes);
   row("full dataset", need);
-  if (s.memory.chunksAllowed < s.chunksTotal && s.state != LoadState::Error && s.memory.chunksAllowed > 0) {
-    const Manifest& m = s.dataset.manifest;
+  if (r.chunksAllowed < chunksTotal && shownState(s) != LoadState::Error && r.chunksAllowed > 0) {
     char buf[160];
-    std::snprintf(buf, sizeof buf,
-                  "Too big for this page: streaming will stop after part %u of %u (%.1f%% of the vertices).",
-                  s.memory.chunksAllowed, s.chunksTotal,
-                  m.vertices ? 100.0 * m.chunks[s.memory.chunksAllowed - 1].vertices / m.vertices : 0.0);
+    std::snprintf(
+        buf, sizeof buf, "Too big for this page: streaming will stop after part %u of %u (%.1f%% of the vertices).",
+        r.chunksAllowed, chunksTotal, m.vertices ? 100.0 * m.chunks[r.chunksAllowed - 1].vertices / m.vertices : 0.0);
     coloredWrapped(kWarning, buf);
   }
 }
 
 // The colour bar: the map over the range, drawn in 64 bands, with five values under it.
-void colourBar(const ViewerState& s, float width, float pixelsPerCssPixel) {
+void colourBar(const ViewSettings& s, float width, float pixelsPerCssPixel) {
   ImDrawList* dl = ImGui::GetWindowDrawList();
   const float fs = ImGui::GetFontSize();
   const ImVec2 p = ImGui::GetCursorScreenPos();
@@ -232,8 +237,8 @@ void colourBar(const ViewerState& s, float width, float pixelsPerCssPixel) {
   const ImVec2 lo(p.x + inset, p.y);
   constexpr int kBands = 64;
   for (int i = 0; i < kBands; ++i) {
-    auto c0 = mapColour(s.colour.map, float(i) / kBands, 0, 1);
-    auto c1 = mapColour(s.colour.map, float(i + 1) / kBands, 0, 1);
+    auto c0 = mapColour(s.colourMap, float(i) / kBands, 0, 1);
+    auto c1 = mapColour(s.colourMap, float(i + 1) / kBands, 0, 1);
     ImU32 a = ImGui::ColorConvertFloat4ToU32(ImVec4(c0[0], c0[1], c0[2], 1));
     ImU32 b = ImGui::ColorConvertFloat4ToU32(ImVec4(c1[0], c1[1], c1[2], 1));
     dl->AddRectFilledMultiColor(ImVec2(lo.x + w * i / kBands, lo.y),
@@ -245,7 +250,7 @@ void colourBar(const ViewerState& s, float width, float pixelsPerCssPixel) {
     const float x = lo.x + w * k / 4;
     dl->AddLine(ImVec2(x, lo.y + h), ImVec2(x, lo.y + h + 0.35f * fs), text);
     char buf[32];
-    std::snprintf(buf, sizeof buf, "%.4g", s.colour.min + (s.colour.max - s.colour.min) * k / 4.f);
+    std::snprintf(buf, sizeof buf, "%.4g", s.colourMin + (s.colourMax - s.colourMin) * k / 4.f);
     const float tw = ImGui::CalcTextSize(buf).x;
     dl->AddText(ImVec2(x - 0.5f * tw, lo.y + h + 0.4f * fs), text, buf);
   }
@@ -253,25 +258,26 @@ void colourBar(const ViewerState& s, float width, float pixelsPerCssPixel) {
   (void)pixelsPerCssPixel;
 }
 
-void colourSection(ViewerState& s, float width, float pixelsPerCssPixel) {
-  const Manifest& m = s.dataset.manifest;
+void colourSection(PageState& s, float width, float pixelsPerCssPixel) {
+  const Manifest& m = s.manifest;
+  const ViewSettings& v = s.settings;
   section("colour");
   ImGui::PushItemWidth(width - ImGui::GetFontSize() * 5.5f);
-  const char* current = s.colour.field >= 0 ? m.fields[size_t(s.colour.field)].name.c_str() : "none (two-sided)";
+  const char* current = v.colourField >= 0 ? m.fields[size_t(v.colourField)].name.c_str() : "none (two-sided)";
   if (ImGui::BeginCombo("colour by", current)) {
-    if (ImGui::Selectable("none (two-sided)", s.colour.field < 0)) setColourField(s, -1);
+    if (ImGui::Selectable("none (two-sided)", v.colourField < 0)) setColourField(s, -1);
     for (size_t i = 0; i < m.fields.size(); ++i)
-      if (ImGui::Selectable(m.fields[i].name.c_str(), int(i) == s.colour.field)) setColourField(s, int(i));
+      if (ImGui::Selectable(m.fields[i].name.c_str(), int(i) == v.colourField)) setColourField(s, int(i));
     ImGui::EndCombo();
   }
-  if (s.colour.field >= 0) {
-    if (ImGui::BeginCombo("colour map", colourMapName(s.colour.map))) {
+  if (v.colourField >= 0) {
+    if (ImGui::BeginCombo("colour map", colourMapName(v.colourMap))) {
       for (int i = 0; i < kColourMapCount; ++i)
-        if (ImGui::Selectable(colourMapName(ColourMap(i)), int(s.colour.map) == i)) setColourMap(s, ColourMap(i));
+        if (ImGui::Selectable(colourMapName(ColourMap(i)), int(v.colourMap) == i)) setColourMap(s, ColourMap(i));
       ImGui::EndCombo();
     }
-    float range[2] = {s.colour.min, s.colour.max};
-    const Range fr = m.fields[size_t(s.colour.field)].range;
+    float range[2] = {v.colourMin, v.colourMax};
+    const Range fr = m.fields[size_t(v.colourField)].range;
     const float speed = float(fr.max - fr.min) / 500.f;
     if (ImGui::DragFloat2("range", range, speed > 0 ? speed : 0.01f, 0, 0, "%.4g"))
       setColourRange(s, range[0], range[1]);
@@ -283,16 +289,17 @@ void colourSection(ViewerState& s, float width, float pixelsPerCssPixel) {
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("the field's whole range");
   }
   ImGui::PopItemWidth();
-  if (s.colour.field >= 0) colourBar(s, width, pixelsPerCssPixel);
+  if (v.colourField >= 0) colourBar(v, width, pixelsPerCssPixel);
 }
 
 // The slice: on/off, x/y/z or free orientation (two angles), and its position.
-void sliceSection(ViewerState& s, float width, float pixelsPerCssPixel) {
+void sliceSection(PageState& s, float width, float pixelsPerCssPixel) {
   section("slice");
-  bool on = s.sliceOn;
+  bool on = s.settings.sliceOn;
   if (ImGui::Checkbox("slice plane", &on)) setSliceEnabled(s, on);
-  if (!s.sliceOn) return;
-  const auto n = s.slice.normal();
+  if (!s.settings.sliceOn) return;
+  const auto n = s.settings.sliceNormal;
+  const Bounds& b = s.manifest.bounds;
   float lo = 0, hi = 0;
   sliceOffsetRange(s, lo, hi);
   static const char* kAxes[3] = {"x", "y", "z"};
@@ -301,7 +308,6 @@ void sliceSection(ViewerState& s, float width, float pixelsPerCssPixel) {
     if (ImGui::SmallButton(kAxes[k])) {
       std::array<float, 3> axis{0, 0, 0};
       axis[size_t(k)] = 1;
-      const Bounds& b = s.dataset.manifest.bounds;
       setSlicePlane(s, axis, 0.5f * (b.min[k] + b.max[k]));
     }
   }
@@ -313,25 +319,27 @@ void sliceSection(ViewerState& s, float width, float pixelsPerCssPixel) {
   if (turned) {
     const float a = az / 57.29578f, e = el / 57.29578f;
     // The same relative position across the bounds for the new normal.
-    const float frac = hi > lo ? (s.slice.offset() - lo) / (hi - lo) : 0.5f;
+    const float frac = hi > lo ? (s.settings.sliceOffset - lo) / (hi - lo) : 0.5f;
     const std::array<float, 3> m{std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e)};
     float lo2 = 0, hi2 = 0;
-    SliceTracker::offsetRange(m, s.dataset.manifest.bounds.min, s.dataset.manifest.bounds.max, lo2, hi2);
+    SliceTracker::offsetRange(m, b.min, b.max, lo2, hi2);
     setSlicePlane(s, m, lo2 + frac * (hi2 - lo2));
   }
-  float offset = s.slice.offset();
-  if (ImGui::SliderFloat("position", &offset, lo, hi, "%.4g")) setSlicePlane(s, s.slice.normal(), offset);
+  float offset = s.settings.sliceOffset;
+  if (ImGui::SliderFloat("position", &offset, lo, hi, "%.4g")) setSlicePlane(s, s.settings.sliceNormal, offset);
   s.telemetry.screen.sliceSlider = cssRect(pixelsPerCssPixel);
   if (ImGui::IsItemHovered()) ImGui::SetTooltip("Or shift + drag in the view, or [ and ].");
   ImGui::PopItemWidth();
-  row("triangles", grouped(s.slice.surface().triangleCount()));
+  row("triangles", grouped(s.slice.triangleCount()));
 }
 
 }  // namespace
 
-PanelActions drawPanel(ViewerState& s, float uiScale, float pixelsPerCssPixel) {
+PanelActions drawPanel(PageState& s, float uiScale, float pixelsPerCssPixel) {
   PanelActions actions;
-  const Manifest& m = s.dataset.manifest;
+  const Manifest& m = s.manifest;
+  const ModelReport& r = s.model;
+  const LoadState state = shownState(s);
   const float width = 320.f * uiScale;
 
   ImGui::SetNextWindowPos(ImVec2(10.f * uiScale, 10.f * uiScale), ImGuiCond_FirstUseEver);
@@ -341,12 +349,14 @@ PanelActions drawPanel(ViewerState& s, float uiScale, float pixelsPerCssPixel) {
 
   const bool haveDataset = !m.chunks.empty();
   ImGui::TextUnformatted(!haveDataset ? "no dataset" : m.name.empty() ? "(unnamed dataset)" : m.name.c_str());
-  if (s.state == LoadState::Idle) ImGui::TextDisabled("waiting for a dataset");
-  if (s.state == LoadState::Complete)
-    ImGui::TextDisabled(s.fetch.mode == FetchMode::Needed && !m.nodes.empty()
+  if (state == LoadState::Idle) ImGui::TextDisabled("waiting for a dataset");
+  if (state == LoadState::Complete)
+    ImGui::TextDisabled(s.settings.fetch == FetchMode::Needed && !m.nodes.empty()
                             ? "complete: every part this view needs received and applied"
                             : "complete: every part received and applied");
-  if (s.state == LoadState::Error) coloredWrapped(kError, (s.memory.limited ? "Stopped: " : "Error: ") + s.error);
+  if (state == LoadState::Error)
+    coloredWrapped(kError, (r.memoryLimited && s.pageError.empty() ? "Stopped: " : "Error: ") +
+                               (s.pageError.empty() ? r.error : s.pageError));
   if (ImGui::SmallButton("copy link")) actions.copyLink = true;
   if (ImGui::IsItemHovered())
     ImGui::SetTooltip("Copies a link that opens this view: dataset, fields, colours, slice,\nlevel and camera (L).");
@@ -362,22 +372,23 @@ PanelActions drawPanel(ViewerState& s, float uiScale, float pixelsPerCssPixel) {
 
   if (haveDataset) {
     downloadSection(s, width, pixelsPerCssPixel);
-    if (s.dataset.chunksReceived > 0) levelSection(s, width, pixelsPerCssPixel);
+    if (r.chunksReceived > 0) levelSection(s, width, pixelsPerCssPixel);
   }
 
-  if (s.field >= 0) {
+  const int field = s.settings.field;
+  if (field >= 0) {
     section("isosurface");
     ImGui::PushItemWidth(width - ImGui::GetFontSize() * 5.5f);
-    if (ImGui::BeginCombo("field", m.fields[size_t(s.field)].name.c_str())) {
+    if (ImGui::BeginCombo("field", m.fields[size_t(field)].name.c_str())) {
       for (size_t i = 0; i < m.fields.size(); ++i) {
-        bool selected = int(i) == s.field;
+        bool selected = int(i) == field;
         if (ImGui::Selectable(m.fields[i].name.c_str(), selected)) setField(s, int(i));
         if (selected) ImGui::SetItemDefaultFocus();
       }
       ImGui::EndCombo();
     }
-    const Range range = m.fields[size_t(s.field)].range;
-    float iso = s.isovalue;
+    const Range range = m.fields[size_t(field)].range;
+    float iso = s.settings.isovalue;
     if (ImGui::SliderFloat("isovalue", &iso, range.min, range.max, "%.5g")) setIsovalue(s, iso);
     s.telemetry.screen.slider = cssRect(pixelsPerCssPixel);
     ImGui::PopItemWidth();
@@ -389,26 +400,26 @@ PanelActions drawPanel(ViewerState& s, float uiScale, float pixelsPerCssPixel) {
     }
   }
 
-  if (s.field >= 0) colourSection(s, width, pixelsPerCssPixel);
-  if (s.field >= 0 && haveDataset) sliceSection(s, width, pixelsPerCssPixel);
+  if (field >= 0) colourSection(s, width, pixelsPerCssPixel);
+  if (field >= 0 && haveDataset) sliceSection(s, width, pixelsPerCssPixel);
 
   memorySection(s);
 
   ImGui::Spacing();
-  ImGui::Checkbox("show boundary", &s.view.showBoundary);
+  if (ImGui::Checkbox("show boundary", &s.settings.showBoundary)) s.settingsDirty = true;
   ImGui::SameLine();
   if (ImGui::Button("reset view")) actions.resetView = true;
 
   ImGui::Separator();
   // Timings fold away while the slice is on (the panel would outgrow a laptop screen).
   static int lastSliceOn = -1;
-  if (int(s.sliceOn) != lastSliceOn) ImGui::SetNextItemOpen(!s.sliceOn);
-  lastSliceOn = int(s.sliceOn);
+  if (int(s.settings.sliceOn) != lastSliceOn) ImGui::SetNextItemOpen(!s.settings.sliceOn);
+  lastSliceOn = int(s.settings.sliceOn);
   if (ImGui::TreeNodeEx("timings", ImGuiTreeNodeFlags_NoTreePushOnOpen)) {
     ImGui::TextDisabled("frames every %.1f ms, longest frame %.0f ms", s.telemetry.frameMs, s.telemetry.maxFrameMs);
-    if (s.telemetry.refineSteps)
-      ImGui::TextDisabled("last refinement %.1f ms (%u splits)", s.telemetry.refineMs, s.telemetry.refineSteps);
-    ImGui::TextDisabled("last full extraction %.1f ms", s.telemetry.extractMs);
+    if (r.refineSteps)
+      ImGui::TextDisabled("last refinement %.1f ms (%u splits, in the worker)", r.refineMs, r.refineSteps);
+    ImGui::TextDisabled("last full extraction %.1f ms", r.extractMs);
     if (s.telemetry.firstSurfaceMs >= 0) {
       if (s.telemetry.completeMs >= 0)
         ImGui::TextDisabled("first surface at %.2f s, complete at %.1f s", s.telemetry.firstSurfaceMs / 1000,

@@ -1,10 +1,11 @@
 // The ImGui control panel (top-left): dataset, download progress (parts, bytes, rate, time left)
 // with pause/resume, the level of detail (slider from the base to the newest level received,
 // counts, estimated field error), field and isovalue, view options, timings, and errors in
-// plain words. Reads and edits the ViewerState; it
-// never touches GL or the platform, so the same code runs under any ImGui backend.
+// plain words. Reads and edits the PageState (what the page holds; the model is in the
+// refinement worker); it never touches GL or the platform, so the same code runs under any
+// ImGui backend.
 #pragma once
-#include "viewer_state.h"
+#include "page_state.h"
 
 namespace tetstream::viewer {
 
@@ -31,6 +32,6 @@ void drawHelp(bool& open, float uiScale);
 // Call between ImGui::NewFrame() and ImGui::Render(). `uiScale` multiplies sizes given in CSS
 // pixels; `pixelsPerCssPixel` converts ImGui coordinates back to CSS pixels for the slider
 // rectangles (sliderRect, levelSliderRect).
-PanelActions drawPanel(ViewerState& s, float uiScale, float pixelsPerCssPixel);
+PanelActions drawPanel(PageState& s, float uiScale, float pixelsPerCssPixel);
 
 }  // namespace tetstream::viewer

@@ -1,6 +1,7 @@
-// The viewer's Emscripten platform: the GLFW window on the canvas, mouse, wheel and keys, the
-// frame loop (drawing only when something changed and the GPU has finished the last frame), the
-// refinement work slices between frames, and WebGL context loss. The exported functions are in
+// The viewer's Emscripten platform on the page's thread: the GLFW window on the canvas, mouse,
+// wheel and keys, the frame loop (drawing only when something changed and the GPU has finished
+// the last frame), the view and camera passed on to the refinement worker, and WebGL context
+// loss. The exported functions are in
 // api.cpp; the JS surface is described in docs/js-api.md.
 #include <GLES3/gl3.h>
 #include <GLFW/glfw3.h>
@@ -27,16 +28,9 @@ namespace tetstream::viewer {
 App g_app;
 
 namespace {
-// Refinement runs in slices of its own between frames (a MessageChannel task loop), not inside
-// the frame callback: on a software or slow GPU a drawn frame takes 100-200 ms to come back
-// (SwiftShader with the hull), and refining only inside frames left the main thread idle most
-// of that time (~11k splits/s on Harmonic 64 in SwiftShader). A slice is short enough that
-// input and network callbacks wait at most that long, and a frame callback is delayed by at
-// most one slice: 8 ms, 4 ms while the user drags the view or a slider.
-constexpr double kSliceMs = 8.0;
-constexpr double kInteractiveSliceMs = 4.0;
-// Download progress alone (no new level) redraws the panel at most this often: each drawn frame
-// costs a software GPU tens of ms that the first surface and refinement need more.
+// Refinement runs in the worker (worker_api.cpp); this thread draws what it reports. Download progress alone (no new
+// level) redraws the panel at most this often: each drawn frame costs a software GPU tens of ms that the first surface
+// and refinement need more.
 constexpr double kProgressRedrawMs = 250.0;
 // On a software GL the GPU process renders each frame on the same CPU cores the refinement runs
 // on (~100 ms a frame for Harmonic 64 in SwiftShader), so a level that is only refining, with
@@ -89,7 +83,7 @@ void onMouseButton(GLFWwindow* w, int button, int action, int mods) {
     g_app.drag.button = button;
     const bool shift = (mods & GLFW_MOD_SHIFT) || glfwGetKey(w, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS ||
                        glfwGetKey(w, GLFW_KEY_RIGHT_SHIFT) == GLFW_PRESS;
-    g_app.drag.slice = button == GLFW_MOUSE_BUTTON_LEFT && shift && g_app.state.sliceOn;
+    g_app.drag.slice = button == GLFW_MOUSE_BUTTON_LEFT && shift && g_app.page.settings.sliceOn;
     glfwGetCursorPos(g_app.canvas.window, &g_app.drag.lastX, &g_app.drag.lastY);
   } else if (action == GLFW_RELEASE && button == g_app.drag.button) {
     g_app.drag.button = -1;
@@ -104,11 +98,12 @@ void onCursorPos(GLFWwindow*, double x, double y) {
   g_app.drag.lastX = x;
   g_app.drag.lastY = y;
   if (g_app.drag.slice) {
-    ViewerState& s = g_app.state;
+    PageState& p = g_app.page;
     float lo = 0, hi = 0;
-    sliceOffsetRange(s, lo, hi);
-    const float offset = s.slice.offset() - dy * (hi - lo) / float(std::max(g_app.canvas.height, 1));
-    setSlicePlane(s, s.slice.normal(), std::clamp(offset, lo, hi));
+    sliceOffsetRange(p, lo, hi);
+    const float offset = p.settings.sliceOffset - dy * (hi - lo) / float(std::max(g_app.canvas.height, 1));
+    setSlicePlane(p, p.settings.sliceNormal, std::clamp(offset, lo, hi));
+    sendCommands();
     return;
   }
   g_app.view.moved = true;
@@ -148,10 +143,10 @@ void resetView() {
 
 // Moves the slice by a fiftieth of its range (sign: forward / back).
 void nudgeSlice(float sign) {
-  ViewerState& s = g_app.state;
+  PageState& p = g_app.page;
   float lo = 0, hi = 0;
-  sliceOffsetRange(s, lo, hi);
-  setSlicePlane(s, s.slice.normal(), std::clamp(s.slice.offset() + sign * (hi - lo) / 50.f, lo, hi));
+  sliceOffsetRange(p, lo, hi);
+  setSlicePlane(p, p.settings.sliceNormal, std::clamp(p.settings.sliceOffset + sign * (hi - lo) / 50.f, lo, hi));
 }
 
 // Keyboard shortcuts (panel.cpp lists them in the help panel). Printable ones come as
@@ -162,16 +157,19 @@ bool keysForUs() { return !(ImGui::GetCurrentContext() && ImGui::GetIO().WantTex
 void onChar(GLFWwindow*, unsigned int c) {
   requestRedraw();
   if (!keysForUs()) return;
-  ViewerState& s = g_app.state;
-  const Manifest& m = s.dataset.manifest;
+  PageState& s = g_app.page;
+  const Manifest& m = s.manifest;
   switch (c) {
     case '?': s.view.showHelp = !s.view.showHelp; break;
     case 'r':
     case 'R': resetView(); break;
     case 'b':
-    case 'B': s.view.showBoundary = !s.view.showBoundary; break;
+    case 'B':
+      s.settings.showBoundary = !s.settings.showBoundary;
+      s.settingsDirty = true;
+      break;
     case 'p':
-    case 'P': setSliceEnabled(s, !s.sliceOn); break;
+    case 'P': setSliceEnabled(s, !s.settings.sliceOn); break;
     case 'x':
     case 'X':
     case 'y':
@@ -189,10 +187,11 @@ void onChar(GLFWwindow*, unsigned int c) {
     case ']': nudgeSlice(1); break;
     case 'c':
     case 'C':
-      if (!m.fields.empty()) setColourField(s, s.colour.field + 1 >= int(m.fields.size()) ? -1 : s.colour.field + 1);
+      if (!m.fields.empty())
+        setColourField(s, s.settings.colourField + 1 >= int(m.fields.size()) ? -1 : s.settings.colourField + 1);
       break;
     case 'm':
-    case 'M': setColourMap(s, ColourMap((int(s.colour.map) + 1) % kColourMapCount)); break;
+    case 'M': setColourMap(s, ColourMap((int(s.settings.colourMap) + 1) % kColourMapCount)); break;
     case 'f':
     case 'F': fitColourRange(s); break;
     case 'l':
@@ -204,13 +203,14 @@ void onChar(GLFWwindow*, unsigned int c) {
       break;
     default: break;
   }
+  sendCommands();
 }
 
 void onKey(GLFWwindow*, int key, int, int action, int) {
   requestRedraw();
   if (action != GLFW_PRESS || !keysForUs()) return;
-  if (key == GLFW_KEY_F1) g_app.state.view.showHelp = !g_app.state.view.showHelp;
-  if (key == GLFW_KEY_ESCAPE) g_app.state.view.showHelp = false;
+  if (key == GLFW_KEY_F1) g_app.page.view.showHelp = !g_app.page.view.showHelp;
+  if (key == GLFW_KEY_ESCAPE) g_app.page.view.showHelp = false;
 }
 
 }  // namespace
@@ -218,7 +218,7 @@ void onKey(GLFWwindow*, int key, int, int action, int) {
 // The panel or a key asked to pause or resume: the page owns the fetches and decides
 // (docs/js-api.md, Module.onPauseChange); its next network snapshot shows the result.
 void notifyPause() {
-  ViewerState& s = g_app.state;
+  PageState& s = g_app.page;
   if (!s.pauseToggleRequested) return;
   s.pauseToggleRequested = false;
   tsjs_pause_change(!s.network.paused);
@@ -227,17 +227,20 @@ void notifyPause() {
 namespace {
 
 // ---------------------------------------------------------------- drawing
-bool interacting();  // below, with the refinement slices
+bool interacting();  // below, with the worker
 
 // Whether a software GL draws this frame's scene at reduced resolution (frame_policy.h).
-bool reducedWanted(const ViewerState& s) { return g_app.canvas.softwareGl && (refining(s) || interacting()); }
+// Splits are being applied, or the worker has yet to answer the latest view.
+bool refining(const PageState& p) { return p.model.refining || !viewCurrent(p); }
+
+bool reducedWanted(const PageState& p) { return g_app.canvas.softwareGl && (refining(p) || interacting()); }
 
 void drawFrame() {
   App& a = g_app;
-  ViewerState& s = a.state;
+  PageState& s = a.page;
   if (s.dirty.bounds) {
     const OrbitCamera pinned = a.view.camera;
-    a.view.camera.setBounds(s.dataset.manifest.bounds.min, s.dataset.manifest.bounds.max, aspect());
+    a.view.camera.setBounds(s.manifest.bounds.min, s.manifest.bounds.max, aspect());
     if (a.view.pinned) {  // a view from a link: the bounds change, the view does not
       a.view.camera.target = pinned.target;
       a.view.camera.distance = pinned.distance;
@@ -270,8 +273,8 @@ void drawFrame() {
     s.dirty.surface = false;
   }
   if (s.dirty.slice) {
-    uploadSlice(a.renderer, s.slice.surface());
-    s.slice.surface().clearChanges();
+    uploadSlice(a.renderer, s.slice);
+    s.slice.clearChanges();
     s.dirty.slice = false;
   }
   if (s.dirty.hull) {
@@ -279,7 +282,7 @@ void drawFrame() {
     s.hull.clearChanges();
     s.dirty.hull = false;
   }
-  s.memory.gpuBytes = gpuBufferBytes(a.renderer);
+  s.gpuBytes = gpuBufferBytes(a.renderer);
   s.telemetry.uploadBytes = a.renderer.uploads.bytes;
   s.telemetry.fullUploads = a.renderer.uploads.full;
   s.telemetry.partialUploads = a.renderer.uploads.partial;
@@ -289,12 +292,12 @@ void drawFrame() {
   p.projection = a.view.camera.projection(aspect());
   p.framebufferWidth = a.canvas.width;
   p.framebufferHeight = a.canvas.height;
-  p.showBoundary = s.view.showBoundary;
-  p.colourBy = s.colour.field >= 0;
-  p.colourMin = s.colour.min;
-  p.colourMax = s.colour.max;
-  p.showSlice = s.sliceOn;
-  setColourMap(a.renderer, s.colour.map);
+  p.showBoundary = s.settings.showBoundary;
+  p.colourBy = s.settings.colourField >= 0;
+  p.colourMin = s.settings.colourMin;
+  p.colourMax = s.settings.colourMax;
+  p.showSlice = s.settings.sliceOn;
+  setColourMap(a.renderer, s.settings.colourMap);
   const bool busy = refining(s) || interacting();
   const float scale = sceneScale(a.canvas.softwareGl, busy, a.pacing.captureRequested, a.canvas.width, a.canvas.height);
   drawSceneScaled(a.renderer, p, scale);
@@ -310,7 +313,7 @@ void drawFrame() {
 
   // The surface's draw calls are submitted; the browser presents them when this callback returns.
   const double now = emscripten_get_now();
-  if (s.surfaceReady && s.telemetry.firstSurfaceMs < 0) {
+  if (s.model.surfaceReady && s.telemetry.firstSurfaceMs < 0) {
     s.telemetry.firstSurfaceMs = now;
     requestRedraw();  // the panel shows the time
   }
@@ -333,62 +336,42 @@ bool gpuBusy(double now) {
   return false;
 }
 
-// ---------------------------------------------------------------- refinement between frames
-void noteComplete(ViewerState& s) {
-  if (s.state == LoadState::Complete && s.telemetry.completeMs < 0) s.telemetry.completeMs = emscripten_get_now();
-}
-
+// ---------------------------------------------------------------- the worker
 bool interacting() { return g_app.drag.button >= 0 || (ImGui::GetCurrentContext() && ImGui::IsAnyItemActive()); }
 
-void queueWork() {
-  if (g_app.pacing.workQueued) return;
-  g_app.pacing.workQueued = true;
-  tsjs_queue_work();  // a task of its own soon after (platform_calls.js)
+void noteComplete(PageState& p) {
+  if (shownState(p) == LoadState::Complete && p.telemetry.completeMs < 0) p.telemetry.completeMs = emscripten_get_now();
 }
 
-// New work (a chunk, a level, resuming) starts at once rather than at the next frame, which on a
-// software GL may be 100-200 ms away while the GPU process renders the last one.
+bool commandsWaiting(const PageState& p) {
+  return p.opened && (p.settingsDirty || ((p.levelRequest >= 0 || p.levelSplitsRequest >= 0) && p.levelVersion == 0));
+}
 }  // namespace
 
-void workOnChange() {
-  if (refining(g_app.state) || treePending(g_app.state)) queueWork();
+void sendCommands() {
+  if (commandsWaiting(g_app.page)) tsjs_command_ready();
 }
 
-// One refinement slice (called from the MessageChannel task queued above; not for the page).
-extern "C" EMSCRIPTEN_KEEPALIVE void ts_work() {
-  App& a = g_app;
-  ViewerState& s = a.state;
-  a.pacing.workQueued = false;
-  const double start = emscripten_get_now();
-  const double deadline = start + (interacting() ? kInteractiveSliceMs : kSliceMs);
-  if (refining(s)) {
-    advance(s, deadline, emscripten_get_now);  // marks what changed; frame() redraws it
-  } else {
-    growTree(s, deadline, emscripten_get_now);
-  }
-  noteComplete(s);
-  if (refining(s) || treePending(s)) queueWork();
-}
 namespace {
 
 // ---------------------------------------------------------------- frame
 // While a dataset of nodes streams in, turning the camera changes which regions come first
-// (fetch_plan.h: what a region covers on screen): the page is asked for a new plan, at most
-// twice a second (each is a pass over the nodes and a new order for the loader).
-void replanForCamera(App& a, double now) {
-  const ViewerState& s = a.state;
+// (fetch_plan.h: what a region covers on screen): the worker hears of the camera at most twice a
+// second (each is a new plan: a pass over the nodes and a new order for the loader).
+void sendCamera(App& a, double now) {
+  const PageState& p = a.page;
   const OrbitCamera& c = a.view.camera;
-  const OrbitCamera& p = a.plannedCamera;
-  if (s.dataset.manifest.nodes.empty() || s.fetch.missing == 0 || now - a.cameraReplanMs < 500) return;
-  if (c.target == p.target && c.distance == p.distance && c.yaw == p.yaw && c.pitch == p.pitch) return;
-  a.plannedCamera = c;
-  a.cameraReplanMs = now;
-  ++a.state.fetch.version;
+  const OrbitCamera& sent = a.cameraSent;
+  if (p.manifest.nodes.empty() || p.model.chunksMissing == 0 || now - a.cameraSentMs < 500) return;
+  if (c.target == sent.target && c.distance == sent.distance && c.yaw == sent.yaw && c.pitch == sent.pitch) return;
+  a.cameraSent = c;
+  a.cameraSentMs = now;
+  tsjs_camera_changed(c.target.x, c.target.y, c.target.z, c.distance, c.yaw, c.pitch, aspect());
 }
 
 void frame() {
   App& a = g_app;
-  ViewerState& s = a.state;
+  PageState& s = a.page;
   const double start = emscripten_get_now();
   const bool measuring = s.telemetry.firstSurfaceMs >= 0;  // frame times count once the first surface is up
   if (a.pacing.lastFrameStart >= 0) {
@@ -399,12 +382,7 @@ void frame() {
   a.pacing.lastFrameStart = start;
   syncCanvasSize();
   noteComplete(s);
-  replanForCamera(a, start);
-  if (s.fetch.version != a.planVersionSent) {
-    a.planVersionSent = s.fetch.version;
-    tsjs_plan_changed();
-  }
-  if (refining(s) || treePending(s)) queueWork();
+  sendCamera(a, start);
   if (downloading(s) && start - a.pacing.lastDrawStart >= kProgressRedrawMs)
     requestRedraw(1);  // progress and rate move
   // Draw only when something changed: on a software GL (SwiftShader) or a slow GPU a frame can
@@ -416,7 +394,7 @@ void frame() {
     requestRedraw();
   if (a.pacing.reducedShown && !reducedWanted(s)) requestRedraw(1);  // the still frame, full size
   // The first surface is drawn at once, even behind a frame the GPU has not finished.
-  const bool firstSurface = s.surfaceReady && s.telemetry.firstSurfaceMs < 0;
+  const bool firstSurface = s.model.surfaceReady && s.telemetry.firstSurfaceMs < 0;
   if (a.pacing.redrawFrames > 0 && !s.contextLost && (firstSurface || !gpuBusy(start))) {
     --a.pacing.redrawFrames;
     a.pacing.lastDrawStart = start;
@@ -429,6 +407,7 @@ void frame() {
     s.telemetry.drawTotalMs += s.telemetry.drawMs;
   }
   notifyPause();
+  sendCommands();
   const double end = emscripten_get_now();
   if (measuring) s.telemetry.maxFrameMs = std::max(s.telemetry.maxFrameMs, end - start);
 }
@@ -442,14 +421,14 @@ constexpr const char* kImGuiGlsl = "#version 300 es";
 // browser gives a context back, the renderer's and the panel's GL objects are made again and
 // everything is uploaded in full.
 EM_BOOL onContextLost(int, const void*, void*) {
-  g_app.state.contextLost = true;
+  g_app.page.contextLost = true;
   g_app.pacing.gpuFence = nullptr;  // (a sync object of the lost context)
   return EM_TRUE;                   // (the event's default is prevented: the browser may restore it)
 }
 
 EM_BOOL onContextRestored(int, const void*, void*) {
   App& a = g_app;
-  ViewerState& s = a.state;
+  PageState& s = a.page;
   const Renderer lost = a.renderer;
   a.renderer = Renderer{};
   a.renderer.samples = lost.samples;
@@ -499,10 +478,10 @@ bool initPlatform(std::string& error) {
   // cost the main thread ~350 ms and, asked from a worker, made a third context in the GPU process
   // just as the first frames were drawn.
   g_app.canvas.softwareGl = tsjs_software_gl() != 0;
-  g_app.state.telemetry.softwareGl = g_app.canvas.softwareGl;
+  g_app.page.telemetry.softwareGl = g_app.canvas.softwareGl;
   const int antialias = tsjs_antialias();
   g_app.renderer.samples = antialias == 1 || (antialias < 0 && !g_app.canvas.softwareGl) ? 4 : 0;
-  g_app.state.telemetry.samples = g_app.renderer.samples;
+  g_app.page.telemetry.samples = g_app.renderer.samples;
   emscripten_set_webglcontextlost_callback("#canvas", nullptr, EM_FALSE, onContextLost);
   emscripten_set_webglcontextrestored_callback("#canvas", nullptr, EM_FALSE, onContextRestored);
   glfwSetMouseButtonCallback(g_app.canvas.window, onMouseButton);
@@ -555,7 +534,7 @@ int main() {
   std::string error;
   if (!initPlatform(error)) {
     g_app.canvas.platformError = error;
-    failLoad(g_app.state, error);
+    failPage(g_app.page, error);
     std::fprintf(stderr, "tetstream: %s\n", error.c_str());
     return 0;  // the exported functions keep working: JS still sees the state and the error
   }

@@ -25,20 +25,16 @@ mergeInto(LibraryManager.library, {
     if (Module.onPauseChange) Module.onPauseChange(!!paused);
   },
 
-  // What the view needs changed (isovalue, field, slice, fetch mode, a node given up): the page
-  // asks for the plan again (ts_plan_json) and hands it to its chunk loader.
-  tsjs_plan_changed: function () {
-    if (Module.onPlanChanged) Module.onPlanChanged();
+  // The view changed (page_state.h): the page's script takes the command (ts_take_command) and
+  // posts it to the refinement worker, once per task however many changes came.
+  tsjs_command_ready: function () {
+    if (Module.onCommandReady) Module.onCommandReady();
   },
 
-  // A message to a MessageChannel port runs as its own task soon after, without setTimeout's
-  // 4 ms clamp; rendering, input and network callbacks get their turns in between.
-  tsjs_queue_work: function () {
-    if (!Module.tsWorkChannel) {
-      Module.tsWorkChannel = new MessageChannel();
-      Module.tsWorkChannel.port1.onmessage = () => Module._ts_work();
-    }
-    Module.tsWorkChannel.port2.postMessage(0);
+  // The camera moved while regions are still to come: the worker orders them by what each
+  // covers on screen.
+  tsjs_camera_changed: function (tx, ty, tz, distance, yaw, pitch, aspect) {
+    if (Module.onCameraChanged) Module.onCameraChanged([tx, ty, tz, distance, yaw, pitch, aspect]);
   },
 
   // 1 when the viewer's WebGL 2 context is drawn by a software rasterizer. Remembers the

@@ -325,7 +325,7 @@ void warmUpRenderer(Renderer& r, bool reducedToo) {
 }
 
 namespace {
-void uploadTo(Renderer& r, SurfaceGpu& g, const IncrementalIsosurface& s) {
+void uploadTo(Renderer& r, SurfaceGpu& g, const SurfaceMirror& s) {
   const bool full = s.fullUploadNeeded();
   glBindVertexArray(0);  // keep the VAO's element binding untouched by the array uploads
   sync(r, GL_ARRAY_BUFFER, g.positions, s.positions().data(), s.vertexSlotCount(), 12, s.changedVertices(), full);
@@ -338,10 +338,10 @@ void uploadTo(Renderer& r, SurfaceGpu& g, const IncrementalIsosurface& s) {
 }
 }  // namespace
 
-void uploadSurface(Renderer& r, const IncrementalIsosurface& s) { uploadTo(r, r.iso, s); }
-void uploadSlice(Renderer& r, const IncrementalIsosurface& s) { uploadTo(r, r.slice, s); }
+void uploadSurface(Renderer& r, const SurfaceMirror& s) { uploadTo(r, r.iso, s); }
+void uploadSlice(Renderer& r, const SurfaceMirror& s) { uploadTo(r, r.slice, s); }
 
-void uploadHull(Renderer& r, const HullTracker& h) {
+void uploadHull(Renderer& r, const HullMirror& h) {
   const bool full = h.fullUploadNeeded();
   glBindVertexArray(0);
   sync(r, GL_ARRAY_BUFFER, r.hullPositions, h.trianglePositions().data(), h.triangleCount(), 36, h.changedTriangles(),

@@ -2,10 +2,10 @@
 // from a headlight, two-sided (the low-field side has a cool tint, the high-field side a warm
 // one), and the domain boundary as a faint translucent hull with its crease edges drawn as lines.
 //
-// Uploads follow the model's change lists: while splits stream in, only the slots written since
-// the last frame go to the GPU (bufferSubData over runs of nearby slots); a whole buffer is sent
-// only after a full extraction (isovalue, field) or when it has to grow (doubling, so rarely).
-// Needs a current GL context; everything else about the viewer lives in GL-free files.
+// Uploads follow the change lists of the mirrors the worker's deltas keep (geometry_sync.h): while splits stream in,
+// only the slots written since the last frame go to the GPU (bufferSubData over runs of nearby slots); a whole buffer
+// is sent only after a full extraction (isovalue, field) or when it has to grow (doubling, so rarely). Needs a current
+// GL context; everything else about the viewer lives in GL-free files.
 #pragma once
 #include <cstdint>
 #include <glm/glm.hpp>
@@ -13,8 +13,7 @@
 #include <vector>
 
 #include "colourmap.h"
-#include "isosurface_incremental.h"
-#include "viewer_state.h"
+#include "geometry_sync.h"
 
 namespace tetstream::viewer {
 
@@ -32,7 +31,7 @@ struct UploadStats {
   uint32_t grown = 0;              // full uploads because the buffer had to grow (first one too)
 };
 
-// The GPU side of an IncrementalIsosurface (the isosurface, or the slice).
+// The GPU side of a surface (the isosurface, or the slice).
 struct SurfaceGpu {
   GpuBuffer positions, normals, colours, indices;  // elements: vertex slots (x3) and triangles
   uint32_t vao = 0;
@@ -75,10 +74,10 @@ bool initRenderer(Renderer& r, std::string& error);
 // multisampled one whenever r.samples is set.
 void warmUpRenderer(Renderer& r, bool reducedToo);
 
-// Sends what changed since the model's last clearChanges(); the caller clears them afterwards.
-void uploadSurface(Renderer& r, const IncrementalIsosurface& surface);
-void uploadSlice(Renderer& r, const IncrementalIsosurface& slice);  // an empty one hides it
-void uploadHull(Renderer& r, const HullTracker& hull);
+// Sends what changed since the mirror's last clearChanges(); the caller clears them afterwards.
+void uploadSurface(Renderer& r, const SurfaceMirror& surface);
+void uploadSlice(Renderer& r, const SurfaceMirror& slice);  // an empty one hides it
+void uploadHull(Renderer& r, const HullMirror& hull);
 
 struct FrameParams {
   glm::mat4 view{1.f}, projection{1.f};

@@ -36,6 +36,8 @@ std::string statsJson(const ViewerState& s) {
       {"chunksApplied", ds.chunksApplied()},
       {"chunksTotal", s.chunksTotal},
       {"exact", exactSurface(s)},
+      {"refining", refining(s)},
+      {"surfaceReady", s.surfaceReady},
       {"nodesLoaded", nodesLoaded(s)},
       {"nodesTotal", m.nodes.size()},
       {"fetchMode", s.fetch.mode == FetchMode::Everything ? "everything" : "needed"},

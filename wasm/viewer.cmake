@@ -1,9 +1,12 @@
 # Browser viewer (Emscripten only; included from the root CMakeLists.txt).
 #   tetstream_imgui   Dear ImGui 1.86 + GLFW and OpenGL3 backends (sources in build/_deps/imgui)
 #   tetstream_viewer  tetstream.js + tetstream.wasm in ${TETSTREAM_WEB_DIR}, plus every file of web/
-# platform.cpp and api.cpp are the only viewer files with Emscripten (and imgui_gl_queries.cpp);
-# the model (viewer_state, viewer_memory, telemetry, colourmap, camera, frame_policy.h) has no GL
-# and no Emscripten and also compiles natively, for the unit tests.
+# One program for both threads: the page runs main() (platform.cpp, api.cpp: drawing, panel,
+# input) and the refinement worker instantiates the same module without it (worker_api.cpp:
+# dataset, splits, surfaces). Those and imgui_gl_queries.cpp are the only viewer files with
+# Emscripten; the model (viewer_state, viewer_memory, telemetry, geometry_sync, page_state,
+# view_settings, colourmap, camera, frame_policy.h) has no GL and no Emscripten and also
+# compiles natively, for the unit tests.
 
 set(TETSTREAM_IMGUI_DIR "${TETSTREAM_DEPS_DIR}/imgui")
 if(NOT EXISTS "${TETSTREAM_IMGUI_DIR}/imgui.cpp")
@@ -30,6 +33,9 @@ target_compile_definitions(tetstream_imgui PUBLIC IMGUI_USER_CONFIG="imconfig_te
 add_executable(tetstream_viewer
   ${CMAKE_CURRENT_LIST_DIR}/platform.cpp
   ${CMAKE_CURRENT_LIST_DIR}/api.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/worker_api.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/page_state.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/view_settings.cpp
   ${CMAKE_CURRENT_LIST_DIR}/viewer_state.cpp
   ${CMAKE_CURRENT_LIST_DIR}/geometry_sync.cpp
   ${CMAKE_CURRENT_LIST_DIR}/telemetry.cpp

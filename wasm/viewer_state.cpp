@@ -580,4 +580,35 @@ std::string viewJson(const ViewerState& s) {
   return viewObject(s).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
+bool applyView(ViewerState& s, const nlohmann::json& view) {
+  using json = nlohmann::json;
+  if (!view.is_object()) return false;
+  const Manifest& m = s.dataset.manifest;
+  auto fieldOf = [&](const char* key) {
+    const json& name = view.value(key, json(nullptr));
+    return name.is_string() ? m.findField(name.get<std::string>()) : -1;
+  };
+  auto number = [&](const json& j, float fallback) { return j.is_number() ? j.get<float>() : fallback; };
+  const int field = fieldOf("field");
+  if (field >= 0 && field != s.field) setField(s, field);
+  setIsovalue(s, number(view.value("isovalue", json(nullptr)), s.isovalue));
+  const int colour = fieldOf("colourField");
+  if (colour != s.colour.field) setColourField(s, colour);
+  if (const json& range = view.value("colourRange", json(nullptr)); range.is_array() && range.size() == 2)
+    setColourRange(s, number(range[0], s.colour.min), number(range[1], s.colour.max));
+  if (const json& map = view.value("colourMap", json(nullptr)); map.is_string())
+    if (std::optional<ColourMap> c = parseColourMap(map.get<std::string>())) setColourMap(s, *c);
+  if (const json& slice = view.value("slice", json(nullptr)); slice.is_object()) {
+    const json& n = slice.value("normal", json(nullptr));
+    if (n.is_array() && n.size() == 3)
+      setSlicePlane(s, {number(n[0], 0), number(n[1], 0), number(n[2], 0)},
+                    number(slice.value("offset", json(nullptr)), s.slice.offset()));
+    setSliceEnabled(s, slice.value("on", false));
+  }
+  if (const json& fetch = view.value("fetch", json(nullptr)); fetch.is_string())
+    setFetchMode(s, fetch.get<std::string>() == "everything" ? FetchMode::Everything : FetchMode::Needed);
+  s.view.showBoundary = view.value("showBoundary", s.view.showBoundary);
+  return true;
+}
+
 }  // namespace tetstream::viewer

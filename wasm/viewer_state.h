@@ -243,4 +243,9 @@ bool growTree(ViewerState& s, double deadlineMs, Clock now);
 nlohmann::json viewObject(const ViewerState& s);
 std::string viewJson(const ViewerState& s);
 
+// Applies a view chosen elsewhere (the page's settings: view_settings.h, settingsObject) as it
+// is: field, isovalue, colour field, map and range, slice, fetch mode, showBoundary. Missing or
+// unknown keys leave their part alone; a field name the dataset lacks changes nothing.
+bool applyView(ViewerState& s, const nlohmann::json& view);
+
 }  // namespace tetstream::viewer

@@ -86,6 +86,7 @@ export class ChunkLoader {
     this.warmed = this.attached;   // before: the program is still downloading, only the base
     this.programNearlyIn = false;  // its last bytes are coming: the first split chunk too
     this.unchecked = new Set();    // arrived before attach()
+    this.checking = new Set();     // offered to the check, its answer not in yet
     this.total = urls.length;
     this.plan = [];                // chunk indices in the order they are handed over
     this.position = new Map();     // chunk index -> its place in the plan
@@ -266,7 +267,7 @@ export class ChunkLoader {
     const limit = baseComing ? MAX_IN_FLIGHT_BEFORE_BASE : MAX_IN_FLIGHT;
     for (let p = this.nextPos; p < end && this.inFlight.size < limit; p++) {
       const i = this.plan[p];
-      if (this.arrived.has(i) || this.inFlight.has(i) || this.waiting.has(i) || this.unavailable.has(i)) continue;
+      if (this.arrived.has(i) || this.checking.has(i) || this.inFlight.has(i) || this.waiting.has(i) || this.unavailable.has(i)) continue;
       if (p > this.nextPos && ahead + this.sizes[i] > MAX_AHEAD_BYTES) break;
       if (this.inFlight.size > 0 && outstanding >= this.lead()) break;
       this.fetchChunk(i, outstanding);
@@ -325,9 +326,11 @@ export class ChunkLoader {
     });
   }
 
-  // Checks chunk i; keeps it for the hand-over, or fetches it again when damaged.
+  // Checks chunk i; keeps it for the hand-over, or fetches it again when damaged. The check may
+  // answer later (a promise: the viewer checks in its worker); the chunk waits meanwhile.
   accept(i, bytes) {
     this.arrived.delete(i);
+    const size = bytes.length;
     let damage;
     try {
       damage = this.check(i, bytes);
@@ -335,7 +338,27 @@ export class ChunkLoader {
       this.failAt(i, e.message);
       return;
     }
+    if (damage && typeof damage.then === 'function') {
+      this.checking.add(i);
+      damage.then((d) => {
+        this.checked(i, bytes, size, d);
+        if (!this.stopped) this.pump(); // room ahead for more
+      }, (e) => {
+        this.checking.delete(i);
+        if (!this.stopped) this.failAt(i, e.message);
+      });
+      return;
+    }
+    this.checked(i, bytes, size, damage);
+  }
+
+  // The check's answer for chunk i (`size` bytes: a check that took them over leaves `bytes`
+  // empty, and only the count is kept).
+  checked(i, bytes, size, damage) {
+    this.checking.delete(i);
+    if (this.stopped) return;
     if (!this.position.has(i)) return; // the page replanned without it meanwhile
+    if (bytes.length !== size) bytes = { length: size };
     if (damage) {
       this.refused++;
       this.note({ event: 'refused', index: i, cause: 'damaged' });

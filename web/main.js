@@ -3,10 +3,11 @@
 // other parameters and window.tetstream are described in docs/js-api.md.
 //   page.js     shared state        program.js  the viewer program
 //   stream.js   manifest, chunks and the network's figures
+//   refiner.js  the refinement worker (worker.js): chunks and the view to it, updates back
 //   api.js      window.tetstream and the view in the URL
 //   status.js   the status line     input.js    touch and folder drop
-// Imports go one way (none back up): net.js, rate.js, loader.js, page.js; program.js, status.js;
-// stream.js; api.js, input.js; this file, which wires the hooks that point back up.
+// Imports go one way (none back up): net.js, rate.js, loader.js, page.js; program.js, status.js,
+// refiner.js; stream.js; api.js, input.js; this file, which wires the hooks that point back up.
 import { applyLinkState, applyPendingLevel, copyLink, forgetPendingLevel, saveScreenshot, syncUrl } from './api.js';
 import { setFolderHooks } from './input.js';
 import { page, params } from './page.js';

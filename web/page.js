@@ -20,6 +20,7 @@ export const maxMemoryMB = positiveParam('maxMemoryMB');
 // compressed response's Content-Length would not tell).
 export const page = {
   viewer: null,          // the Emscripten module once it is instantiated
+  programModule: null,   // the compiled tetstream.wasm (WebAssembly.Module), for the refinement worker too
   viewerStarted: false,  // its main() has run
   loader: null,          // the ChunkLoader of the dataset being streamed
   state: 'loading',      // what stats() says before the viewer runs

@@ -131,7 +131,10 @@ export async function loadProgram(hooks) {
       antialias: antialiasOption(),
       onAbort: hooks.onAbort,
       instantiateWasm(imports, receive) {
-        instantiateProgram(imports, hooks).then((r) => receive(r.instance, r.module), reject);
+        instantiateProgram(imports, hooks).then((r) => {
+          page.programModule = r.module; // the refinement worker instantiates it too
+          receive(r.instance, r.module);
+        }, reject);
         return {}; // exports arrive through receive()
       },
     }).then(resolve, (e) => reject(new LoadError(`The viewer program (tetstream.wasm) could not start: ${e && e.message ? e.message : e}`)));

@@ -8,6 +8,7 @@ import { fetchBytes } from './net.js';
 import { boot, copyToWasm, LoadError, maxMemoryMB, page, stallMs, viewerReady, wasmString } from './page.js';
 import { loadProgram, prepareWebGl, withRetries } from './program.js';
 import { RateMeter } from './rate.js';
+import { refiner } from './refiner.js';
 import { noticeText, showError, showStatus } from './status.js';
 
 const MANIFEST_LIMIT = 64 << 20; // FORMAT.md §1
@@ -57,6 +58,7 @@ export const network = {
     if (!page.loader || page.loader.stopped) return;
     this.paused = !!paused;
     page.loader.setPaused(this.paused);
+    refiner.post({ type: 'paused', paused: this.paused });
     this.report();
   },
 };
@@ -86,6 +88,7 @@ export function fail(message) {
   if (page.aborted) return;
   if (page.loader) page.loader.stop();
   if (page.viewer) page.viewer.ccall('ts_fail', null, ['string'], [message]);
+  refiner.post({ type: 'fail', message });
   Object.assign(page, { state: 'error', error: message });
   showError(message);
 }
@@ -224,21 +227,18 @@ function chunksOfViewer() {
 // A dataset of nodes (FORMAT.md §1.1): the loader fetches what the viewer's plan says (the
 // nodes the view needs, most important first) and follows it as the view changes; a chunk that
 // cannot be had leaves its region coarse instead of stopping the stream.
-function followPlan(viewer, loader) {
-  const plan = () => JSON.parse(wasmString(viewer._ts_plan_json()));
-  const follow = () => {
+// The plan is the worker's (it knows what is in); it sends a new one whenever it changes.
+function followPlan(viewer, loader, firstPlan) {
+  const follow = (plan) => {
     if (page.loader !== loader || loader.stopped) return;
-    loader.replan(plan());
-    page.datasetTotal = viewer._ts_needed_bytes();
+    loader.replan(plan);
+    page.datasetTotal = viewer._ts_needed_bytes() || page.datasetTotal;
     network.report();
   };
   loader.onIdle = () => network.report();
-  loader.onChunkFailed = (i, message) => {
-    viewer.ccall('ts_chunk_unavailable', null, ['number', 'string'], [i, message]);
-    follow();
-  };
-  viewer.onPlanChanged = follow;
-  follow();
+  loader.onChunkFailed = (i, message) => refiner.post({ type: 'unavailable', index: i, message });
+  refiner.onPlan = follow;
+  follow(firstPlan);
 }
 
 // The viewer said no: its error, on the page too.
@@ -263,6 +263,9 @@ async function stream(manifestUrl) {
   }, () => {});
 
   const viewer = page.viewer = await programPromise; // a failure here has no viewer to report into
+  if (!refiner.worker && !page.aborted) refiner.start(page.programModule, viewerAborted);
+  viewer.onCommandReady = () => refiner.commandReady();
+  viewer.onCameraChanged = (values) => refiner.post({ type: 'camera', values });
   viewer.onPauseChange = (paused) => network.setPaused(paused);
   viewer.onCopyLink = () => { viewHooks.copyLink(); };
   viewer.onScreenshot = () => { viewHooks.saveScreenshot().catch((e) => console.warn(`tetstream: screenshot: ${e.message}`)); };
@@ -272,7 +275,6 @@ async function stream(manifestUrl) {
   } catch (e) {
     return fail(e.message);
   }
-  if (maxMemoryMB) viewer._ts_set_memory_limit(maxMemoryMB);
   const ptr = copyToWasm(manifestBytes);
   let opened;
   try {
@@ -284,6 +286,17 @@ async function stream(manifestUrl) {
     if (page.loader) page.loader.stop();
     return viewerStopped();
   }
+  // The worker reads it too and says how much of it memory allows, and the first plan.
+  const answer = await refiner.open(manifestBytes, maxMemoryMB);
+  if (!answer.ok) {
+    if (page.loader) page.loader.stop();
+    let error = '';
+    try {
+      error = JSON.parse(answer.stats).error || '';
+    } catch { /* the worker stopped: viewerAborted has said so */ }
+    return page.aborted ? undefined : fail(error || 'The viewer could not open this dataset.');
+  }
+  refiner.commandReady(); // the view the dataset starts with
   document.title = `tetstream — ${wasmString(viewer._ts_name()) || manifestUrl.pathname}`;
   if (page.state === 'error') return fail(page.error); // the base could not be had: say so in the panel too
   viewHooks.applyLinkState();
@@ -295,23 +308,26 @@ async function stream(manifestUrl) {
     page.loader = null;
   }
   if (!page.loader) startLoader({ names, sizes }, manifestUrl);
-  const allowed = viewer._ts_chunks_allowed();
+  const allowed = answer.chunksAllowed;
   page.datasetTotal = sizes.slice(0, allowed).reduce((a, b) => a + b, 0);
   const selective = viewer._ts_node_count() > 0;
-  if (selective) followPlan(viewer, page.loader);
+  if (selective) followPlan(viewer, page.loader, answer.plan);
   page.loader.attach({
-    allowed: selective ? Infinity : allowed, // (the viewer's plan holds what memory allows)
-    // The one hand-over: copied into wasm memory once, checked (size, hash) once there, kept
-    // by the viewer and added in order. The viewer frees the copy.
-    check(i, bytes) {
-      const code = viewer._ts_offer_chunk(i, copyToWasm(bytes), bytes.length);
+    allowed: selective ? Infinity : allowed, // (the worker's plan holds what memory allows)
+    // The one hand-over: transferred to the worker, checked (size, hash) there once, kept by
+    // its model and added in order. The answer comes as a message.
+    async check(i, bytes) {
+      const size = bytes.length;
+      const code = await refiner.offer(i, bytes);
+      if (code < 0) throw new LoadError(page.error || 'The viewer stopped.');
       network.report(); // the rate counts these bytes now, not at the next status tick
-      return code === 1 ? null : damageText(code, bytes.length, sizes[i]);
+      return code === 1 ? null : damageText(code, size, sizes[i]);
     },
-    // The loader's turn for chunk i: the viewer added it when it was offered in turn.
-    deliver(i) {
+    // The loader's turn for chunk i: the worker added it when it came in turn (a chunk it could
+    // not add puts the model in error, which its next report says).
+    deliver() {
       startViewer(); // the base is in: show it as soon as possible
-      if (viewer._ts_has_chunk(i) && viewer._ts_load_state() !== ERROR_STATE) return true;
+      if (viewer._ts_load_state() !== ERROR_STATE) return true;
       viewerStopped();
       return false;
     },

@@ -12,8 +12,13 @@
 //   all bytes in    when the last response ended (Resource Timing), against bytes ÷ bandwidth
 //   complete        every chunk received and every split applied, against bytes ÷ bandwidth
 //   frames          rAF intervals from the first surface to complete: how many over 33 ms,
-//                   95th percentile, longest; the viewer's own longest frame callback and
-//                   refinement slice, and all work slices (refinement, interval tree) by duration
+//                   95th percentile, longest; the viewer's own longest frame callback and the
+//                   worker's longest refinement slice, and all its work slices by duration
+//   long tasks      tasks of the page's thread over 50 ms (Long Tasks API) before the first
+//                   surface and while streaming: refinement runs in a worker, so these are
+//                   start-up, drawing (SwiftShader draws on the CPU) and the browser's own
+//   splits/s        the worker's rate while it refines, and splits over the time from the
+//                   first surface to complete
 // Writes build/bench/stream.json. Not a test: nothing is asserted; single runs unless --runs.
 // EXTRA_QUERY (environment) is appended to the viewer's URL, e.g. "&boundary=0"; VW and VH set
 // the window size (default 1280 x 800).
@@ -52,6 +57,10 @@ function packed(name, makeInput, packArgs = []) {
 function recordFrames() {
   window.__frames = [];
   window.__samples = [];
+  window.__longTasks = [];
+  new PerformanceObserver((list) => {
+    for (const e of list.getEntries()) window.__longTasks.push([e.startTime, e.duration]);
+  }).observe({ type: 'longtask', buffered: true });
   let last = performance.now();
   const tick = (t) => {
     window.__frames.push([t, t - last]);
@@ -87,6 +96,8 @@ async function measure(browser, url) {
     const timeline = [nav, ...resources].map((e) => [e.name.split('/').pop(), e.startTime, e.responseStart, e.responseEnd, e.encodedBodySize]
       .map((x) => (typeof x === 'number' ? Math.round(x) : x)));
     const streaming = window.__frames.filter(([t]) => t > s.firstSurfaceMs && t <= s.completeMs).map(([, d]) => d);
+    const longTasks = (from, to) => window.__longTasks.filter(([t]) => t >= from && t < to).map(([, d]) => d);
+    const startupLong = longTasks(0, s.firstSurfaceMs), streamingLong = longTasks(s.firstSurfaceMs, s.completeMs);
     streaming.sort((a, b) => a - b);
     return {
       state: s.state, error: s.error, name: s.name, chunks: s.chunksTotal, splits: s.splitsTotal, tets: s.tets,
@@ -101,10 +112,13 @@ async function measure(browser, url) {
       framesOver33: streaming.filter((d) => d > 33).length,
       frameP95: streaming.length ? streaming[Math.floor(0.95 * (streaming.length - 1))] : 0,
       frameMax: streaming.length ? streaming[streaming.length - 1] : 0,
+      longTasksStartup: startupLong.length, longestStartup: Math.max(0, ...startupLong),
+      longTasksStreaming: streamingLong.length, longestStreaming: Math.max(0, ...streamingLong),
+      refinement: s.refinement, workerUpdates: s.worker ? s.worker.updates : 0, splitsApplied: s.splitsApplied,
       maxFrameMs: s.maxFrameMs, maxRefineMs: s.maxRefineMs, maxDrawMs: s.maxDrawMs,
       sliceEdgesMs: s.sliceEdgesMs, sliceCounts: s.sliceCounts,
       refineTotalMs: s.refineTotalMs, drawTotalMs: s.drawTotalMs, softwareGl: s.softwareGl, reducedFrames: s.reducedFrames, uploads: { bytes: s.uploadBytes, full: s.fullUploads, partial: s.partialUploads, grown: s.grownUploads },
-      heapMB: s.memory.heapBytes / 1048576, dataMB: s.memory.dataBytes / 1048576, gpuMB: s.memory.gpuBytes / 1048576,
+      heapMB: s.memory.heapBytes / 1048576, pageHeapMB: (s.memory.pageHeapBytes || 0) / 1048576, dataMB: s.memory.dataBytes / 1048576, gpuMB: s.memory.gpuBytes / 1048576,
     };
   });
   await page.close();
@@ -126,9 +140,14 @@ function report(r) {
       `longest ${r.frameMax.toFixed(1)} ms; viewer: longest callback ${r.maxFrameMs.toFixed(1)} ms, ` +
       `refinement ${r.maxRefineMs.toFixed(1)} ms, drawing ${(r.maxDrawMs ?? 0).toFixed(1)} ms`,
     `  ${sliceReport(r)}`,
-    `  main thread from navigation to complete (${f(r.completeMs)} ms): refinement ${f(r.refineTotalMs)} ms ` +
-      `(${f(r.splits / r.refineTotalMs * 1000)} splits/s), drawing ${f(r.drawTotalMs)} ms`,
-    `  memory: heap ${r.heapMB.toFixed(0)} MB, data ${r.dataMB.toFixed(1)} MB, GPU ${r.gpuMB.toFixed(1)} MB` +
+    `  long tasks on the page's thread: ${r.longTasksStartup} before the first surface (longest ` +
+      `${f(r.longestStartup)} ms), ${r.longTasksStreaming} while streaming (longest ${f(r.longestStreaming)} ms)`,
+    `  refinement in the ${r.refinement || 'page'}: ${f(r.refineTotalMs)} ms for ${r.splitsApplied} splits ` +
+      `(${f(r.splitsApplied / r.refineTotalMs * 1000)} splits/s while refining; ` +
+      `${f(r.splitsApplied / Math.max(1, r.completeMs - r.firstSurfaceMs) * 1000)} splits/s from first surface to complete), ` +
+      `${r.workerUpdates} updates to the page; page drawing ${f(r.drawTotalMs)} ms`,
+    `  memory: worker heap ${r.heapMB.toFixed(0)} MB, page heap ${r.pageHeapMB.toFixed(0)} MB, data ${r.dataMB.toFixed(1)} MB, ` +
+      `GPU ${r.gpuMB.toFixed(1)} MB` +
       (r.state !== 'complete' ? `\n  ENDED IN ${r.state}: ${r.error}` : '') +
       (r.pageErrors.length ? `\n  PAGE ERRORS: ${r.pageErrors.join('; ')}` : ''),
   ].join('\n');
@@ -183,7 +202,8 @@ async function main() {
       console.log(`${name}, median of ${rs.length}: first surface ${median('firstSurfaceMs').toFixed(0)} ms, ` +
         `all bytes in ${median('lastByteMs').toFixed(0)} ms, complete ${median('completeMs').toFixed(0)} ms ` +
         `(bytes ÷ bandwidth ${median('idealMs').toFixed(0)} ms), frames over 33 ms ${median('framesOver33')} of ` +
-        `${median('frames')}, longest frame ${median('frameMax').toFixed(0)} ms`);
+        `${median('frames')}, longest frame ${median('frameMax').toFixed(0)} ms, long tasks while streaming ` +
+        `${median('longTasksStreaming')} (longest ${median('longestStreaming').toFixed(0)} ms)`);
     }
   }
   const out = path.join(root, 'build/bench/stream.json');

@@ -118,11 +118,12 @@ export async function waitForState(page, states, timeout = 120000) {
   return page.evaluate(() => window.tetstream.stats());
 }
 
-// Waits until the level has reached its target (the frame loop applies splits a few ms a frame).
+// Waits until the level has reached its target (the refinement worker applies splits in
+// slices) with the latest view applied (viewCurrent: the worker has answered every change).
 export async function waitForLevel(page, timeout = 120000) {
   await page.waitForFunction(() => {
     const s = window.tetstream.stats();
-    return s.splitsApplied === s.targetSplits;
+    return s.viewCurrent && s.splitsApplied === s.targetSplits;
   }, null, { timeout });
   return page.evaluate(() => window.tetstream.stats());
 }
@@ -153,7 +154,13 @@ export function frameReport(s) {
 }
 
 // Lets the viewer draw a few frames (ImGui reads input and applies it on the next frame).
+// Waits for the refinement worker to have answered every change of the view (a surface asked
+// for is in the page), then for `n` animation frames (it is drawn).
 export async function frames(page, n = 4) {
+  await page.waitForFunction(() => {
+    const s = window.tetstream && window.tetstream.stats();
+    return !s || s.viewCurrent !== false || s.state === 'error';
+  }, null, { timeout: 60000 });
   for (let i = 0; i < n; i++) await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => r())));
 }
 

@@ -114,6 +114,13 @@ test('streams a multi-chunk pack to complete, matches the CLI surface, and the i
     `${s.firstSurfaceMs.toFixed(0)} ms after navigation start, complete after ${s.completeMs.toFixed(0)} ms`);
   t.diagnostic(frameReport(s));
   assertSlices(s);
+  // The splits were applied by the refinement worker: the page took its updates (each a
+  // geometry delta), and its own heap holds the surfaces' copies, not the dataset.
+  assert.equal(s.refinement, 'worker');
+  assert.ok(s.worker.updates > 0 && s.worker.deltaBytes > 0, `updates from the worker: ${JSON.stringify(s.worker)}`);
+  assert.ok(s.worker.commands >= 1, 'the view went to the worker');
+  assert.ok(s.memory.pageHeapBytes < s.memory.heapBytes,
+    `the page's heap (${s.memory.pageHeapBytes}) is smaller than the worker's (${s.memory.heapBytes})`);
   // Splits upload changed ranges: a whole buffer goes only when it has to grow (doubling).
   assert.ok(s.partialUploads > 0, 'changed ranges were uploaded');
   assert.equal(s.fullUploads, s.grownUploads, 'no whole-buffer upload while streaming except to grow a buffer');

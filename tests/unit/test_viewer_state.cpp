@@ -8,8 +8,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstring>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <numbers>
@@ -23,6 +23,7 @@
 #include "io/generators.h"
 #include "pack/chunk_encode.h"
 #include "pack/packer.h"
+#include "page_state.h"
 #include "test_helpers.h"
 #include "viewer_memory.h"
 #include "viewer_state.h"
@@ -881,4 +882,83 @@ TEST(GeometrySync, ADamagedDeltaChangesNothing) {
   EXPECT_EQ(surface.triangleCount(), 0u);
   ASSERT_TRUE(applyDelta(delta, surface, slice, hull, applied, error)) << error;
   expectMirrors(s.surface, surface, "whole");
+}
+
+// The page holds the view and the worker's reports; the worker's model follows the commands.
+// One round: the page's choices reach the model as they are (the page's rules, not the
+// model's, decide the values), the report comes back with the geometry, and until the worker
+// has applied the latest view the page does not repeat its "complete" or "exact".
+TEST(PageState, TheWorkersModelFollowsThePageAndReportsBack) {
+  const Packed& p = packedStream();
+  PageState page;
+  ASSERT_TRUE(openPage(page, p.manifest));
+  ViewerState model;  // the worker's
+  ASSERT_TRUE(openManifest(model, p.manifest).ok());
+
+  // The worker's side of one exchange: apply the command, refine, report with a delta.
+  uint32_t seen = 0;
+  auto exchange = [&](bool settle) {
+    const std::string text = takeCommand(page);
+    if (!text.empty()) {
+      const auto c = nlohmann::json::parse(text);
+      applyView(model, c["view"]);
+      if (c.contains("level")) setLevelFraction(model, c["level"]["fraction"].get<double>());
+      seen = c["version"].get<uint32_t>();
+    }
+    while (settle && advance(model, g_ticks + 3, fakeNow)) {
+    }
+    std::vector<uint8_t> delta;
+    writeDelta(&model.surface, &model.slice.surface(), &model.hull, delta);
+    model.surface.clearChanges();
+    model.slice.surface().clearChanges();
+    model.hull.clearChanges();
+    std::string error;
+    ASSERT_TRUE(takeReport(page, statsJson(model), seen, delta, error)) << error;
+  };
+
+  ASSERT_TRUE(setField(page, "distance"));
+  ASSERT_TRUE(setColourField(page, "harmonic"));
+  setSliceEnabled(page, true);
+  ASSERT_TRUE(setSlicePlane(page, {0, 0, 3}, 0.25f));
+  setIsovalue(page, 0.7f);
+  EXPECT_EQ(page.settings.sliceNormal[2], 1.f) << "normalised on the page";
+  for (size_t c = 0; c < p.chunks.size(); ++c) ASSERT_TRUE(addChunk(model, uint32_t(c), p.chunks[c]).ok());
+  exchange(true);
+  EXPECT_TRUE(takeCommand(page).empty()) << "nothing changed since";
+  EXPECT_EQ(shownState(page), LoadState::Complete);
+  EXPECT_EQ(model.dataset.manifest.fields[size_t(model.field)].name, "distance");
+  EXPECT_EQ(model.isovalue, 0.7f);
+  EXPECT_TRUE(model.sliceOn);
+  EXPECT_EQ(model.slice.offset(), 0.25f);
+  // The page's view and the model's are the same object (the level aside, which the model keeps).
+  nlohmann::json a = viewObject(page), b = viewObject(model);
+  a.erase("fetch");
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(page.surface.triangleCount(), model.surface.triangleCount());
+  EXPECT_EQ(page.slice.triangleCount(), model.slice.surface().triangleCount());
+  EXPECT_GT(page.surface.triangleCount(), 0u);
+
+  // A new isovalue: until the worker answers, the old surface is not "complete".
+  setIsovalue(page, 0.4f);
+  EXPECT_EQ(shownState(page), LoadState::Streaming);
+  exchange(false);  // the command goes out, the report comes back
+  EXPECT_EQ(shownState(page), LoadState::Complete);
+  EXPECT_EQ(page.surface.triangleCount(), model.surface.triangleCount());
+
+  // A level asked for is shown on the slider at once and kept until the worker has it.
+  setLevelFraction(page, 0.5);
+  const uint32_t asked = shownTargetSplits(page);
+  EXPECT_LT(asked, page.model.splitsReceived);
+  EXPECT_EQ(shownState(page), LoadState::Streaming);
+  exchange(true);
+  EXPECT_EQ(page.levelRequest, -1.0);
+  EXPECT_EQ(shownTargetSplits(page), asked);
+  EXPECT_EQ(page.model.splitsApplied, asked);
+  EXPECT_EQ(page.surface.triangleCount(), model.surface.triangleCount());
+
+  // A report that is not JSON changes nothing and says so.
+  std::string error;
+  EXPECT_FALSE(takeReport(page, "not json", seen, {}, error));
+  EXPECT_FALSE(error.empty());
+  EXPECT_EQ(page.surface.triangleCount(), model.surface.triangleCount());
 }
