@@ -194,23 +194,11 @@ void setColourRange(PageState& p, float lo, float hi) {
 
 bool fitColourRange(PageState& p) {
   if (p.settings.colourField < 0) return false;
-  float lo = std::numeric_limits<float>::infinity(), hi = -lo;
-  auto cover = [&](const SurfaceMirror& surface) {
-    std::span<const float> colours = surface.colours();
-    for (uint32_t v : surface.indices()) {  // live vertices only: free slots hold stale values
-      lo = std::min(lo, colours[v]);
-      hi = std::max(hi, colours[v]);
-    }
-  };
-  cover(p.surface);
-  if (p.settings.sliceOn) cover(p.slice);
-  if (!(lo <= hi)) return false;
-  if (lo == hi) {  // a flat colour: a small range around it, so the map still shows where it is
-    const Range fr = p.manifest.fields[size_t(p.settings.colourField)].range;
-    const float pad = std::max(1e-6f * std::abs(lo), float(fr.max - fr.min) * 1e-3f);
-    lo -= pad;
-    hi += pad;
-  }
+  ColourSpan span;
+  span.cover(p.surface);
+  if (p.settings.sliceOn) span.cover(p.slice);
+  float lo = 0, hi = 0;
+  if (!span.fitted(p.manifest.fields[size_t(p.settings.colourField)].range, lo, hi)) return false;
   setColourRange(p, lo, hi);
   return true;
 }

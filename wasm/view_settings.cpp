@@ -67,6 +67,18 @@ void sliceOffsetRange(const ViewSettings& v, const Manifest& m, float& lo, float
   SliceTracker::offsetRange(v.sliceNormal, m.bounds.min, m.bounds.max, lo, hi);
 }
 
+bool ColourSpan::fitted(const Range& field, float& outLo, float& outHi) const {
+  if (!(lo <= hi)) return false;
+  outLo = lo;
+  outHi = hi;
+  if (lo == hi) {
+    const float pad = std::max(1e-6f * std::abs(lo), float(field.max - field.min) * 1e-3f);
+    outLo -= pad;
+    outHi += pad;
+  }
+  return true;
+}
+
 nlohmann::json settingsObject(const ViewSettings& v, const Manifest& m) {
   using json = nlohmann::json;
   auto name = [&](int f) {

@@ -6,8 +6,12 @@
 // a colour field colours by the isovalue's field) are made here only: the worker takes the
 // values as they are. GL-free and Emscripten-free.
 #pragma once
+#include <algorithm>
 #include <array>
+#include <cstdint>
+#include <limits>
 #include <nlohmann/json_fwd.hpp>
+#include <span>
 
 #include "colourmap.h"
 #include "fetch_plan.h"
@@ -41,6 +45,24 @@ void chooseSliceEnabled(ViewSettings& v, const Manifest& m, bool on);  // colour
 bool chooseSlicePlane(ViewSettings& v, std::array<float, 3> normal, float offset);  // a zero normal is refused
 // The range of offsets that cut the dataset's bounds for the slice's normal.
 void sliceOffsetRange(const ViewSettings& v, const Manifest& m, float& lo, float& hi);
+
+// What "fit" makes the colour range: the colour values at the vertices the shown triangles use
+// (free slots hold stale values), padded around a flat colour so the map still shows where it
+// is. Works on the model's surfaces and on the page's mirrors alike.
+struct ColourSpan {
+  float lo = std::numeric_limits<float>::infinity(), hi = -std::numeric_limits<float>::infinity();
+
+  template <class Surface>
+  void cover(const Surface& surface) {
+    std::span<const float> colours = surface.colours();
+    for (uint32_t v : surface.indices()) {
+      lo = std::min(lo, colours[v]);
+      hi = std::max(hi, colours[v]);
+    }
+  }
+  // False when nothing was covered. `field`: the colour field's whole range.
+  bool fitted(const Range& field, float& outLo, float& outHi) const;
+};
 
 // The view object (docs/js-api.md: field, isovalue, colourField, colourMap, colourRange,
 // slice {on, normal, offset}, showBoundary, fetch) without the level, which the model keeps.

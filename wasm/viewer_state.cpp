@@ -11,6 +11,7 @@
 #include "adjacency.h"
 #include "hash.h"
 #include "tet_tables.h"
+#include "view_settings.h"
 #include "viewer_memory.h"
 
 namespace tetstream::viewer {
@@ -431,23 +432,11 @@ void setColourRange(ViewerState& s, float lo, float hi) {
 
 bool fitColourRange(ViewerState& s) {
   if (s.colour.field < 0) return false;
-  float lo = std::numeric_limits<float>::infinity(), hi = -lo;
-  auto cover = [&](const IncrementalIsosurface& surface) {
-    std::span<const float> colours = surface.colours();
-    for (uint32_t v : surface.indices()) {  // live vertices only: free slots hold stale values
-      lo = std::min(lo, colours[v]);
-      hi = std::max(hi, colours[v]);
-    }
-  };
-  cover(s.surface);
-  if (s.sliceOn && s.slice.built()) cover(s.slice.surface());
-  if (!(lo <= hi)) return false;
-  if (lo == hi) {  // a flat colour: a small range around it, so the map still shows where it is
-    const Range fr = s.dataset.manifest.fields[size_t(s.colour.field)].range;
-    const float pad = std::max(1e-6f * std::abs(lo), float(fr.max - fr.min) * 1e-3f);
-    lo -= pad;
-    hi += pad;
-  }
+  ColourSpan span;
+  span.cover(s.surface);
+  if (s.sliceOn && s.slice.built()) span.cover(s.slice.surface());
+  float lo = 0, hi = 0;
+  if (!span.fitted(s.dataset.manifest.fields[size_t(s.colour.field)].range, lo, hi)) return false;
   setColourRange(s, lo, hi);
   return true;
 }
