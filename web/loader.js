@@ -161,14 +161,8 @@ export class ChunkLoader {
   // words. deliver(i, bytes): hands chunk i over; false = the viewer stopped (it says why
   // itself). allowed: plan places to fetch (fewer than the plan's when memory is short).
   attach({ check, deliver, allowed = this.urls.length }) {
-    Object.assign(this, { check, deliver, allowed, attached: true, warmed: true });
-    for (const [j, e] of [...this.inFlight]) {
-      if (this.position.get(j) >= allowed) {
-        e.controller.abort();
-        this.inFlight.delete(j);
-      }
-    }
-    for (const j of [...this.arrived.keys()]) if (this.position.get(j) >= allowed) this.arrived.delete(j);
+    Object.assign(this, { check, deliver, attached: true, warmed: true });
+    this.limitTo(allowed);
     for (const i of this.inPlanOrder(this.unchecked)) {
       this.unchecked.delete(i);
       if (this.stopped) return;
@@ -177,6 +171,27 @@ export class ChunkLoader {
     }
     this.deliverReady();
     this.pump();
+  }
+
+  // Plan places to fetch from now on (more, or fewer: the requests and chunks past them are
+  // dropped).
+  setAllowed(allowed) {
+    if (this.stopped) return;
+    this.limitTo(allowed);
+    if (this.nextPos < Math.min(this.allowed, this.plan.length)) this.idle = false;
+    this.deliverReady();
+    this.pump();
+  }
+
+  limitTo(allowed) {
+    this.allowed = allowed;
+    for (const [j, e] of [...this.inFlight]) {
+      if (this.position.get(j) >= allowed) {
+        e.controller.abort();
+        this.inFlight.delete(j);
+      }
+    }
+    for (const j of [...this.arrived.keys()]) if (this.position.get(j) >= allowed) this.arrived.delete(j);
   }
 
   // The view changed: what was handed over stays, the rest of the plan becomes `tail` (chunk

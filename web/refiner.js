@@ -3,7 +3,7 @@
 // pause, and takes its updates: the model's figures and a geometry delta go into the page's
 // viewer (ts_take_report), the fetch plan to whoever follows it. Nothing here waits for the
 // worker: each answer comes as its own message.
-import { copyToWasm, page } from './page.js';
+import { boot, copyToWasm, page } from './page.js';
 
 export const refiner = {
   worker: null,
@@ -13,10 +13,16 @@ export const refiner = {
   onAborted: null,   // (what) the worker stopped: nothing more comes from it
 
   // Starts the worker with the compiled program (WebAssembly.Module). onAborted: as above.
+  // (index.html starts it early, so that its scripts load while the program downloads.)
   start(module, onAborted) {
     this.onAborted = onAborted;
+    if (boot.workerError) {
+      onAborted(`the refinement worker failed (${boot.workerError})`);
+      return;
+    }
     try {
-      this.worker = new Worker(new URL('worker.js', location.href));
+      this.worker = boot.worker || new Worker(new URL('worker.js', location.href));
+      boot.worker = null; // (a second dataset reuses this one)
     } catch (e) {
       onAborted(`the refinement worker could not start (${e && e.message ? e.message : e})`);
       return;

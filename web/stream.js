@@ -286,20 +286,8 @@ async function stream(manifestUrl) {
     if (page.loader) page.loader.stop();
     return viewerStopped();
   }
-  // The worker reads it too and says how much of it memory allows, and the first plan.
-  const answer = await refiner.open(manifestBytes, maxMemoryMB);
-  if (!answer.ok) {
-    if (page.loader) page.loader.stop();
-    let error = '';
-    try {
-      error = JSON.parse(answer.stats).error || '';
-    } catch { /* the worker stopped: viewerAborted has said so */ }
-    return page.aborted ? undefined : fail(error || 'The viewer could not open this dataset.');
-  }
-  refiner.commandReady(); // the view the dataset starts with
   document.title = `tetstream — ${wasmString(viewer._ts_name()) || manifestUrl.pathname}`;
   if (page.state === 'error') return fail(page.error); // the base could not be had: say so in the panel too
-  viewHooks.applyLinkState();
 
   const { names, sizes } = chunksOfViewer();
   network.chunkSizes = sizes;
@@ -308,12 +296,18 @@ async function stream(manifestUrl) {
     page.loader = null;
   }
   if (!page.loader) startLoader({ names, sizes }, manifestUrl);
-  const allowed = answer.chunksAllowed;
-  page.datasetTotal = sizes.slice(0, allowed).reduce((a, b) => a + b, 0);
   const selective = viewer._ts_node_count() > 0;
-  if (selective) followPlan(viewer, page.loader, answer.plan);
+  // The worker reads the manifest too and answers with how much of it memory allows and, with
+  // nodes, the first plan. Until then only what is surely wanted is handed over: every chunk of
+  // one sequence (unless a memory limit may end it sooner), else the base alone.
+  const opening = refiner.open(manifestBytes, maxMemoryMB);
+  viewHooks.applyLinkState();
+  refiner.commandReady(); // the view the dataset starts with
+  const surelyWanted = !selective && !maxMemoryMB ? names.length : 1;
+  page.datasetTotal = sizes.slice(0, surelyWanted).reduce((a, b) => a + b, 0);
+  if (surelyWanted < names.length) page.loader.onIdle = () => {}; // the answer brings the rest
   page.loader.attach({
-    allowed: selective ? Infinity : allowed, // (the worker's plan holds what memory allows)
+    allowed: surelyWanted,
     // The one hand-over: transferred to the worker, checked (size, hash) there once, kept by
     // its model and added in order. The answer comes as a message.
     async check(i, bytes) {
@@ -333,7 +327,23 @@ async function stream(manifestUrl) {
     },
   });
   network.report();
-  startViewer(); // WebGL setup overlaps the downloads
+  // WebGL and the panel are set up now (main() holds the page's thread for a few hundred ms on a
+  // software GL) while the worker starts, opens the dataset and takes the base.
+  startViewer();
+  const answer = await opening;
+  if (!answer.ok) {
+    if (page.loader) page.loader.stop();
+    let error = '';
+    try {
+      error = JSON.parse(answer.stats).error || '';
+    } catch { /* the worker stopped: viewerAborted has said so */ }
+    return page.aborted ? undefined : fail(error || 'The viewer could not open this dataset.');
+  }
+  page.datasetTotal = sizes.slice(0, answer.chunksAllowed).reduce((a, b) => a + b, 0);
+  if (selective) followPlan(viewer, page.loader, answer.plan);
+  else page.loader.onIdle = null; // one sequence: its end is the end
+  page.loader.setAllowed(selective ? Infinity : answer.chunksAllowed); // (the worker's plan holds what memory allows)
+  network.report();
   await loaderDone;
 }
 

@@ -3,7 +3,7 @@
 // bandwidth cap shared by all responses and a latency before each response, the viewer in headless
 // Chromium (SwiftShader: software WebGL, so frame times are those of a machine without a GPU).
 //
-//   node tests/bench/stream_bench.mjs [--rate 10mbit] [--latency 50] [--n 64] [--runs 1] [--timeline]
+//   node tests/bench/stream_bench.mjs [--rate 10mbit] [--latency 50] [--n 64] [--runs 1] [--timeline] [--sequence]
 //
 // For Harmonic N³ and the real post.vtk (postVtk below, when present) it reports:
 //   first surface   ms from navigation start to the first frame drawn with an isosurface,
@@ -157,11 +157,13 @@ async function main() {
   checkBuilds();
   fs.mkdirSync(outDir, { recursive: true });
   await precompressDir(webDir); // the wasm goes compressed (br) as any real deployment would send it
-  const datasets = [[`Harmonic ${n}³`, packed(`harmonic-${n}`, () => {
+  // --sequence: packed as one sequence of chunks (no patch hierarchy), every chunk fetched.
+  const sequence = args.includes('--sequence');
+  const datasets = [[`Harmonic ${n}³`, packed(`harmonic-${n}${sequence ? '-sequence' : ''}`, () => {
     const vtu = path.join(outDir, `harmonic-${n}.vtu`);
-    cli('gen', 'harmonic', '--n', String(n), '-o', vtu);
+    if (!fs.existsSync(vtu)) cli('gen', 'harmonic', '--n', String(n), '-o', vtu);
     return vtu;
-  }, ['--name', `Harmonic ${n}³`])]];
+  }, ['--name', `Harmonic ${n}³`, ...(sequence ? ['--leaf-vertices', '0'] : [])])]];
   if (fs.existsSync(postVtk)) datasets.push(['post.vtk', packed('post', () => postVtk, ['--name', 'post.vtk'])]);
   else console.log(`(no ${postVtk}: the real dataset is skipped)`);
 
