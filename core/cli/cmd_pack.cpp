@@ -162,7 +162,7 @@ int packOnRanks(const Opts& o, bool maxErrorSet, bool baseVerticesSet, bool base
                {"baseFieldMax", m.chunks[0].fieldMax},
                {"readMs", s.readMs},
                {"partitionMs", s.partitionMs},
-               {"simplifyMs", s.combineMs},
+               {"simplifyMs", s.simplifyMs},
                {"ms", total.ms()},
                {"peakMemoryMB", worstPeak},
                {"perRank", ranks},
@@ -181,7 +181,7 @@ int packOnRanks(const Opts& o, bool maxErrorSet, bool baseVerticesSet, bool base
   std::printf("  stream    %u splits in %zu chunks, %zu nodes, %.2f MB in all\n", s.pack.splits, m.chunks.size() - 1,
               m.nodes.size(), bytes / 1e6);
   std::printf("  time      read %.0f ms, partition %.0f ms, simplify %.0f ms, all %.0f ms\n", s.readMs, s.partitionMs,
-              s.combineMs, total.ms());
+              s.simplifyMs, total.ms());
   for (size_t k = 0; k < s.ranks.size(); ++k)
     std::printf(
         "  rank %-4zu %llu vertices, %llu tets; its part %.0f ms, combining %.0f ms, encode %.0f ms; %.1f s of "

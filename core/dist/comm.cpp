@@ -4,6 +4,7 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 
 #if TETSTREAM_MPI
 #include <mpi.h>
@@ -93,7 +94,24 @@ std::vector<Bytes> Comm::allGather(const Bytes& mine) {
   sizes[size_t(rank_)] = mine.size();
   sumInPlace(sizes);
   std::vector<Bytes> all(static_cast<size_t>(size_));
-  for (int r = 0; r < size_; ++r) {
+  uint64_t total = 0;
+  for (uint64_t n : sizes) total += n;
+  if (total <= uint64_t(std::numeric_limits<int>::max())) {
+    // One collective for all ranks (the library picks a ring or a tree for hundreds of them);
+    // its counts and displacements are ints, hence the bound.
+    std::vector<int> counts(sizes.size()), starts(sizes.size());
+    for (size_t r = 0, at = 0; r < sizes.size(); at += sizes[r], ++r) {
+      counts[r] = int(sizes[r]);
+      starts[r] = int(at);
+    }
+    Bytes flat(total);
+    MPI_Allgatherv(mine.data(), int(mine.size()), MPI_BYTE, flat.data(), counts.data(), starts.data(), MPI_BYTE,
+                   MPI_COMM_WORLD);
+    for (size_t r = 0; r < sizes.size(); ++r)
+      all[r].assign(flat.begin() + starts[r], flat.begin() + starts[r] + counts[r]);
+    return all;
+  }
+  for (int r = 0; r < size_; ++r) {  // more than 2 GB in all: one broadcast per rank, in pieces
     Bytes& b = all[size_t(r)];
     b = r == rank_ ? mine : Bytes(sizes[size_t(r)]);
     for (uint64_t at = 0; at < b.size(); at += kPiece)

@@ -240,7 +240,7 @@ Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& 
   }
   mine.simplifyMs = msSince(t0);
   if (r = comm.agree(status, secondary); !r) return r;
-  out.combineMs = msSince(t0);
+  out.simplifyMs = msSince(t0);
 
   // ---- the base's values fitted again against the whole input
   Unit* root = nullptr;

@@ -44,7 +44,8 @@ struct DistributedSummary {
   std::string inputFormat;
   uint64_t inputTets = 0;
   std::vector<RankFigures> ranks;  // on rank 0: every rank's
-  double readMs = 0, partitionMs = 0, combineMs = 0;
+  double readMs = 0, partitionMs = 0;
+  double simplifyMs = 0;  // from the partition to the root: every rank's part and the top of the tree
 };
 
 // Packs `input` into `outDir` on every rank of `comm` (all ranks call it with the same
