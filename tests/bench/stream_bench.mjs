@@ -4,6 +4,7 @@
 // Chromium (SwiftShader: software WebGL, so frame times are those of a machine without a GPU).
 //
 //   node tests/bench/stream_bench.mjs [--rate 10mbit] [--latency 50] [--n 64] [--runs 1] [--timeline] [--sequence]
+//                                     [--mesh FILE ...]
 //
 // For Harmonic N³ and the real post.vtk (postVtk below, when present) it reports:
 //   first surface   ms from navigation start to the first frame drawn with an isosurface,
@@ -166,6 +167,13 @@ async function main() {
   }, ['--name', `Harmonic ${n}³`, ...(sequence ? ['--leaf-vertices', '0'] : [])])]];
   if (fs.existsSync(postVtk)) datasets.push(['post.vtk', packed('post', () => postVtk, ['--name', 'post.vtk'])]);
   else console.log(`(no ${postVtk}: the real dataset is skipped)`);
+  // --mesh FILE (repeatable): any other mesh, packed as the CLI packs it by default.
+  args.forEach((a, i) => {
+    if (a !== '--mesh') return;
+    const file = path.resolve(args[i + 1]);
+    const name = path.basename(file);
+    datasets.push([name, packed(name.replace(/[^0-9a-z]+/gi, '-').toLowerCase(), () => file, ['--name', name])]);
+  });
 
   const server = createServer({
     mounts: [{ prefix: '/data', dir: outDir }, { prefix: '/', dir: webDir }],
