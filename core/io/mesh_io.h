@@ -95,7 +95,9 @@ struct ReadOptions {
   // the listed files from shareIndex·n/shareCount up to (shareIndex + 1)·n/shareCount, n the
   // files listed (each process of a distributed pack reads its own; every path is still
   // checked). A share with no file gives an empty mesh. A VTKHDF file of at least shareCount
-  // partitions: the partitions likewise. Other files ignore it (ReadReport::shared says).
+  // partitions: the partitions likewise. An XDMF file of one grid of one cell type: the cells
+  // in those rows of its topology and the points from the smallest to the largest id they use.
+  // Other files ignore it (ReadReport::shared says).
   uint32_t shareIndex = 0, shareCount = 1;
 };
 

@@ -338,6 +338,67 @@ Result Document::integers(pugi::xml_node item, const std::string& what, Values<i
   return read(item, what, 0, out);
 }
 
+Result Document::numberRows(pugi::xml_node item, const std::string& what, uint64_t total, uint64_t first,
+                            uint64_t count, Values<double>& out) {
+  return readRows(item, what, total, first, count, out);
+}
+
+Result Document::integerRows(pugi::xml_node item, const std::string& what, uint64_t total, uint64_t first,
+                             uint64_t count, Values<int64_t>& out) {
+  return readRows(item, what, total, first, count, out);
+}
+
+std::vector<uint64_t> Document::declaredDims(pugi::xml_node item) {
+  pugi::xml_node node;
+  std::vector<uint64_t> dims;
+  if (!follow(item, "", node) || std::strcmp(node.name(), "DataItem") != 0) return dims;
+  std::string_view itemType = node.attribute("ItemType").value();
+  if ((!itemType.empty() && !iequals(itemType, "Uniform")) ||
+      !parseDims(node.attribute("Dimensions").value(), "", dims))
+    dims.clear();
+  return dims;
+}
+
+template <class T>
+Result Document::readRows(pugi::xml_node item, const std::string& what, uint64_t total, uint64_t first, uint64_t count,
+                          Values<T>& out) {
+  out = Values<T>{};
+  if (first > total || count > total - first)
+    return fail(Status::OutOfRange, what + ": rows " + std::to_string(first) + " to " + std::to_string(first + count) +
+                                        " of " + std::to_string(total));
+  if (const std::vector<uint64_t> d = declaredDims(item); !d.empty() && d[0] == total && total > 0) {
+    pugi::xml_node node;
+    if (Result r = follow(item, what, node); !r) return r;
+    if (++itemReads_ > kMaxItemReads)
+      return fail(Status::TooLarge, what + ": more than " + std::to_string(kMaxItemReads) + " DataItems to read");
+    std::vector<uint64_t> dims;
+    if (Result r = parseDims(node.attribute("Dimensions").value(), what, dims); !r) return r;
+    hdf5::Slab slab;
+    slab.start.assign(dims.size(), 0);
+    slab.stride.assign(dims.size(), 1);
+    slab.count = dims;
+    slab.start[0] = first;
+    slab.count[0] = count;
+    if (count == 0) {  // (an empty selection: nothing to read)
+      out.dims = slab.count;
+      return Result::success();
+    }
+    Result r = readUniform(node, what, &slab, out);
+    out.dims = slab.count;
+    // (a dataset shaped otherwise than its Dimensions cannot take a hyperslab: read whole below)
+    if (r || r.status != Status::Unsupported) return r;
+  }
+  Values<T> all;
+  if (Result r = read(item, what, 0, all); !r) return r;
+  if (total == 0 || all.values.size() % total != 0)
+    return fail(Status::Corrupt, what + ": " + std::to_string(all.values.size()) +
+                                     " values are not a whole number per " + "row of " + std::to_string(total));
+  const uint64_t per = all.values.size() / total;
+  out.values.assign(all.values.begin() + ptrdiff_t(first * per), all.values.begin() + ptrdiff_t((first + count) * per));
+  out.dims = {count, per};
+  return Result::success();
+}
+
 template <class T>
 Result Document::read(pugi::xml_node item, const std::string& what, int depth, Values<T>& out) {
   out = Values<T>{};

@@ -64,12 +64,26 @@ class Document {
   Result numbers(pugi::xml_node item, const std::string& what, Values<double>& out);
   Result integers(pugi::xml_node item, const std::string& what, Values<int64_t>& out);
 
+  // Rows [first, first + count) of a DataItem of `total` rows (its slowest dimension), for a
+  // process that reads its share of a grid. A Uniform item whose first dimension is `total` is
+  // read only there (an HDF5 hyperslab; XML and binary data are sliced once read); any other
+  // item is read whole and sliced, which needs its values to be a whole number per row.
+  Result numberRows(pugi::xml_node item, const std::string& what, uint64_t total, uint64_t first, uint64_t count,
+                    Values<double>& out);
+  Result integerRows(pugi::xml_node item, const std::string& what, uint64_t total, uint64_t first, uint64_t count,
+                     Values<int64_t>& out);
+  // A Uniform DataItem's declared Dimensions (empty for any other item, or none declared).
+  std::vector<uint64_t> declaredDims(pugi::xml_node item);
+
   // Where data came from, for ReadReport::format: "HDF5 heavy data", "XML data", "binary data".
   const std::set<std::string>& sources() const { return sources_; }
 
  private:
   template <class T>
   Result read(pugi::xml_node item, const std::string& what, int depth, Values<T>& out);
+  template <class T>
+  Result readRows(pugi::xml_node item, const std::string& what, uint64_t total, uint64_t first, uint64_t count,
+                  Values<T>& out);
   template <class T>
   Result readUniform(pugi::xml_node item, const std::string& what, const hdf5::Slab* slab, Values<T>& out);
   Result select(std::string_view path, const std::string& what, const std::vector<pugi::xml_node>*& out);

@@ -129,6 +129,13 @@ bool isTemporal(pugi::xml_node g) {
   return isCollection(g) && iequals(g.attribute("CollectionType").value(), "Temporal");
 }
 
+// One process's share of a grid (ReadOptions::shareIndex of shareCount): rows of its cells and
+// of its points, out of how many.
+struct Rows {
+  uint64_t cellsTotal = 0, cellFirst = 0;
+  uint64_t pointsTotal = 0, pointFirst = 0;
+};
+
 // A piece's arrays, merged across pieces like the VTK XML reader does.
 struct PieceArrays {
   std::vector<ScalarField> fields;
@@ -148,14 +155,21 @@ class XdmfReader {
   Result sameMesh(pugi::xml_node a, pugi::xml_node b, const std::string& what, bool& same);
   Result readPiece(pugi::xml_node grid, const std::vector<pugi::xml_node>& companions, const std::string& where,
                    bool first, PieceArrays& arrays, bool& skipped, bool& sharedPoints);
+  Result readShareOfGrid(pugi::xml_node topo, pugi::xml_node geo, const TopologyKind& kind,
+                         const std::vector<pugi::xml_node>& attributes, const std::string& where, PieceArrays& arrays,
+                         bool& done);
+  Result pointRows(pugi::xml_node geo, const std::string& where, uint64_t first, uint64_t count, uint64_t& total);
   void dropRepeatedCells(size_t firstNew, uint64_t vertexBase, uint64_t points, const std::string& where);
   Result readCells(pugi::xml_node topo, const TopologyKind* kind, const std::string& where, uint64_t points,
                    uint64_t vertexBase, std::vector<int64_t>& conn, int& nodes, uint64_t& cells);
   Result readMixed(const std::vector<int64_t>& values, const std::string& where, uint64_t points, uint64_t vertexBase,
                    uint64_t& cells);
   Result readPoints(pugi::xml_node geo, const std::string& where, uint64_t& points);
+  // rows: given, only those rows of each attribute are read (a share of the grid).
   Result readAttributes(const std::vector<pugi::xml_node>& attributes, const std::string& where,
-                        const xdmf::GridCells& grid, bool first, bool sharedPoints, PieceArrays& arrays);
+                        const xdmf::GridCells& grid, bool first, bool sharedPoints, PieceArrays& arrays,
+                        const Rows* rows = nullptr);
+  Result baseOffset(pugi::xml_node topo, const std::string& what, int64_t& base);
 
   Document& doc_;
   const ReadOptions& options_;
@@ -163,6 +177,7 @@ class XdmfReader {
   TetMesh mesh_;
   CellSoup soup_;
   std::vector<std::string> topologies_;  // read, in order, for ReadReport::format
+  bool shareGrid_ = false;               // the file is one grid read by several processes, each its share
   // Geometry elements read so far (after references): their first vertex and point count. A
   // grid on the points of an earlier one adds its cells to those points.
   std::map<const void*, std::pair<uint64_t, uint64_t>> geometries_;
@@ -398,6 +413,124 @@ Result XdmfReader::readMixed(const std::vector<int64_t>& values, const std::stri
   return Result::success();
 }
 
+// XDMF 2: ids start at BaseOffset (1 for Fortran-style numbering); 0 without one.
+Result XdmfReader::baseOffset(pugi::xml_node topo, const std::string& what, int64_t& base) {
+  base = 0;
+  if (!topo.attribute("BaseOffset")) return Result::success();
+  size_t pos = 0;
+  if (parseNextInt(topo.attribute("BaseOffset").value(), pos, base) != 1 || std::abs(base) > (int64_t(1) << 40))
+    return fail(Status::Corrupt, what + ": BaseOffset='" + printable(topo.attribute("BaseOffset").value()) + "'");
+  return Result::success();
+}
+
+// Points [first, first + count) of a Geometry of `total` points (total: set from its declared
+// size), appended to the mesh's.
+Result XdmfReader::pointRows(pugi::xml_node geo, const std::string& where, uint64_t first, uint64_t count,
+                             uint64_t& total) {
+  std::string_view type = geo.attribute("GeometryType").value();
+  if (type.empty()) type = geo.attribute("Type").value();
+  if (type.empty()) type = "XYZ";
+  const std::string what = where + " Geometry";
+  const bool xyz = iequals(type, "XYZ");
+  if (!xyz && !iequals(type, "X_Y_Z")) return readPoints(geo, where, total);  // (refused there, in words)
+  std::vector<pugi::xml_node> items;
+  if (xyz) {
+    pugi::xml_node item;
+    if (Result r = doc_.dataItem(geo, what, item); !r) return r;
+    items.push_back(item);
+  } else if (Result r = doc_.children(geo, "DataItem", what, items); !r) {
+    return r;
+  } else if (items.size() != 3) {
+    return fail(Status::Corrupt,
+                what + ": GeometryType X_Y_Z with " + std::to_string(items.size()) + " DataItems, expected 3");
+  }
+  const std::vector<uint64_t> dims = doc_.declaredDims(items[0]);
+  uint64_t values = 1;
+  for (uint64_t d : dims) values *= d;
+  total = xyz ? values / 3 : values;
+  if (dims.empty() || (xyz && values % 3) || first > total || count > total - first)
+    return fail(Status::Corrupt,
+                what + ": Dimensions that do not hold the " + std::to_string(first + count) + " points its cells use");
+  Values<double> axis[3];
+  for (size_t a = 0; a < items.size(); ++a) {
+    // (XYZ as N x 3 rows or as 3N values; X_Y_Z as N values each)
+    const bool rowsOfThree = xyz && dims.size() == 2 && dims[1] == 3;
+    const uint64_t scale = xyz && !rowsOfThree ? 3 : 1;
+    if (Result r = doc_.numberRows(items[a], what, rowsOfThree || !xyz ? total : 3 * total, scale * first,
+                                   scale * count, axis[a]);
+        !r)
+      return r;
+  }
+  mesh_.positions.reserve(mesh_.positions.size() + 3 * count);
+  for (uint64_t i = 0; i < count; ++i)
+    for (int k = 0; k < 3; ++k)
+      mesh_.positions.push_back(float(xyz ? axis[0].values[3 * i + uint64_t(k)] : axis[k].values[i]));
+  return Result::success();
+}
+
+// A share of one grid for one of several processes (core/dist): the cells in rows [from, to)
+// of the topology, from index·N/count to (index + 1)·N/count, and the points from the smallest
+// to the largest id they use, with those rows of every attribute. Each process reads about a
+// count-th of the cells; the points on the cuts are read by both sides and joined later by their
+// coordinates. done stays false (nothing read) for a grid this cannot cut by rows: a topology of
+// no declared size, or an attribute of a function space (its dofs are not per point or cell).
+Result XdmfReader::readShareOfGrid(pugi::xml_node topo, pugi::xml_node geo, const TopologyKind& kind,
+                                   const std::vector<pugi::xml_node>& attributes, const std::string& where,
+                                   PieceArrays& arrays, bool& done) {
+  done = false;
+  for (pugi::xml_node a : attributes)
+    if (iequals(a.attribute("Center").value(), "Other")) return Result::success();
+  const std::string what = where + " Topology";
+  pugi::xml_node item;
+  if (Result r = doc_.dataItem(topo, what, item); !r) return r;
+  const std::vector<uint64_t> dims = doc_.declaredDims(item);
+  const uint64_t nodes = uint64_t(kind.nodes);
+  const bool cellRows = dims.size() == 2 && dims[1] == nodes;
+  if (!cellRows && !(dims.size() == 1 && dims[0] % nodes == 0)) return Result::success();
+  const uint64_t cellsTotal = cellRows ? dims[0] : dims[0] / nodes;
+  const uint64_t from = cellsTotal * options_.shareIndex / options_.shareCount,
+                 to = cellsTotal * (options_.shareIndex + 1ull) / options_.shareCount;
+  Values<int64_t> ids;
+  if (Result r = doc_.integerRows(item, what, dims[0], cellRows ? from : from * nodes,
+                                  cellRows ? to - from : (to - from) * nodes, ids);
+      !r)
+    return r;
+  int64_t base = 0;
+  if (Result r = baseOffset(topo, what, base); !r) return r;
+  int64_t lo = INT64_MAX, hi = -1;
+  for (int64_t& id : ids.values) {
+    id -= base;
+    if (id < 0) return fail(Status::Corrupt, what + ": a cell names point " + std::to_string(id));
+    lo = std::min(lo, id);
+    hi = std::max(hi, id);
+  }
+  if (hi < 0) lo = 0;
+  Rows rows;
+  rows.cellsTotal = cellsTotal;
+  rows.cellFirst = from;
+  rows.pointFirst = uint64_t(lo);
+  const uint64_t points = uint64_t(hi + 1 - lo);
+  const uint64_t vertexBase = mesh_.positions.size() / 3;
+  if (Result r = pointRows(geo, where, rows.pointFirst, points, rows.pointsTotal); !r) return r;
+  for (int64_t& id : ids.values) id -= lo;
+  std::vector<int64_t> offsets(to - from + 1), types(to - from, kind.vtk);
+  for (uint64_t c = 0; c < offsets.size(); ++c) offsets[c] = int64_t(c * nodes);
+  if (Result r = appendVtkCells(where, ids.values, offsets, types, vertexBase, points, soup_); !r) return r;
+  xdmf::GridCells gc;
+  gc.connectivity = &ids.values;
+  gc.cells = to - from;
+  gc.nodes = int(nodes);
+  gc.corners = kShapeCorners[int(vtkCellInfo(kind.vtk).shape)];
+  gc.points = points;
+  if (Result r = readAttributes(attributes, where, gc, true, false, arrays, &rows); !r) return r;
+  report_.shared = true;
+  report_.notes.push_back("read cells " + std::to_string(from) + " to " + std::to_string(to) + " of " +
+                          std::to_string(cellsTotal) + " and the " + std::to_string(points) +
+                          " points they span, this process's share of the grid");
+  done = true;
+  return Result::success();
+}
+
 Result XdmfReader::readCells(pugi::xml_node topo, const TopologyKind* kind, const std::string& where, uint64_t points,
                              uint64_t vertexBase, std::vector<int64_t>& conn, int& nodes, uint64_t& cells) {
   const std::string what = where + " Topology";
@@ -405,14 +538,9 @@ Result XdmfReader::readCells(pugi::xml_node topo, const TopologyKind* kind, cons
   if (Result r = doc_.dataItem(topo, what, item); !r) return r;
   Values<int64_t> v;
   if (Result r = doc_.integers(item, what, v); !r) return r;
-  if (topo.attribute("BaseOffset")) {
-    // XDMF 2: ids start at BaseOffset (1 for Fortran-style numbering).
-    size_t pos = 0;
-    int64_t base = 0;
-    if (parseNextInt(topo.attribute("BaseOffset").value(), pos, base) != 1 || std::abs(base) > (int64_t(1) << 40))
-      return fail(Status::Corrupt, what + ": BaseOffset='" + printable(topo.attribute("BaseOffset").value()) + "'");
-    for (int64_t& id : v.values) id -= base;
-  }
+  int64_t base = 0;
+  if (Result r = baseOffset(topo, what, base); !r) return r;
+  for (int64_t& id : v.values) id -= base;
   uint64_t declared = 0;
   const bool hasCount = topo.attribute("NumberOfElements") || topo.attribute("Dimensions");
   if (hasCount) {
@@ -448,7 +576,8 @@ Result XdmfReader::readCells(pugi::xml_node topo, const TopologyKind* kind, cons
 }
 
 Result XdmfReader::readAttributes(const std::vector<pugi::xml_node>& attributes, const std::string& where,
-                                  const xdmf::GridCells& grid, bool first, bool sharedPoints, PieceArrays& arrays) {
+                                  const xdmf::GridCells& grid, bool first, bool sharedPoints, PieceArrays& arrays,
+                                  const Rows* rows) {
   ReadReport scratch;  // conversions are noted for the first piece only
   ReadReport& notes = first ? report_ : scratch;
   int index = 0;
@@ -483,8 +612,15 @@ Result XdmfReader::readAttributes(const std::vector<pugi::xml_node>& attributes,
     pugi::xml_node item;
     if (Result r = doc_.dataItem(a, what, item); !r) return r;
     Values<double> v;
-    if (Result r = doc_.numbers(item, what, v); !r) return r;
     const uint64_t n = node ? grid.points : grid.cells;
+    if (rows) {  // a share of the grid: the rows of its points, or of its cells
+      if (Result r = doc_.numberRows(item, what, node ? rows->pointsTotal : rows->cellsTotal,
+                                     node ? rows->pointFirst : rows->cellFirst, n, v);
+          !r)
+        return r;
+    } else if (Result r = doc_.numbers(item, what, v); !r) {
+      return r;
+    }
     if (n == 0) continue;
     const uint64_t comps = v.values.size() / n;
     if (v.values.size() % n != 0 || comps == 0 || comps > kMaxComponents)
@@ -592,6 +728,21 @@ Result XdmfReader::readPiece(pugi::xml_node grid, const std::vector<pugi::xml_no
   if (Result r = doc_.children(grid, "Geometry", where, geos); !r) return r;
   if (geos.size() != 1)
     return fail(Status::Corrupt, where + ": " + (geos.empty() ? "no <Geometry>" : "more than one <Geometry>"));
+  std::vector<pugi::xml_node> attributes;
+  if (Result r = doc_.children(grid, "Attribute", where, attributes); !r) return r;
+  for (pugi::xml_node c : companions) {
+    std::vector<pugi::xml_node> more;
+    if (Result r = doc_.children(c, "Attribute", where, more); !r) return r;
+    attributes.insert(attributes.end(), more.begin(), more.end());
+  }
+  if (shareGrid_ && kind) {
+    bool done = false;
+    if (Result r = readShareOfGrid(topo, geos[0], *kind, attributes, where, arrays, done); !r) return r;
+    if (done) {
+      topologies_.push_back(kind->name);
+      return Result::success();
+    }
+  }
 
   uint64_t vertexBase = mesh_.positions.size() / 3, points = 0, cells = 0;
   if (auto seen = geometries_.find(geos[0].internal_object()); seen != geometries_.end()) {
@@ -610,13 +761,6 @@ Result XdmfReader::readPiece(pugi::xml_node grid, const std::vector<pugi::xml_no
   const std::string name = mixed ? "Mixed" : kind->name;
   if (std::find(topologies_.begin(), topologies_.end(), name) == topologies_.end()) topologies_.push_back(name);
 
-  std::vector<pugi::xml_node> attributes;
-  if (Result r = doc_.children(grid, "Attribute", where, attributes); !r) return r;
-  for (pugi::xml_node c : companions) {
-    std::vector<pugi::xml_node> more;
-    if (Result r = doc_.children(c, "Attribute", where, more); !r) return r;
-    attributes.insert(attributes.end(), more.begin(), more.end());
-  }
   xdmf::GridCells gc;
   gc.connectivity = mixed ? nullptr : &conn;
   gc.cells = cells;
@@ -691,6 +835,10 @@ Result XdmfReader::read(TetMesh& out) {
       if (Result r = flatten(g, label + " Grid" + (name.empty() ? "" : " '" + name + "'"), 0, pieces); !r) return r;
     }
   }
+
+  // One grid on several processes: each reads its share of it (more pieces are shared as files
+  // are by core/dist: each process keeps its share of the tets).
+  shareGrid_ = options_.shareCount > 1 && pieces.size() == 1;
 
   // Pieces, their arrays merged: an array survives only if every piece that was read has it.
   PieceArrays merged;

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The distributed pack (core/dist) under mpirun, as a user runs it: a mesh written as the pieces
-# of a parallel run by VTK's own writers (write_pieces.py), packed on 1, 2 and 4 ranks. Each pack
+# of a parallel run by VTK's own writers (write_pieces.py), and as one XDMF grid by meshio,
+# packed on 1 to 4 ranks. Each pack
 # must pass every check of the patch hierarchy (tests/unit/test_partial.cpp, run on these packs:
 # any set of nodes with their parents is a valid mesh in any order, all nodes give the input,
 # the nodes an isovalue needs give its full-resolution surface exactly, the incremental surface
@@ -58,6 +59,28 @@ for input in vtkhdf_parts.vtkhdf:3 vtkhdf_series.vtkhdf:2; do
   checks="$checks;$out=$HPC/$file"
 done
 echo "ok: VTKHDF partitions packed on 3 and 2 ranks"
+
+# One XDMF grid with HDF5 heavy data (meshio writes it as DOLFINx and others do: one file for the
+# whole mesh): each rank reads its rows of the cells and the points they span, on 2 and 3 ranks;
+# the surfaces equal one process's pack of the same file.
+/usr/bin/python3 -c "
+import meshio, sys
+m = meshio.read(sys.argv[1])
+meshio.write(sys.argv[2], meshio.Mesh(m.points, m.cells, point_data=m.point_data))" "$WORK/harmonic.vtu" "$WORK/harmonic.xdmf"
+"$TETSTREAM" "${PACK[@]}" "$WORK/harmonic.xdmf" -o "$WORK/xdmf-serial" >/dev/null
+for np in 2 3; do
+  out="$WORK/xdmf-np$np"
+  timeout 300 "${MPIRUN[@]}" -np $np "$TETSTREAM" "${PACK[@]}" "$WORK/harmonic.xdmf" -o "$out" >"$out.json"
+  [ "$(grep -c "this process's share of the grid" "$out.json")" -eq $np ] ||
+    { echo "FAIL: the XDMF grid was not read in shares on $np ranks"; cat "$out.json"; exit 1; }
+  for value in 0 0.25; do
+    a=$("$TETSTREAM" iso "$out" --value $value --json | tr -d ' \n' | grep -o '"triangles":[0-9]*')
+    b=$("$TETSTREAM" iso "$WORK/xdmf-serial" --value $value --json | tr -d ' \n' | grep -o '"triangles":[0-9]*')
+    [ -n "$a" ] && [ "$a" = "$b" ] || { echo "FAIL: XDMF on $np ranks, iso $value: $a, one process $b"; exit 1; }
+  done
+  checks="$checks;$out=$WORK/harmonic.xdmf"
+done
+echo "ok: one XDMF grid read in shares on 2 and 3 ranks gives one process's surfaces"
 
 # The same bytes on a second run.
 again="$WORK/again"
