@@ -27,8 +27,12 @@ import { fetchBytes, retryDelayMs, seconds, STALL_SECONDS } from './net.js';
 // still to come of those under way drop below the lead: what the link delivers while a request
 // waits for its first byte (measured: rate of finished responses, time to their first byte),
 // with a margin, so that the next response starts as the last one ends and the link never idles.
-// At most MAX_IN_FLIGHT requests (many small chunks on a long link).
+// At most MAX_IN_FLIGHT requests (many small chunks on a long link): browsers open six
+// connections to a host over HTTP/1.1, and a seventh request would only queue. Over HTTP/2 or 3
+// (Resource Timing's nextHopProtocol) requests share one connection and more of them may be
+// under way: small chunks, each a round trip to its first byte, then fill the link.
 export const MAX_IN_FLIGHT = 6;
+export const MAX_IN_FLIGHT_MULTIPLEXED = 16;
 export const MIN_LEAD_BYTES = 4 << 10;
 export const MAX_LEAD_BYTES = 1 << 20;
 export const FIRST_LEAD_BYTES = 256 << 10;  // before anything is measured
@@ -38,6 +42,7 @@ export const STARTUP_SECONDS = 1;
 // link with one more request only (which keeps the link busy while the base's last bytes come).
 export const MAX_IN_FLIGHT_BEFORE_BASE = 2;
 export const MAX_AHEAD = 12;                // plan places fetched past the next one the viewer needs
+export const MAX_AHEAD_MULTIPLEXED = 32;    // ... over HTTP/2 or 3
 export const MAX_AHEAD_BYTES = 64 << 20;    // ... and at most this much held in the page
 export const MAX_DAMAGED = 4;               // a chunk damaged this often in a row is broken at the source
 export const LOG_LIMIT = 2000;              // entries kept in ChunkLoader.log (the newest)
@@ -52,7 +57,8 @@ export function networkTiming(url) {
   const entries = performance.getEntriesByName(new URL(url, location.href).href, 'resource');
   const e = entries[entries.length - 1];
   if (!e || !(e.responseStart > e.startTime) || !(e.responseEnd > e.responseStart)) return null;
-  return { firstByteMs: e.responseStart - e.startTime, transferMs: e.responseEnd - e.responseStart };
+  return { firstByteMs: e.responseStart - e.startTime, transferMs: e.responseEnd - e.responseStart,
+    protocol: e.nextHopProtocol || '' };
 }
 
 // What the loader waits on: the page's clock and timers (tests give a fake one).
@@ -107,6 +113,7 @@ export class ChunkLoader {
     this.refused = 0;              // responses the check refused (never handed over)
     this.rate = 0;                 // bytes/s of the last finished response, first byte to last
     this.firstByteMs = 0;          // time to the first byte of the last response that had one
+    this.multiplexed = false;      // the responses came over HTTP/2 or 3 (measure())
     this.paused = false;
     this.stopped = false;
     this.failure = null;           // { index, message }: the first chunk that cannot be had
@@ -252,6 +259,7 @@ export class ChunkLoader {
     const transferMs = t ? t.transferMs : this.clock.now() - entry.firstByte;
     if (entry.firstByte && firstByteMs > 0) this.firstByteMs = t || !this.firstByteMs ? firstByteMs : Math.min(this.firstByteMs, firstByteMs);
     if (transferMs > 0 && bytes >= MIN_LEAD_BYTES) this.rate = bytes / (transferMs / 1000);
+    if (t && t.protocol) this.multiplexed = /^h[23]/.test(t.protocol);
   }
 
   // Bytes still to come of the requests under way below which the next one starts (see above).
@@ -264,11 +272,16 @@ export class ChunkLoader {
     return Math.min(MAX_LEAD_BYTES, Math.max(MIN_LEAD_BYTES, this.rate * seconds));
   }
 
+  // Requests under way at most, once the base is in.
+  inFlightLimit() {
+    return this.multiplexed ? MAX_IN_FLIGHT_MULTIPLEXED : MAX_IN_FLIGHT;
+  }
+
   pump() {
     if (this.paused || this.stopped) return;
     // After a failure only the chunks before it, which are handed over before it is reported.
     const end = Math.min(this.allowed, this.failure ? this.position.get(this.failure.index) : this.plan.length,
-      this.warmed ? this.nextPos + MAX_AHEAD : this.programNearlyIn ? 2 : 1);
+      this.warmed ? this.nextPos + (this.multiplexed ? MAX_AHEAD_MULTIPLEXED : MAX_AHEAD) : this.programNearlyIn ? 2 : 1);
     let ahead = 0, outstanding = 0;
     for (const b of this.arrived.values()) ahead += b.length;
     for (const [j, e] of this.inFlight) {
@@ -279,7 +292,7 @@ export class ChunkLoader {
     // requests now, as the main thread may be busy starting the program for a while (no
     // callbacks run then, so requests not opened before it would wait).
     const baseComing = this.nextPos === 0 && !this.arrived.has(this.plan[0]) && !this.warmed;
-    const limit = baseComing ? MAX_IN_FLIGHT_BEFORE_BASE : MAX_IN_FLIGHT;
+    const limit = baseComing ? MAX_IN_FLIGHT_BEFORE_BASE : this.inFlightLimit();
     for (let p = this.nextPos; p < end && this.inFlight.size < limit; p++) {
       const i = this.plan[p];
       if (this.arrived.has(i) || this.checking.has(i) || this.inFlight.has(i) || this.waiting.has(i) || this.unavailable.has(i)) continue;
@@ -316,7 +329,7 @@ export class ChunkLoader {
         if (!entry.firstByte) entry.firstByte = this.clock.now();
         entry.received += n;
         this.networkBytes += n;
-        if (this.inFlight.size < MAX_IN_FLIGHT) this.pump(); // outstanding bytes dropped
+        if (this.inFlight.size < this.inFlightLimit()) this.pump(); // outstanding bytes dropped
       },
     }).then((bytes) => {
       if (this.inFlight.get(i) !== entry) return; // dropped meanwhile (pause, replan, stop)
