@@ -17,20 +17,21 @@ export const refiner = {
   start(module, onAborted) {
     this.onAborted = onAborted;
     if (boot.workerError) {
-      onAborted(`the refinement worker failed (${boot.workerError})`);
+      const why = boot.workerError === true ? '' : `: ${boot.workerError}`;
+      onAborted(`its refinement worker, worker.js, could not be loaded${why}`);
       return;
     }
     try {
       this.worker = boot.worker || new Worker(new URL('worker.js', location.href));
       boot.worker = null; // (a second dataset reuses this one)
     } catch (e) {
-      onAborted(`the refinement worker could not start (${e && e.message ? e.message : e})`);
+      onAborted(`its refinement worker could not start: ${e && e.message ? e.message : e}`);
       return;
     }
     this.worker.onmessage = (e) => this.receive(e.data);
     this.worker.onerror = (e) => {
       e.preventDefault();
-      this.stopped(`the refinement worker failed (${e.message || 'worker.js could not be loaded'})`);
+      this.stopped(e.message ? `its refinement worker failed: ${e.message}` : 'its refinement worker, worker.js, could not be loaded');
     };
     this.worker.postMessage({ type: 'start', module });
   },
@@ -83,7 +84,7 @@ export const refiner = {
   },
 
   receive(m) {
-    if (m.type === 'aborted') return this.stopped(`the refinement worker stopped (${m.what})`);
+    if (m.type === 'aborted') return this.stopped(`its refinement worker stopped: ${m.what}`);
     if (m.type === 'opened') {
       const resolve = this.opening;
       this.opening = null;

@@ -454,6 +454,17 @@ test('a 404 chunk stops the stream with a message naming the part; the loaded le
   await page.close();
 });
 
+test('a refinement worker that cannot be loaded stops the viewer with a message, never a hang', async () => {
+  own.setFaults([{ match: '/worker.js', kind: 'status', status: 404 }]);
+  const { page, s, problems } = await streamTo(`${ownUrl}/index.html?data=/data/manifest.json`, { states: ['error'] });
+  own.setFaults([]);
+  assert.equal(s.state, 'error');
+  assert.match(s.error, /refinement worker/, s.error);
+  assert.equal(await page.textContent('#status-text'), s.error);
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
 test('offline and back: retries wait for the network and streaming resumes when it returns', async () => {
   own.setFaults([]);
   // The link is down for every chunk after the first two (requests fail as on a dead network)
