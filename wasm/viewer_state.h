@@ -4,7 +4,7 @@
 // (telemetry.h) as parts of their own. No GL, no ImGui, no Emscripten: it compiles natively so the viewer's logic can
 // be unit-tested and debugged without a browser.
 //
-// Flow (driven by wasm/api.cpp from the JS calls in docs/js-api.md):
+// Flow (driven by the refinement worker, wasm/worker_api.cpp, from the messages in docs/js-api.md):
 //   openManifest(bytes)          state idle/error -> loading (or error)
 //   offerChunk(i, bytes)         a downloaded chunk, in any order: checked against the manifest
 //                                (size, hash) once, kept, and added (addChunk) in order
