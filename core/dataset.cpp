@@ -79,16 +79,15 @@ Result openDataset(Dataset& ds, std::string_view manifestJson) {
 
 namespace {
 
-// The stable ids node k's records may name (FORMAT.md §1.1): the base's, its ancestors' and its
-// own, which come next in the mesh.
-VertexIdMap idMapOf(const Dataset& ds, uint32_t k) {
+// The stable ids node k's records may name (FORMAT.md §1.1) besides its own: its ancestors' and
+// the base's. A map's first runs are its node's own, one per chunk received (receiveChunk):
+// chunks of several nodes may arrive interleaved, so a node's vertices need not be contiguous.
+VertexIdMap ancestorIdMap(const Dataset& ds, uint32_t k) {
   VertexIdMap map;
   const Manifest& m = ds.manifest;
-  const NodeInfo& own = m.nodes[k];
-  map.runs.push_back({own.vertexBegin, own.vertexEnd, ds.pm.baseVertices + ds.splitsReceived()});
-  for (int32_t a = own.parent; a >= 0; a = m.nodes[size_t(a)].parent) {
-    const VertexIdMap& up = ds.nodeIds[size_t(a)];
-    map.runs.push_back(up.runs.front());  // (each map's first run is its node's own)
+  for (int32_t a = m.nodes[k].parent; a >= 0; a = m.nodes[size_t(a)].parent) {
+    const std::vector<VertexIdMap::Run>& up = ds.nodeIds[size_t(a)].runs;
+    map.runs.insert(map.runs.end(), up.begin(), up.begin() + ds.nodeChunksReceived[size_t(a)]);
   }
   map.runs.push_back({0, m.chunks[0].vertices, 0});
   return map;
@@ -115,8 +114,14 @@ Result receiveChunk(Dataset& ds, uint32_t index, std::span<const uint8_t> file, 
   } else {
     if (Result r = beginSplits(ds.reader, payload, info, ds.manifest); !r) return r;
     if (const int32_t k = ds.nodeOfChunk(index); k >= 0) {
-      if (ds.nodeChunksReceived[size_t(k)] == 0) ds.nodeIds[size_t(k)] = idMapOf(ds, uint32_t(k));
-      ++ds.nodeChunksReceived[size_t(k)];
+      // The chunk's vertices: stable ids from where the manifest's order puts them, local ids next in the mesh.
+      const VertexIdMap::Run own{ds.manifest.chunks[index - 1].vertices, info.vertices,
+                                 ds.pm.baseVertices + ds.splitsReceived()};
+      uint32_t& count = ds.nodeChunksReceived[size_t(k)];
+      VertexIdMap& map = ds.nodeIds[size_t(k)];
+      if (count == 0) map = ancestorIdMap(ds, uint32_t(k));
+      map.runs.insert(map.runs.begin() + count, own);
+      ++count;
     }
     ds.inManifestOrder = ds.inManifestOrder && index == ds.chunksReceived;
     ds.payloads.emplace_back(payload.begin(), payload.end());
@@ -133,8 +138,12 @@ namespace {
 
 // Drops received chunks from place `place` on (after a decode failure inside it).
 void dropChunksFrom(Dataset& ds, uint32_t place) {
-  for (uint32_t c = place; c < ds.received.size(); ++c)
-    if (const int32_t k = ds.nodeOfChunk(ds.received[c]); k >= 0) --ds.nodeChunksReceived[size_t(k)];
+  for (uint32_t c = uint32_t(ds.received.size()); c-- > place;)  // (latest first: each is its node's last own run)
+    if (const int32_t k = ds.nodeOfChunk(ds.received[c]); k >= 0) {
+      uint32_t& count = ds.nodeChunksReceived[size_t(k)];
+      --count;
+      ds.nodeIds[size_t(k)].runs.erase(ds.nodeIds[size_t(k)].runs.begin() + count);
+    }
   ds.received.resize(place);
   ds.payloads.resize(place);
   ds.chunkFirstSplit.resize(place + 1);

@@ -52,10 +52,10 @@ struct VertexIdMap {
   struct Run {
     uint32_t stableBegin, stableEnd, localBegin;
   };
-  std::vector<Run> runs;  // ascending and disjoint (a node's ids follow its ancestors')
+  std::vector<Run> runs;  // disjoint stable ranges
 
   bool toLocal(uint32_t stable, uint32_t& local) const {
-    for (const Run& r : runs)  // (a chain of a few tens of nodes at most)
+    for (const Run& r : runs)  // (a chain of a few tens of nodes, a run per chunk)
       if (stable >= r.stableBegin && stable < r.stableEnd) {
         local = r.localBegin + (stable - r.stableBegin);
         return true;

@@ -401,3 +401,63 @@ TEST(Partial, ADatasetReceivesNodesInAnyParentFirstOrder) {
       break;
     }
 }
+
+// Chunks of several nodes may arrive interleaved (the loader fetches in parallel): a node of
+// several chunks whose next chunk comes after another node's. Every vertex still gets the place
+// its stable id names, and the level is the same mesh as the nodes loaded one after the other.
+TEST(Partial, ChunksOfSeveralNodesMayInterleave) {
+  PackOptions o;
+  o.leafVertices = 512;
+  o.chunkKb = 1;
+  const std::string dir = pack("partial-interleaved", harmonic(16), o);
+  const std::string json = loadFile(dir + "/manifest.json");
+  Dataset ds;
+  ASSERT_TRUE(openDataset(ds, json));
+  const Manifest& m = ds.manifest;
+  uint32_t multiChunk = 0;
+  for (const NodeInfo& n : m.nodes) multiChunk += n.parent >= 0 && n.chunkCount > 1;
+  ASSERT_GE(multiChunk, 2u) << "the case needs inner nodes of several chunks";
+  auto file = [&](uint32_t index) { return loadBytes(dir + "/" + m.chunks[index].file); };
+  ASSERT_TRUE(receiveChunk(ds, 0, file(0)));
+  std::mt19937 rng(5);
+  std::vector<uint32_t> changed;
+  bool reached = false;
+  // Always the receivable chunk of another node than the last, when there is one.
+  int32_t lastNode = -1;
+  uint32_t interleaved = 0;
+  for (;;) {
+    std::vector<uint32_t> ready;
+    for (uint32_t k = 0; k < m.nodes.size(); ++k)
+      if (ds.nodeChunksReceived[k] < m.nodes[k].chunkCount &&
+          ds.canReceive(m.nodes[k].firstChunk + ds.nodeChunksReceived[k]))
+        ready.push_back(k);
+    if (ready.empty()) break;
+    std::vector<uint32_t> others;
+    for (uint32_t k : ready)
+      if (int32_t(k) != lastNode) others.push_back(k);
+    const std::vector<uint32_t>& from = others.empty() ? ready : others;
+    const uint32_t k = from[rng() % from.size()];
+    if (ds.nodeChunksReceived[k] > 0 && int32_t(k) != lastNode) ++interleaved;
+    const uint32_t chunk = m.nodes[k].firstChunk + ds.nodeChunksReceived[k];
+    ASSERT_TRUE(receiveChunk(ds, chunk, file(chunk))) << "chunk " << chunk;
+    lastNode = int32_t(k);
+    if (rng() % 2) {
+      ASSERT_TRUE(stepTowards(ds, ds.splitsReceived(), ~0u, changed, &reached));
+    }
+  }
+  EXPECT_GT(interleaved, 0u) << "no node's chunks were interleaved with another's";
+  ASSERT_TRUE(stepTowards(ds, ds.splitsReceived(), ~0u, changed, &reached) && reached);
+  expectValidLevel(ds.pm.mesh, "interleaved chunks");
+  Dataset whole;
+  ASSERT_TRUE(loadPackedDir(dir, whole));
+  std::vector<uint32_t> stableOf(ds.pm.vertexCount());
+  for (uint32_t v = 0; v < ds.pm.baseVertices; ++v) stableOf[v] = v;
+  for (uint32_t place = 1; place < ds.received.size(); ++place) {
+    const uint32_t before = m.chunks[ds.received[place] - 1].vertices;
+    for (uint32_t s = ds.chunkFirstSplit[place]; s < ds.chunkFirstSplit[place + 1]; ++s)
+      stableOf[ds.pm.baseVertices + s] = before + (s - ds.chunkFirstSplit[place]);
+  }
+  std::vector<uint32_t> identity(whole.pm.vertexCount());
+  for (uint32_t v = 0; v < identity.size(); ++v) identity[v] = v;
+  EXPECT_TRUE(stableMesh(ds.pm.mesh, stableOf) == stableMesh(whole.pm.mesh, identity));
+}
