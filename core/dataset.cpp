@@ -214,6 +214,73 @@ Result stepTowards(Dataset& ds, uint32_t targetSplits, uint32_t maxSteps, std::v
   return Result::success();
 }
 
+uint32_t nodeFirstSplit(const Dataset& ds, uint32_t node) {
+  for (uint32_t place = 1; place < ds.received.size(); ++place)
+    if (ds.nodeOfChunk(ds.received[place]) == int32_t(node)) return ds.chunkFirstSplit[place];
+  return ds.splitsReceived();
+}
+
+Result forgetNode(Dataset& ds, uint32_t node) {
+  const std::vector<NodeInfo>& nodes = ds.manifest.nodes;
+  if (node >= nodes.size() || ds.nodeChunksReceived[node] == 0)
+    return fail(Status::BadArgument, "node " + std::to_string(node) + " has no chunk received");
+  for (uint32_t k = 0; k < nodes.size(); ++k)
+    if (nodes[k].parent == int32_t(node) && ds.nodeChunksReceived[k] > 0)
+      return fail(Status::BadArgument, "node " + std::to_string(node) + " has a received child");
+  if (ds.splitsApplied() > nodeFirstSplit(ds, node))
+    return fail(Status::BadArgument, "splits of node " + std::to_string(node) + " are applied");
+  // The places that stay, in order; the splits of the others leave the order, and so do their
+  // vertices' places in the mesh (local ids), which the id maps' later runs move down past.
+  const uint32_t base = ds.pm.baseVertices, decoded = ds.splitsDecoded;
+  std::vector<uint32_t> received{ds.received[0]}, firstSplit{0, 0}, tetsAfter{ds.tetsAfter[0]};
+  std::vector<std::vector<uint8_t>> payloads(1);
+  std::vector<uint32_t> recordStart, stableJ;
+  std::vector<std::pair<uint32_t, uint32_t>> gone;  // local vertex ranges [begin, end) given back
+  for (uint32_t place = 1; place < ds.received.size(); ++place) {
+    const uint32_t index = ds.received[place], g0 = ds.chunkFirstSplit[place], g1 = ds.chunkFirstSplit[place + 1];
+    if (ds.nodeOfChunk(index) == int32_t(node)) {
+      gone.push_back({base + g0, base + g1});
+      continue;
+    }
+    received.push_back(index);
+    payloads.push_back(std::move(ds.payloads[place]));
+    firstSplit.push_back(firstSplit.back() + (g1 - g0));
+    tetsAfter.push_back(tetsAfter.back() + (ds.manifest.chunks[index].tets - ds.manifest.chunks[index - 1].tets));
+    for (uint32_t g = g0; g < std::min(g1, decoded); ++g) {  // (decoded splits stay a prefix of the order)
+      recordStart.insert(recordStart.end(), &ds.recordStart[kSplitColumns * size_t(g)],
+                         &ds.recordStart[kSplitColumns * size_t(g + 1)]);
+      stableJ.push_back(ds.stableJ[g]);
+    }
+  }
+  // Where the next record to decode starts: only read inside a chunk, where it stayed.
+  recordStart.insert(recordStart.end(), &ds.recordStart[kSplitColumns * size_t(decoded)],
+                     &ds.recordStart[kSplitColumns * size_t(decoded + 1)]);
+  for (uint32_t k = 0; k < nodes.size(); ++k)
+    for (VertexIdMap::Run& run : ds.nodeIds[k].runs) {
+      uint32_t below = 0;
+      for (const auto& [begin, end] : gone)
+        if (begin < run.localBegin) below += end - begin;
+      run.localBegin -= below;
+    }
+  ds.nodeIds[node] = {};
+  ds.nodeChunksReceived[node] = 0;
+  ds.received = std::move(received);
+  ds.payloads = std::move(payloads);
+  ds.chunkFirstSplit = std::move(firstSplit);
+  ds.tetsAfter = std::move(tetsAfter);
+  ds.splitsDecoded = uint32_t(stableJ.size());
+  ds.recordStart = std::move(recordStart);
+  ds.stableJ = std::move(stableJ);
+  ds.chunksReceived = uint32_t(ds.received.size());
+  ds.bytesReceived = 0;
+  ds.inManifestOrder = true;
+  for (uint32_t place = 0; place < ds.received.size(); ++place) {
+    ds.bytesReceived += ds.manifest.chunks[ds.received[place]].bytes;
+    ds.inManifestOrder = ds.inManifestOrder && ds.received[place] == place;
+  }
+  return Result::success();
+}
+
 Result applyChunk(Dataset& ds, uint32_t index, std::span<const uint8_t> file) {
   if (ds.splitsApplied() != ds.splitsReceived())
     return fail(Status::BadArgument, "applyChunk needs every received split applied first");

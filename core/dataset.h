@@ -87,6 +87,17 @@ Result receiveChunk(Dataset& ds, uint32_t index, std::span<const uint8_t> file, 
 Result stepTowards(Dataset& ds, uint32_t targetSplits, uint32_t maxSteps, std::vector<uint32_t>& changed,
                    bool* reached);
 
+// Where node `node`'s splits start in the order received: the first split of its first chunk
+// received (splitsReceived() when it has none).
+uint32_t nodeFirstSplit(const Dataset& ds, uint32_t node);
+
+// Gives back every received chunk of `node`, as if it had never come: the viewer forgets a region
+// the view no longer needs when memory is tight. The node must have no received child and none
+// of its splits applied (stepTowards to nodeFirstSplit first), so the mesh does not change; the
+// splits received after it move down in the order, and their records stay valid (each node's
+// stable ids map to the new places). On a refusal nothing changes.
+Result forgetNode(Dataset& ds, uint32_t node);
+
 // Receives and fully applies a chunk. On any failure the dataset stays at its last valid level.
 Result applyChunk(Dataset& ds, uint32_t index, std::span<const uint8_t> file);
 

@@ -461,3 +461,97 @@ TEST(Partial, ChunksOfSeveralNodesMayInterleave) {
   for (uint32_t v = 0; v < identity.size(); ++v) identity[v] = v;
   EXPECT_TRUE(stableMesh(ds.pm.mesh, stableOf) == stableMesh(whole.pm.mesh, identity));
 }
+
+namespace {
+
+// A dataset's mesh in stable vertex ids: each place's vertices from where the manifest puts its chunk.
+StableMesh stableMesh(const Dataset& ds) {
+  std::vector<uint32_t> stableOf(ds.pm.vertexCount());
+  for (uint32_t v = 0; v < ds.pm.baseVertices; ++v) stableOf[v] = v;
+  for (uint32_t place = 1; place < ds.received.size(); ++place) {
+    const uint32_t before = ds.manifest.chunks[ds.received[place] - 1].vertices;
+    for (uint32_t s = ds.chunkFirstSplit[place]; s < ds.chunkFirstSplit[place + 1]; ++s)
+      if (ds.pm.baseVertices + s < stableOf.size())
+        stableOf[ds.pm.baseVertices + s] = before + (s - ds.chunkFirstSplit[place]);
+  }
+  return stableMesh(ds.pm.mesh, stableOf);
+}
+
+}  // namespace
+
+// The viewer gives back regions it no longer needs (memory): a node without received children,
+// its splits undone first, leaves the dataset as if it had never come. What stays is the same
+// mesh as those nodes loaded on their own, the level still moves both ways, and the node can come
+// again. A node with a received child, or with splits applied, is refused and nothing changes.
+TEST(Partial, ADatasetForgetsNodesItNoLongerNeeds) {
+  std::mt19937 rng(21);
+  PackOptions o;
+  o.leafVertices = 256;
+  o.chunkKb = 2;
+  const std::string dir = pack("partial-forget", harmonic(16), o);
+  const std::string json = loadFile(dir + "/manifest.json");
+  Dataset ds;
+  ASSERT_TRUE(openDataset(ds, json));
+  const Manifest& m = ds.manifest;
+  auto file = [&](uint32_t index) { return loadBytes(dir + "/" + m.chunks[index].file); };
+  std::vector<uint32_t> changed;
+  bool reached = false;
+  auto receiveNode = [&](uint32_t k) {
+    for (uint32_t ch = m.nodes[k].firstChunk; ch < m.nodes[k].firstChunk + m.nodes[k].chunkCount; ++ch)
+      ASSERT_TRUE(receiveChunk(ds, ch, file(ch))) << "chunk " << ch;
+  };
+  auto applyAll = [&] { ASSERT_TRUE(stepTowards(ds, ds.splitsReceived(), ~0u, changed, &reached) && reached); };
+  ASSERT_TRUE(receiveChunk(ds, 0, file(0)));
+  std::vector<uint32_t> all(m.nodes.size());
+  std::iota(all.begin(), all.end(), 0u);
+  for (uint32_t k : randomParentFirstOrder(m, all, rng)) receiveNode(k);
+  applyAll();
+  auto hasReceivedChild = [&](uint32_t k) {
+    for (uint32_t c = 0; c < m.nodes.size(); ++c)
+      if (m.nodes[c].parent == int32_t(k) && ds.nodeChunksReceived[c] > 0) return true;
+    return false;
+  };
+  // Refusals change nothing.
+  const StableMesh full = stableMesh(ds);
+  ASSERT_TRUE(hasReceivedChild(0));
+  EXPECT_FALSE(forgetNode(ds, 0)) << "the root has received children";
+  uint32_t leaf = 0;
+  while (hasReceivedChild(leaf) || m.nodes[leaf].parent < 0) ++leaf;
+  EXPECT_FALSE(forgetNode(ds, leaf)) << "its splits are applied";
+  EXPECT_TRUE(stableMesh(ds) == full);
+  // Forget leaves of the received tree at random, then bring some back.
+  std::vector<uint8_t> in(m.nodes.size(), 1);
+  for (int round = 0; round < 12; ++round) {
+    std::vector<uint32_t> leaves;
+    for (uint32_t k = 0; k < m.nodes.size(); ++k)
+      if (in[k] && m.nodes[k].parent >= 0 && !hasReceivedChild(k)) leaves.push_back(k);
+    ASSERT_FALSE(leaves.empty());
+    const uint32_t k = leaves[rng() % leaves.size()];
+    ASSERT_TRUE(stepTowards(ds, nodeFirstSplit(ds, k), ~0u, changed, &reached) && reached);
+    ASSERT_TRUE(forgetNode(ds, k)) << "node " << k;
+    in[k] = 0;
+    EXPECT_EQ(ds.nodeChunksReceived[k], 0u);
+    if (round % 3 == 2) {  // the level back to the base and forward again
+      ASSERT_TRUE(stepTowards(ds, 0, ~0u, changed, &reached) && reached);
+    }
+    applyAll();
+    std::vector<uint32_t> kept;
+    for (uint32_t n = 0; n < m.nodes.size(); ++n)
+      if (in[n]) kept.push_back(n);
+    PartialDataset pd;
+    ASSERT_TRUE(loadPartialDir(dir, kept, pd));
+    const std::string what = "after forgetting node " + std::to_string(k) + " (round " + std::to_string(round) + ")";
+    EXPECT_TRUE(stableMesh(ds) == stableMesh(pd)) << what;
+    expectValidLevel(ds.pm.mesh, what);
+    if (round % 4 == 3) {  // one comes back
+      receiveNode(k);
+      in[k] = 1;
+      applyAll();
+    }
+  }
+  // Everything again: the whole mesh.
+  for (uint32_t k : randomParentFirstOrder(m, all, rng))
+    if (!in[k]) receiveNode(k);
+  applyAll();
+  EXPECT_TRUE(stableMesh(ds) == full);
+}
