@@ -68,6 +68,7 @@ void replan(ViewerState& s) {
   p.missing = ds.chunksReceived == 0 ? 1 : 0;
   for (size_t k = 0; k < m.nodes.size(); ++k)
     if (p.needed[k] && !broken[k]) p.missing += m.nodes[k].chunkCount - ds.nodeChunksReceived[k];
+  planEviction(s);
 }
 
 void notePlannedChunk(ViewerState& s, uint32_t index) {

@@ -68,6 +68,7 @@ ModelReport reportOf(const json& j) {
   r.heapBytes = number<uint64_t>(memory, "heapBytes", 0);
   r.neededBytes = number<uint64_t>(memory, "neededBytes", 0);
   r.limitBytes = number<uint64_t>(memory, "limitBytes", 0);
+  r.memoryFull = flag(memory, "full");
   r.refineMs = number<double>(j, "refineMs", 0);
   r.extractMs = number<double>(j, "extractMs", 0);
   r.refineSteps = number<uint32_t>(j, "refineSteps", 0);

@@ -29,6 +29,7 @@ struct ModelReport {
   uint32_t chunksReceived = 0, chunksAllowed = 0, chunksMissing = 0, nodesLoaded = 0;
   uint64_t bytesReceived = 0, bytesNeeded = 0;
   bool exact = false, refining = false, surfaceReady = false, memoryLimited = false;
+  bool memoryFull = false;  // regions the view needs do not fit in memory (eviction.h)
   uint32_t splitsReceived = 0, splitsApplied = 0, targetSplits = 0;
   bool live = true;
   uint32_t baseVertices = 0, vertices = 0, tets = 0;

@@ -73,6 +73,9 @@ void selectionLines(PageState& s) {
                 formatBytes(r.bytesReceived).c_str(), formatBytes(m.totalBytes()).c_str());
   ImGui::TextDisabled("%s", line);
   if (!r.unavailable.empty()) coloredWrapped(kWarning, r.unavailable);
+  if (r.memoryFull)
+    coloredWrapped(kWarning, "Memory is full (" + formatBytes(r.limitBytes) +
+                                 "): the regions shown are those that fit; the rest of this view stays coarse.");
   bool everything = s.settings.fetch == FetchMode::Everything;
   if (ImGui::Checkbox("load everything", &everything))
     setFetchMode(s, everything ? FetchMode::Everything : FetchMode::Needed);

@@ -96,8 +96,12 @@ std::string statsJson(const ViewerState& s) {
         {"gpuBytes", s.memory.gpuBytes},
         {"limitBytes", s.memory.limitBytes ? json(s.memory.limitBytes) : json(nullptr)},
         {"neededBytes", s.memory.neededBytes},
-        {"allowedBytes",
-         s.memory.chunksAllowed ? s.memory.baseBytes + estimateLevelBytes(m, s.memory.chunksAllowed) : 0}}},
+        {"allowedBytes", budgetedByRegions(s)     ? s.memory.limitBytes
+                         : s.memory.chunksAllowed ? s.memory.baseBytes + estimateLevelBytes(m, s.memory.chunksAllowed)
+                                                  : 0},
+        {"budgetedBytes", s.memory.baseBytes + estimateBytes(m, s.memory.received)},
+        {"full", s.evict.memoryFull},
+        {"nodesForgotten", s.evict.nodesForgotten}}},
       {"sliderRect", rect(s.telemetry.screen.slider)},
       {"levelSliderRect", rect(s.telemetry.screen.levelSlider)},
       {"pauseButtonRect", rect(s.telemetry.screen.pauseButton)},

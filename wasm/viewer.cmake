@@ -40,6 +40,7 @@ add_executable(tetstream_viewer
   ${CMAKE_CURRENT_LIST_DIR}/geometry_sync.cpp
   ${CMAKE_CURRENT_LIST_DIR}/telemetry.cpp
   ${CMAKE_CURRENT_LIST_DIR}/fetch_plan.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/eviction.cpp
   ${CMAKE_CURRENT_LIST_DIR}/colourmap.cpp
   ${CMAKE_CURRENT_LIST_DIR}/viewer_memory.cpp
   ${CMAKE_CURRENT_LIST_DIR}/camera.cpp

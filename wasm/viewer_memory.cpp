@@ -44,6 +44,14 @@ void addCounts(LevelCounts& total, const LevelCounts& more) {
   total.largestRaw = std::max(total.largestRaw, more.largestRaw);
 }
 
+void subtractCounts(LevelCounts& total, const LevelCounts& less) {
+  total.vertices = std::max(0.0, total.vertices - less.vertices);
+  total.tets = std::max(0.0, total.tets - less.tets);
+  total.splits = std::max(0.0, total.splits - less.splits);
+  total.payloadBytes = std::max(0.0, total.payloadBytes - less.payloadBytes);
+  // (largestRaw stays: the decoder's buffer does not shrink)
+}
+
 uint64_t estimateBytes(const Manifest& m, const LevelCounts& c) {
   const double v = c.vertices, t = c.tets;
   const double hullTriangles = 4 * std::cbrt(t * t);  // a cube of 6n³ tets has 12n² ≈ 3.6 t^(2/3)

@@ -30,6 +30,7 @@ struct LevelCounts {
 // the chunks of a patch hierarchy arrive.
 LevelCounts chunkCounts(const Manifest& m, uint32_t index);
 void addCounts(LevelCounts& total, const LevelCounts& more);
+void subtractCounts(LevelCounts& total, const LevelCounts& less);
 
 // The memory budget (bytes). The platform sets the limit (the browser's wasm maximum, or the
 // page's ?maxMemoryMB=; 0 = none), the heap in use before any dataset (code, stack, UI), the heap

@@ -127,7 +127,8 @@ void updateState(ViewerState& s) {
   const Dataset& ds = s.dataset;
   if (ds.chunksReceived == 0)
     s.state = LoadState::Loading;
-  else if (s.fetch.missing == 0 && ds.splitsApplied() == ds.splitsReceived())
+  else if ((s.fetch.missing == 0 || s.evict.memoryFull) && s.evict.nodes.empty() &&
+           ds.splitsApplied() == ds.splitsReceived())
     s.state = LoadState::Complete;
   else
     s.state = LoadState::Streaming;
@@ -179,6 +180,7 @@ Result openManifest(ViewerState& s, std::string_view manifestJson) {
   s.memory.neededBytes = 0;
   s.memory.chunksAllowed = 0;
   s.memory.limited = false;
+  s.evict = {};
   if (Result r = openDataset(s.dataset, manifestJson); !r) {
     s.dataset.manifest = {};
     s.dataset.pm = {};
@@ -213,6 +215,9 @@ Result openManifest(ViewerState& s, std::string_view manifestJson) {
       failLoad(s, message);
       return fail(Status::TooLarge, message);
     }
+    // Regions are fetched as far as they fit and given back when the view moves on (eviction.h),
+    // not cut at a count of chunks in the manifest's order.
+    if (budgetedByRegions(s)) s.memory.chunksAllowed = s.chunksTotal;
   }
   return Result::success();
 }
@@ -243,7 +248,7 @@ ChunkCheck offerChunk(ViewerState& s, uint32_t index, uint8_t* bytes, size_t siz
       const uint32_t i = next->first;
       const PendingChunk ready = std::move(next->second);
       s.pendingChunks.erase(next);
-      if (!addChunk(s, i, {ready.bytes.get(), ready.size}, /*hashChecked=*/true).ok()) {
+      if (!addChunk(s, i, {ready.bytes.get(), ready.size}, /*hashChecked=*/true).ok() && s.state == LoadState::Error) {
         s.pendingChunks.clear();
         return ChunkCheck::Ok;
       }
@@ -276,6 +281,13 @@ Result addChunk(ViewerState& s, uint32_t index, std::span<const uint8_t> bytes, 
   LevelCounts after = s.memory.received;
   addCounts(after, chunkCounts(ds.manifest, index));
   const uint64_t need = s.memory.baseBytes + estimateBytes(ds.manifest, after);
+  // A region that came after the view moved on and no longer fits is given back, not an error
+  // (the plan asks only for what fits: eviction.h); the page may fetch it again later.
+  if (budgetedByRegions(s) && index > 0 && need > s.memory.limitBytes) {
+    s.evict.forgottenChunks.push_back(index);
+    ++s.fetch.version;
+    return fail(Status::TooLarge, partName(s, index) + " does not fit in memory now");
+  }
   const bool reserveAll =
       index == 0 && (!s.memory.reserveHeap || s.memory.reserveHeap(s.memory.baseBytes + plannedLevelBytes(s)));
   if (s.memory.reserveHeap && !reserveAll && !s.memory.reserveHeap(need)) {
@@ -294,6 +306,7 @@ Result addChunk(ViewerState& s, uint32_t index, std::span<const uint8_t> bytes, 
   }
   s.memory.received = after;
   notePlannedChunk(s, index);
+  planEviction(s);
   if (ds.chunksReceived == 1) {  // the base: shown at once
     if (reserveAll) reserveLevel(s);
     extract(s);
@@ -309,7 +322,8 @@ Result addChunk(ViewerState& s, uint32_t index, std::span<const uint8_t> bytes, 
 
 bool advance(ViewerState& s, double deadlineMs, Clock now) {
   Dataset& ds = s.dataset;
-  if (ds.chunksReceived == 0 || std::min(s.level.targetSplits, ds.splitsReceived()) == ds.splitsApplied()) {
+  forgetEvicted(s);  // (once the level is down to the regions given back)
+  if (ds.chunksReceived == 0 || levelCap(s) == ds.splitsApplied()) {
     updateState(s);
     return false;
   }
@@ -317,7 +331,7 @@ bool advance(ViewerState& s, double deadlineMs, Clock now) {
   const uint32_t base = ds.pm.baseVertices;
   uint32_t steps = 0;
   do {
-    const uint32_t target = std::min(s.level.targetSplits, ds.splitsReceived());
+    const uint32_t target = levelCap(s);
     const uint32_t a0 = ds.splitsApplied();
     if (a0 == target) break;
     const uint32_t n = std::min(kStepBatch, a0 > target ? a0 - target : target - a0);
@@ -346,6 +360,7 @@ bool advance(ViewerState& s, double deadlineMs, Clock now) {
     }
     s.hull.update(ds.pm, s.splitVertices);
   } while (now() < deadlineMs);
+  forgetEvicted(s);
   s.dirty.surface = s.dirty.hull = true;
   if (s.sliceOn) s.dirty.slice = true;
   s.telemetry.refineMs = now() - t0;
@@ -496,7 +511,7 @@ uint64_t memoryInUse(const ViewerState& s) {
 
 bool downloading(const ViewerState& s) {
   return (s.state == LoadState::Loading || s.state == LoadState::Streaming) && !s.network.paused &&
-         s.fetch.missing > 0 && s.dataset.chunksReceived < s.memory.chunksAllowed;
+         s.fetch.missing > 0 && s.dataset.chunksReceived < s.memory.chunksAllowed && !s.evict.memoryFull;
 }
 
 bool treePending(const ViewerState& s) {
@@ -520,7 +535,7 @@ bool growTree(ViewerState& s, double deadlineMs, Clock now) {
 
 bool refining(const ViewerState& s) {
   const Dataset& ds = s.dataset;
-  return ds.chunksReceived > 0 && std::min(s.level.targetSplits, ds.splitsReceived()) != ds.splitsApplied();
+  return ds.chunksReceived > 0 && levelCap(s) != ds.splitsApplied();
 }
 
 double levelFraction(const ViewerState& s) {

@@ -40,6 +40,7 @@
 
 #include "colourmap.h"
 #include "dataset.h"
+#include "eviction.h"
 #include "fetch_plan.h"
 #include "hull.h"
 #include "isosurface_incremental.h"
@@ -138,6 +139,7 @@ struct ViewerState {
   MemoryBudget memory;
   Telemetry telemetry;
   FetchPlan fetch;  // which chunks the view needs, most important first (fetch_plan.h)
+  Eviction evict;   // regions given back to make room (eviction.h)
 
   // Scratch, reused every frame.
   std::vector<uint32_t> changed, splitVertices;

@@ -33,6 +33,12 @@ std::vector<uint8_t> g_delta;
 // Strings handed to the worker's script stay valid until the next call that returns one of the same kind.
 std::string g_stats, g_plan;
 
+std::string jsonArray(const std::vector<uint32_t>& values) {
+  std::string out = "[";
+  for (uint32_t v : values) out += (out.size() > 1 ? "," : "") + std::to_string(v);
+  return out + "]";
+}
+
 // Heap in use before a dataset, plus the worker's copies of chunks on their way in.
 constexpr uint64_t kTransferBytes = 16u << 20;
 
@@ -188,12 +194,15 @@ EMSCRIPTEN_KEEPALIVE int tw_plan_version() { return int(g_model.fetch.version); 
 // The chunks to fetch next, most important first, as a JSON array of indices (fetch_plan.h); at
 // most as many as memory allows.
 EMSCRIPTEN_KEEPALIVE const char* tw_plan() {
-  const ViewerState& s = g_model;
-  const uint32_t room =
-      s.memory.chunksAllowed > s.dataset.chunksReceived ? s.memory.chunksAllowed - s.dataset.chunksReceived : 0;
-  g_plan = "[";
-  for (uint32_t c : plannedChunks(s, room)) g_plan += (g_plan.size() > 1 ? "," : "") + std::to_string(c);
-  g_plan += "]";
+  g_plan = jsonArray(chunksToFetch(g_model));
+  return g_plan.c_str();
+}
+
+// The chunks the model gave back since the last call (eviction.h), as a JSON array: the page's
+// loader may fetch them again.
+EMSCRIPTEN_KEEPALIVE const char* tw_forgotten() {
+  g_plan = jsonArray(g_model.evict.forgottenChunks);
+  g_model.evict.forgottenChunks.clear();
   return g_plan.c_str();
 }
 

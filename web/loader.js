@@ -128,6 +128,7 @@ export class ChunkLoader {
     //   { event: 'online', waiting }          { event: 'pause' }   { event: 'resume' }
     //   { event: 'replan', count }: the plan past what was handed over is now `count` chunks.
     //   { event: 'drop', index, reason: 'replan' }: a request under way for a chunk it left.
+    //   { event: 'forget', count }: chunks handed over that the viewer gave back (forget()).
     //   { event: 'discard', index, bytes }: a chunk it left that had arrived.
     //   { event: 'skip', index }: a chunk that cannot be had, left out (onChunkFailed).
     //   { event: 'idle' }: the end of the plan, waiting for more (onIdle).
@@ -233,6 +234,19 @@ export class ChunkLoader {
     if (this.nextPos < Math.min(this.allowed, this.plan.length)) this.idle = false;
     this.deliverReady();
     this.pump();
+  }
+
+  // The viewer gave these chunks back (short of memory, it forgot regions the view no longer
+  // needs): they leave what was handed over, so that a later plan may fetch them again.
+  forget(indices) {
+    const gone = new Set(indices.filter((i) => this.position.has(i) && this.position.get(i) < this.nextPos));
+    if (!gone.size) return;
+    const handed = this.plan.slice(0, this.nextPos).filter((i) => !gone.has(i));
+    for (const i of gone) this.deliveredBytes -= this.sizes[i];
+    this.plan = [...handed, ...this.plan.slice(this.nextPos)];
+    this.nextPos = handed.length;
+    this.position = new Map(this.plan.map((i, p) => [i, p]));
+    this.note({ event: 'forget', count: gone.size });
   }
 
   // The program's bytes are in: the link is free for more than the base.

@@ -10,6 +10,7 @@ export const refiner = {
   offers: new Map(), // chunk index -> resolve(code) of an offer under way
   opening: null,     // resolve({ ok, chunksAllowed, plan, stats }) of the open under way
   onPlan: null,      // (plan: chunk indices) when the worker's plan changed
+  onForgotten: null, // (chunk indices) the worker gave back for memory, before the plan that follows
   onAborted: null,   // (what) the worker stopped: nothing more comes from it
 
   // Starts the worker with the compiled program (WebAssembly.Module). onAborted: as above.
@@ -102,7 +103,7 @@ export const refiner = {
   },
 
   // The model's figures and the geometry that changed, into the page's viewer; then the plan.
-  update({ stats, seen, delta, plan }) {
+  update({ stats, seen, delta, plan, forgotten }) {
     const viewer = page.viewer;
     if (!viewer || page.aborted) return;
     const bytes = delta ? new Uint8Array(delta) : null;
@@ -113,6 +114,7 @@ export const refiner = {
     } finally {
       if (ptr) viewer._free(ptr);
     }
+    if (forgotten && this.onForgotten) this.onForgotten(forgotten);
     if (plan && this.onPlan) this.onPlan(plan);
   },
 };

@@ -237,6 +237,7 @@ function followPlan(viewer, loader, firstPlan) {
   };
   loader.onIdle = () => network.report();
   loader.onChunkFailed = (i, message) => refiner.post({ type: 'unavailable', index: i, message });
+  refiner.onForgotten = (chunks) => loader.forget(chunks);
   refiner.onPlan = follow;
   follow(firstPlan);
 }

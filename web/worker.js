@@ -55,14 +55,17 @@ function publish() {
   const delta = size ? viewer.HEAPU8.slice(ptr, ptr + size) : null;
   const stats = text(viewer._tw_stats());
   let plan = null;
+  let forgotten = null; // chunks given back for memory: the page's loader may fetch them again
   if (viewer._tw_plan_version() !== planVersion) {
     planVersion = viewer._tw_plan_version();
     plan = JSON.parse(text(viewer._tw_plan()));
+    forgotten = JSON.parse(text(viewer._tw_forgotten()));
+    if (!forgotten.length) forgotten = null;
   }
   if (!delta && !plan && stats === lastStats && seen === lastSeen) return;
   lastStats = stats;
   lastSeen = seen;
-  const message = { type: 'update', stats, seen, delta: delta ? delta.buffer : null, plan };
+  const message = { type: 'update', stats, seen, delta: delta ? delta.buffer : null, plan, forgotten };
   postMessage(message, delta ? [delta.buffer] : []);
 }
 

@@ -153,3 +153,51 @@ test('the slice plane fetches the regions it crosses: the slice is at full resol
     await new Promise((resolve) => server.close(resolve));
   }
 });
+
+// Memory for two views, one at a time: with ?maxMemoryMB= below what both isovalues' regions
+// take together, moving from one to the other gives back regions the new one does not need,
+// fetches those it does, and reaches its exact surface; the memory counted stays under the limit.
+test('short of memory, the regions the view no longer needs are given back and each surface is still exact', async () => {
+  const shells = makePack(tmp, 'd32', { kind: 'distance', n: 32, packArgs: ['--leaf-vertices', '256'] });
+  const { min, max } = readManifest(shells.dir).fields[0];
+  const near = min + 0.2 * (max - min), far = min + 0.85 * (max - min);
+  const server = createServer({ mounts: [{ prefix: '/data', dir: shells.dir }, { prefix: '/', dir: webDir }] });
+  const url = await listen(server);
+  const open = async (iso, extra = '') => openViewer(await browser, `${url}/index.html?data=/data/manifest.json&iso=${iso}${extra}`);
+  try {
+    // What each view takes alone, and both together, without a limit.
+    const alone = [];
+    for (const iso of [near, far]) {
+      const { page } = await open(iso);
+      alone.push((await waitForExact(page)).memory.budgetedBytes);
+      if (iso === far) {
+        await page.evaluate((v) => window.tetstream.setIsovalue(v), near);
+        await page.waitForFunction(() => !window.tetstream.stats().exact);
+        alone.push((await waitForExact(page)).memory.budgetedBytes);
+      }
+      await page.close();
+    }
+    const [, , both] = alone;
+    const limitMB = Math.ceil((Math.max(alone[0], alone[1]) * 1.02) / 1048576 * 10) / 10;
+    assert.ok(both > limitMB * 1048576, `both views (${both} bytes) must not fit in ${limitMB} MB`);
+
+    const { page, problems } = await open(far, `&maxMemoryMB=${limitMB}`);
+    let s = await waitForExact(page);
+    assertSurfaceMatches(s, cliIso(s.isovalue, { dir: shells.dir }), `exact at ${s.isovalue}`);
+    for (const iso of [near, far]) {
+      await page.evaluate((v) => window.tetstream.setIsovalue(v), iso);
+      await page.waitForFunction(() => !window.tetstream.stats().exact);
+      s = await waitForExact(page);
+      assertSurfaceMatches(s, cliIso(s.isovalue, { dir: shells.dir }), `exact at ${s.isovalue} within ${limitMB} MB`);
+      assert.ok(s.memory.budgetedBytes <= s.memory.limitBytes, `${s.memory.budgetedBytes} of ${s.memory.limitBytes}`);
+      assert.equal(s.memory.full, false);
+    }
+    assert.ok(s.memory.nodesForgotten > 0, 'regions were given back');
+    assert.ok(s.requestLog.some((e) => e.event === 'forget'), 'the loader heard which chunks to fetch again');
+    assert.equal(s.state, 'complete');
+    assert.deepEqual(problems, []);
+    await page.close();
+  } finally {
+    await new Promise((resolve) => server.close(resolve));
+  }
+});

@@ -457,3 +457,21 @@ test('a chunk that fails for a while before one that cannot be had is still fetc
   assert.deepEqual(run.delivered, [0, 1]);
   assert.match(run.result.failed, /^Could not download part 3 of 4 .* Showing the last complete level\.$/);
 });
+
+test('chunks the viewer gave back leave what was handed over, and a later plan fetches them again', async () => {
+  const run = makeLoader({ order: [0, 1, 2], onIdle: () => {} });
+  run.loader.pump();
+  await answerAll(run.net, run.size);
+  assert.deepEqual(run.delivered, [0, 1, 2]);
+  const have = run.loader.haveBytes();
+  run.loader.replan([1]); // handed over: ignored
+  assert.equal(run.net.open().length, 0);
+  run.loader.forget([1, 5]); // 5 was never handed over: nothing to forget
+  assert.equal(run.loader.log.filter((e) => e.event === 'forget')[0].count, 1);
+  assert.equal(run.loader.haveBytes(), have - run.size);
+  run.loader.replan([1, 3]);
+  assert.deepEqual(run.net.open().map((r) => r.index), [1, 3]);
+  await answerAll(run.net, run.size);
+  assert.deepEqual(run.delivered, [0, 1, 2, 1, 3]);
+  run.loader.stop();
+});

@@ -3,11 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <iterator>
 #include <string>
 #include <vector>
 
 #include "io/generators.h"
+#include "isosurface.h"
 #include "pack/packer.h"
+#include "partial.h"
 #include "test_helpers.h"
 #include "viewer_state.h"
 
@@ -21,27 +24,36 @@ struct Packed {
   std::vector<std::vector<uint8_t>> chunks;
 };
 
+Packed packGrid(const char* name, void (*addField)(TetMesh&), uint32_t leafVertices) {
+  test::ScratchDir dir(name);
+  TetMesh m = makeGridMesh(16);
+  addField(m);
+  PackOptions o;
+  o.leafVertices = leafVertices;
+  o.zstdLevel = 3;
+  PackSummary s;
+  EXPECT_TRUE(packMesh(m, dir.path, o, s));
+  Packed out;
+  out.manifest = test::loadFile(dir.path + "/manifest.json");
+  for (const ChunkInfo& c : s.manifest.chunks) out.chunks.push_back(test::loadBytes(dir.path + "/" + c.file));
+  return out;
+}
+
 // Harmonic 16³ in regions of at most 128 vertices.
 const Packed& packedNodes() {
-  static const Packed p = [] {
-    test::ScratchDir dir("fetch-plan");
-    TetMesh m = makeGridMesh(16);
-    addHarmonicField(m);
-    PackOptions o;
-    o.leafVertices = 128;
-    o.zstdLevel = 3;
-    PackSummary s;
-    EXPECT_TRUE(packMesh(m, dir.path, o, s));
-    Packed out;
-    out.manifest = test::loadFile(dir.path + "/manifest.json");
-    for (const ChunkInfo& c : s.manifest.chunks) out.chunks.push_back(test::loadBytes(dir.path + "/" + c.file));
-    return out;
-  }();
+  static const Packed p = packGrid("fetch-plan", addHarmonicField, 128);
   return p;
 }
 
-void offer(ViewerState& s, uint32_t index) {
-  const std::vector<uint8_t>& bytes = packedNodes().chunks[index];
+// The distance from the centre on 16³ in regions of at most 64 vertices: a small isovalue needs
+// the regions near the centre, a large one those near the corners.
+const Packed& packedShells() {
+  static const Packed p = packGrid("fetch-plan-shells", addDistanceField, 64);
+  return p;
+}
+
+void offer(ViewerState& s, uint32_t index, const Packed& p = packedNodes()) {
+  const std::vector<uint8_t>& bytes = p.chunks[index];
   auto* copy = static_cast<uint8_t*>(std::malloc(bytes.size()));
   std::copy(bytes.begin(), bytes.end(), copy);
   ASSERT_EQ(offerChunk(s, index, copy, bytes.size()), ChunkCheck::Ok) << "chunk " << index;
@@ -163,4 +175,103 @@ TEST(FetchPlan, MemoryAskedForIsWhatArrived) {
   EXPECT_LT(estimateBytes(m, planned), estimateLevelBytes(m, plan.back() + 1))
       << "the manifest's prefix up to the last planned chunk needs more: the test tells them apart";
   EXPECT_EQ(s.memory.received.tets, planned.tets);
+}
+
+namespace {
+
+// What the base and every chunk of `nodes` bring.
+LevelCounts countsOf(const Manifest& m, const std::vector<uint32_t>& nodes) {
+  LevelCounts c = chunkCounts(m, 0);
+  for (uint32_t k : nodes)
+    for (uint32_t i = m.nodes[k].firstChunk; i < m.nodes[k].firstChunk + m.nodes[k].chunkCount; ++i)
+      addCounts(c, chunkCounts(m, i));
+  return c;
+}
+
+// As the page drives the worker: fetch the first chunk the model asks for, refine, and again,
+// until there is nothing to fetch, apply or give back. The memory in use never passes the limit.
+void followPlan(ViewerState& s, const Packed& p) {
+  for (int step = 0; step < 100000; ++step) {
+    const std::vector<uint32_t> next = chunksToFetch(s);
+    if (!next.empty()) offer(s, next[0], p);
+    while (advance(s, g_ticks + 50, fakeNow)) {
+    }
+    ASSERT_NE(s.state, LoadState::Error) << s.error;
+    ASSERT_LE(s.memory.baseBytes + estimateBytes(s.dataset.manifest, s.memory.received), s.memory.limitBytes);
+    if (next.empty() && !refining(s) && s.evict.nodes.empty()) return;
+  }
+  FAIL() << "the plan never settled";
+}
+
+// The surface shown is the full mesh's isosurface: the same number of triangles and area.
+void expectFullResolutionSurface(const ViewerState& s, const TetMesh& full, const char* where) {
+  SCOPED_TRACE(where);
+  EXPECT_TRUE(exactSurface(s));
+  IsoExtractor x;
+  IsoSurface ref;
+  extractIsosurface(full, full.fields[0].values, s.isovalue, x, ref);
+  EXPECT_EQ(s.surface.triangleCount(), ref.triangleCount());
+  EXPECT_NEAR(s.surface.area(), surfaceArea(ref), 1e-6 * std::max(1.0, surfaceArea(ref)));
+  EXPECT_TRUE(s.surface.validate());
+}
+
+}  // namespace
+
+// Two isovalues whose regions fit in memory one at a time but not together: moving from one to
+// the other gives back regions the new one does not need (undone, latest first) and fetches the
+// ones it does; each surface is exact, and the memory in use stays under the limit throughout.
+// Where even the regions a view needs do not fit, what fits is shown: not an error.
+TEST(FetchPlan, RegionsTheViewNoLongerNeedsAreGivenBackWhenMemoryIsShort) {
+  const Packed& p = packedShells();
+  Manifest m;
+  ASSERT_TRUE(parseManifest(p.manifest, m).ok());
+  const Range r = m.fields[0].range;
+  const float a = r.min + 0.2f * (r.max - r.min), b = r.min + 0.85f * (r.max - r.min);
+  const std::vector<uint32_t> needA = withAncestors(m, nodesForIsovalue(m, 0, a));
+  const std::vector<uint32_t> needB = withAncestors(m, nodesForIsovalue(m, 0, b));
+  std::vector<uint32_t> both;
+  std::set_union(needA.begin(), needA.end(), needB.begin(), needB.end(), std::back_inserter(both));
+  ViewerState s;
+  s.memory.baseBytes = 1 << 20;
+  const uint64_t one = std::max(estimateBytes(m, countsOf(m, needA)), estimateBytes(m, countsOf(m, needB)));
+  s.memory.limitBytes = s.memory.baseBytes + one + one / 50;
+  ASSERT_GT(s.memory.baseBytes + estimateBytes(m, countsOf(m, both)), s.memory.limitBytes)
+      << "the two views must not fit together";
+  Dataset whole;
+  ASSERT_TRUE(openDataset(whole, p.manifest));
+  for (uint32_t c = 0; c < p.chunks.size(); ++c) ASSERT_TRUE(applyChunk(whole, c, p.chunks[c]));
+
+  ASSERT_TRUE(openManifest(s, p.manifest).ok());
+  setIsovalue(s, a);
+  followPlan(s, p);
+  EXPECT_EQ(s.state, LoadState::Complete);
+  expectFullResolutionSurface(s, whole.pm.mesh, "the first isovalue");
+  EXPECT_EQ(s.evict.nodesForgotten, 0u);
+
+  setIsovalue(s, b);
+  EXPECT_FALSE(s.evict.nodes.empty()) << "regions to give back are chosen at once";
+  followPlan(s, p);
+  EXPECT_EQ(s.state, LoadState::Complete);
+  EXPECT_FALSE(s.evict.memoryFull);
+  expectFullResolutionSurface(s, whole.pm.mesh, "the second isovalue");
+  EXPECT_GT(s.evict.nodesForgotten, 0u);
+  EXPECT_FALSE(s.evict.forgottenChunks.empty()) << "the page hears which chunks to fetch again";
+  for (uint32_t k = 0; k < m.nodes.size(); ++k)
+    if (s.dataset.nodeChunksReceived[k] == 0 && std::binary_search(needA.begin(), needA.end(), k) &&
+        !std::binary_search(needB.begin(), needB.end(), k)) {
+      EXPECT_FALSE(s.fetch.needed[k]);
+    }
+
+  setIsovalue(s, a);  // and back: what was given back comes again
+  followPlan(s, p);
+  expectFullResolutionSurface(s, whole.pm.mesh, "back at the first isovalue");
+
+  // Every region does not fit: as much as fits, the surface still exact for its isovalue.
+  setFetchMode(s, FetchMode::Everything);
+  followPlan(s, p);
+  EXPECT_EQ(s.state, LoadState::Complete);
+  EXPECT_TRUE(s.evict.memoryFull);
+  EXPECT_FALSE(downloading(s));
+  EXPECT_LT(s.dataset.chunksReceived, m.chunks.size());
+  expectFullResolutionSurface(s, whole.pm.mesh, "everything asked for");
 }
