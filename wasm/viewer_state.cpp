@@ -535,7 +535,8 @@ bool growTree(ViewerState& s, double deadlineMs, Clock now) {
 
 bool refining(const ViewerState& s) {
   const Dataset& ds = s.dataset;
-  return ds.chunksReceived > 0 && levelCap(s) != ds.splitsApplied();
+  // (Regions to give back whose splits are not applied wait for advance() too.)
+  return ds.chunksReceived > 0 && (levelCap(s) != ds.splitsApplied() || !s.evict.nodes.empty());
 }
 
 double levelFraction(const ViewerState& s) {

@@ -188,14 +188,15 @@ LevelCounts countsOf(const Manifest& m, const std::vector<uint32_t>& nodes) {
   return c;
 }
 
-// As the page drives the worker: fetch the first chunk the model asks for, refine, and again,
-// until there is nothing to fetch, apply or give back. The memory in use never passes the limit.
+// As the page and the worker go: a few chunks of the plan arrive, one slice of refinement (when
+// the worker has any: tw_work), and again, until there is nothing to fetch, apply or give back.
+// Chunks arrive while splits wait, and while regions are being given back. The memory in use
+// never passes the limit.
 void followPlan(ViewerState& s, const Packed& p) {
   for (int step = 0; step < 100000; ++step) {
     const std::vector<uint32_t> next = chunksToFetch(s);
-    if (!next.empty()) offer(s, next[0], p);
-    while (advance(s, g_ticks + 50, fakeNow)) {
-    }
+    for (size_t k = 0; k < std::min<size_t>(3, next.size()); ++k) offer(s, next[k], p);
+    if (refining(s)) advance(s, g_ticks + 3, fakeNow);
     ASSERT_NE(s.state, LoadState::Error) << s.error;
     ASSERT_LE(s.memory.baseBytes + estimateBytes(s.dataset.manifest, s.memory.received), s.memory.limitBytes);
     if (next.empty() && !refining(s) && s.evict.nodes.empty()) return;

@@ -402,6 +402,23 @@ TEST(Partial, ADatasetReceivesNodesInAnyParentFirstOrder) {
     }
 }
 
+namespace {
+
+// A dataset's mesh in stable vertex ids: each place's vertices from where the manifest puts its chunk.
+StableMesh stableMesh(const Dataset& ds) {
+  std::vector<uint32_t> stableOf(ds.pm.vertexCount());
+  for (uint32_t v = 0; v < ds.pm.baseVertices; ++v) stableOf[v] = v;
+  for (uint32_t place = 1; place < ds.received.size(); ++place) {
+    const uint32_t before = ds.manifest.chunks[ds.received[place] - 1].vertices;
+    for (uint32_t s = ds.chunkFirstSplit[place]; s < ds.chunkFirstSplit[place + 1]; ++s)
+      if (ds.pm.baseVertices + s < stableOf.size())
+        stableOf[ds.pm.baseVertices + s] = before + (s - ds.chunkFirstSplit[place]);
+  }
+  return stableMesh(ds.pm.mesh, stableOf);
+}
+
+}  // namespace
+
 // Chunks of several nodes may arrive interleaved (the loader fetches in parallel): a node of
 // several chunks whose next chunk comes after another node's. Every vertex still gets the place
 // its stable id names, and the level is the same mesh as the nodes loaded one after the other.
@@ -450,34 +467,8 @@ TEST(Partial, ChunksOfSeveralNodesMayInterleave) {
   expectValidLevel(ds.pm.mesh, "interleaved chunks");
   Dataset whole;
   ASSERT_TRUE(loadPackedDir(dir, whole));
-  std::vector<uint32_t> stableOf(ds.pm.vertexCount());
-  for (uint32_t v = 0; v < ds.pm.baseVertices; ++v) stableOf[v] = v;
-  for (uint32_t place = 1; place < ds.received.size(); ++place) {
-    const uint32_t before = m.chunks[ds.received[place] - 1].vertices;
-    for (uint32_t s = ds.chunkFirstSplit[place]; s < ds.chunkFirstSplit[place + 1]; ++s)
-      stableOf[ds.pm.baseVertices + s] = before + (s - ds.chunkFirstSplit[place]);
-  }
-  std::vector<uint32_t> identity(whole.pm.vertexCount());
-  for (uint32_t v = 0; v < identity.size(); ++v) identity[v] = v;
-  EXPECT_TRUE(stableMesh(ds.pm.mesh, stableOf) == stableMesh(whole.pm.mesh, identity));
+  EXPECT_TRUE(stableMesh(ds) == stableMesh(whole)) << "(the whole stream in manifest order: stable ids are its own)";
 }
-
-namespace {
-
-// A dataset's mesh in stable vertex ids: each place's vertices from where the manifest puts its chunk.
-StableMesh stableMesh(const Dataset& ds) {
-  std::vector<uint32_t> stableOf(ds.pm.vertexCount());
-  for (uint32_t v = 0; v < ds.pm.baseVertices; ++v) stableOf[v] = v;
-  for (uint32_t place = 1; place < ds.received.size(); ++place) {
-    const uint32_t before = ds.manifest.chunks[ds.received[place] - 1].vertices;
-    for (uint32_t s = ds.chunkFirstSplit[place]; s < ds.chunkFirstSplit[place + 1]; ++s)
-      if (ds.pm.baseVertices + s < stableOf.size())
-        stableOf[ds.pm.baseVertices + s] = before + (s - ds.chunkFirstSplit[place]);
-  }
-  return stableMesh(ds.pm.mesh, stableOf);
-}
-
-}  // namespace
 
 // The viewer gives back regions it no longer needs (memory): a node without received children,
 // its splits undone first, leaves the dataset as if it had never come. What stays is the same
