@@ -21,14 +21,13 @@ LevelCounts receivedCounts(const Dataset& ds, uint32_t k) {
   return c;
 }
 
-// What the chunks in hand bring once the nodes being given back are gone.
+}  // namespace
+
 LevelCounts keptCounts(const ViewerState& s) {
   LevelCounts c = s.memory.received;
   for (uint32_t k : s.evict.nodes) subtractCounts(c, receivedCounts(s.dataset, k));
   return c;
 }
-
-}  // namespace
 
 bool budgetedByRegions(const ViewerState& s) { return !s.dataset.manifest.nodes.empty() && s.memory.limitBytes > 0; }
 

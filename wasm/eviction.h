@@ -11,6 +11,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "viewer_memory.h"
+
 namespace tetstream::viewer {
 
 struct ViewerState;
@@ -28,6 +30,10 @@ bool budgetedByRegions(const ViewerState& s);
 
 // The level advance() moves toward: the target, at most what was received and the eviction's cap.
 uint32_t levelCap(const ViewerState& s);
+
+// What the chunks in hand bring once the nodes being given back are gone: what the memory limit
+// bounds (the nodes' splits are being undone, and the level cannot grow past them meanwhile).
+LevelCounts keptCounts(const ViewerState& s);
 
 // The chunks to fetch next, most important first: the plan (fetch_plan.h) as far as it fits in
 // memory once the nodes being given back are gone; without regions, the chunks still allowed.

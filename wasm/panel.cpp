@@ -100,6 +100,8 @@ void downloadSection(PageState& s, float width, float pixelsPerCssPixel) {
     ImGui::Text("all %u parts received", chunksTotal);
   else if (allReceived)
     ImGui::Text("all %u parts this view needs received", r.chunksReceived);
+  else if (r.memoryFull)
+    ImGui::Text("%u parts received; %u more of this view do not fit", r.chunksReceived, r.chunksMissing);
   else
     ImGui::Text("%u of %u parts received", r.chunksReceived,
                 selective ? r.chunksReceived + r.chunksMissing : chunksTotal);
@@ -111,7 +113,7 @@ void downloadSection(PageState& s, float width, float pixelsPerCssPixel) {
 
   s.telemetry.screen.pauseButton = {};
   if (!net.notice.empty() && state != LoadState::Error) coloredWrapped(kWarning, net.notice);
-  if (allReceived || state == LoadState::Error) return;
+  if (allReceived || r.memoryFull || state == LoadState::Error) return;  // (nothing is coming)
   // One line that is always there, so the button below does not move under the mouse.
   if (net.paused) {
     ImGui::TextUnformatted("download paused");
@@ -354,7 +356,8 @@ PanelActions drawPanel(PageState& s, float uiScale, float pixelsPerCssPixel) {
   ImGui::TextUnformatted(!haveDataset ? "no dataset" : m.name.empty() ? "(unnamed dataset)" : m.name.c_str());
   if (state == LoadState::Idle) ImGui::TextDisabled("waiting for a dataset");
   if (state == LoadState::Complete)
-    ImGui::TextDisabled(s.settings.fetch == FetchMode::Needed && !m.nodes.empty()
+    ImGui::TextDisabled(r.memoryFull ? "complete: every part that fits in memory received and applied"
+                        : s.settings.fetch == FetchMode::Needed && !m.nodes.empty()
                             ? "complete: every part this view needs received and applied"
                             : "complete: every part received and applied");
   if (state == LoadState::Error)

@@ -282,8 +282,12 @@ Result addChunk(ViewerState& s, uint32_t index, std::span<const uint8_t> bytes, 
   addCounts(after, chunkCounts(ds.manifest, index));
   const uint64_t need = s.memory.baseBytes + estimateBytes(ds.manifest, after);
   // A region that came after the view moved on and no longer fits is given back, not an error
-  // (the plan asks only for what fits: eviction.h); the page may fetch it again later.
-  if (budgetedByRegions(s) && index > 0 && need > s.memory.limitBytes) {
+  // (the plan asks only for what fits once the regions being given back are gone: eviction.h);
+  // the page may fetch it again later.
+  LevelCounts kept = keptCounts(s);
+  addCounts(kept, chunkCounts(ds.manifest, index));
+  if (budgetedByRegions(s) && index > 0 &&
+      s.memory.baseBytes + estimateBytes(ds.manifest, kept) > s.memory.limitBytes) {
     s.evict.forgottenChunks.push_back(index);
     ++s.fetch.version;
     return fail(Status::TooLarge, partName(s, index) + " does not fit in memory now");

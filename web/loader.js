@@ -237,16 +237,25 @@ export class ChunkLoader {
   }
 
   // The viewer gave these chunks back (short of memory, it forgot regions the view no longer
-  // needs): they leave what was handed over, so that a later plan may fetch them again.
+  // needs, or could not keep one that came late): those handed over leave what was handed over,
+  // so that a later plan may fetch them again; those checked and waiting for their turn are
+  // dropped, to be fetched again in their turn.
   forget(indices) {
     const gone = new Set(indices.filter((i) => this.position.has(i) && this.position.get(i) < this.nextPos));
-    if (!gone.size) return;
+    let waiting = 0;
+    for (const i of indices) {
+      if (gone.has(i) || !this.arrived.delete(i)) continue;
+      this.unchecked.delete(i);
+      waiting++;
+    }
+    if (!gone.size && !waiting) return;
     const handed = this.plan.slice(0, this.nextPos).filter((i) => !gone.has(i));
     for (const i of gone) this.deliveredBytes -= this.sizes[i];
     this.plan = [...handed, ...this.plan.slice(this.nextPos)];
     this.nextPos = handed.length;
     this.position = new Map(this.plan.map((i, p) => [i, p]));
-    this.note({ event: 'forget', count: gone.size });
+    this.note({ event: 'forget', count: gone.size + waiting });
+    this.pump();
   }
 
   // The program's bytes are in: the link is free for more than the base.

@@ -475,3 +475,26 @@ test('chunks the viewer gave back leave what was handed over, and a later plan f
   assert.deepEqual(run.delivered, [0, 1, 2, 1, 3]);
   run.loader.stop();
 });
+
+test('a chunk the viewer gave back before its turn is fetched again in its turn', async () => {
+  const run = makeLoader({ order: [0, 1, 2], onIdle: () => {} });
+  run.loader.pump();
+  await settle();
+  const [r0, r1, r2] = run.net.open();
+  for (const r of [r1, r2]) {
+    run.net.send(r, run.size);
+    run.net.finish(r);
+  }
+  await settle();
+  assert.deepEqual(run.delivered, [], 'chunks 1 and 2 wait for 0');
+  run.loader.forget([2]); // checked, then given back by the viewer
+  assert.equal(run.loader.log.filter((e) => e.event === 'forget')[0].count, 1);
+  run.net.send(r0, run.size);
+  run.net.finish(r0);
+  await settle();
+  assert.deepEqual(run.delivered, [0, 1]);
+  assert.deepEqual(run.net.open().map((r) => r.index), [2], 'fetched again');
+  await answerAll(run.net, run.size);
+  assert.deepEqual(run.delivered, [0, 1, 2]);
+  run.loader.stop();
+});
