@@ -14,6 +14,7 @@ APT_PACKAGES=(
   libpugixml-dev libcli11-dev nlohmann-json3-dev libgtest-dev libstb-dev
   chromium                         # headless browser tests
   nginx wrk                        # tests against real nginx (server/nginx.conf); server load test
+  openssl                          # certificates for the HTTPS and HTTP/2 tests and bench
   libhdf5-dev libnetcdf-dev libexodusii-dev libcgns-dev   # Exodus II, CGNS, XDMF and VTKHDF readers
   python3-vtk9 python3-meshio python3-netcdf4 python3-h5py cgns-convert  # independent writers for their tests
   openmpi-bin libopenmpi-dev       # packing on several processes (mpirun tetstream pack)

@@ -2,6 +2,7 @@
 // (which does MIME types, ETag/Last-Modified, conditional requests, Range and HEAD) and
 // finalhandler (error pages). Node's http module parses HTTP.
 import http from 'node:http';
+import http2 from 'node:http2';
 import fs from 'node:fs';
 import path from 'node:path';
 import serveStatic from 'serve-static';
@@ -36,22 +37,38 @@ const LOG_LIMIT = 10000; // requestLog keeps the newest entries only: bounded me
 // prints). A plugin may wrap `res` (to change how the body goes out) or answer the request
 // itself and return true (or a Promise of true): then nothing else serves it. This is the one
 // seam for behaviour that is not static file serving, so the server itself stays just that.
+// tls: { key, cert } (PEM): HTTPS, with HTTP/2 for clients that speak it and HTTP/1.1 for the
+// rest. Over HTTP/2 a browser asks for many chunks at once on one connection instead of six at a
+// time, which is what a view of many small regions needs on a slow link.
 export function createServer({
   mounts,
   plugins = [],
   maxConnections = 512,
+  tls = null,
   log = null, // a function called with each finished entry of requestLog (the CLI's --log)
 } = {}) {
   if (!Array.isArray(mounts) || !mounts.length) throw new Error('createServer: give at least one mount {prefix, dir}');
   const table = mounts.map(({ prefix, dir }) => makeMount(prefix, dir));
   table.sort((a, b) => b.prefix.length - a.prefix.length); // longest prefix first: /data/ wins over /
 
-  const server = http.createServer((req, res) => {
+  const respond = (req, res) => {
     handle(server, table, plugins, req, res).catch((e) => {
       if (!res.headersSent) plain(res, 500, 'internal error');
       else res.destroy(e);
     });
-  });
+  };
+  const server = tls
+    ? http2.createSecureServer({ key: tls.key, cert: tls.cert, allowHTTP1: true }, respond)
+    : http.createServer(respond);
+  if (tls) {
+    // As an HTTP/1.1 server has: closing every socket at once (stopping the command line).
+    const sockets = new Set();
+    server.on('secureConnection', (socket) => {
+      sockets.add(socket);
+      socket.on('close', () => sockets.delete(socket));
+    });
+    server.closeAllConnections = () => { for (const socket of sockets) socket.destroy(); };
+  }
   server.requestLog = [];
   server.logger = log;
   // Bounded resource use: slow or idle clients cannot hold sockets for long, and the number of

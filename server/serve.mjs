@@ -28,6 +28,9 @@ dataset.
   --viewer DIR          the viewer folder used with a dataset DIR (default build/web)
   --no-viewer           serve a dataset DIR alone, at /
   --max-connections N   sockets open at once (default 512; more are closed at once)
+  --tls-cert FILE       serve HTTPS with this certificate (PEM; with --tls-key): HTTP/2 for
+  --tls-key FILE        browsers that speak it (many chunks at once on one connection), HTTP/1.1
+                        for the rest
   --log                 print one line per request
   -h, --help            this text
 
@@ -63,11 +66,15 @@ export function parseArgs(argv) {
       const v = value(++i, a);
       if (!/^[1-9]\d*$/.test(v)) throw new UsageError(`--max-connections: cannot read "${v}"; write a positive number`);
       opts.maxConnections = Number(v);
-    } else if (a === '--log') opts.log = true;
+    } else if (a === '--tls-cert') opts.tlsCert = value(++i, a);
+    else if (a === '--tls-key') opts.tlsKey = value(++i, a);
+    else if (a === '--log') opts.log = true;
     else if (a === '-h' || a === '--help') opts.help = true;
     else if (a.startsWith('-')) throw new UsageError(`unknown option ${a} (see --help)`);
     else positional.push(a);
   }
+  if (!opts.tlsCert !== !opts.tlsKey) throw new UsageError('--tls-cert and --tls-key go together');
+  if (opts.tlsCert) opts.tls = { cert: readPem(opts.tlsCert, '--tls-cert'), key: readPem(opts.tlsKey, '--tls-key') };
   if (positional.length > 1) throw new UsageError(`one DIR at most (got ${positional.join(' ')}); use --mount /PREFIX=DIR for more`);
   for (const m of opts.mounts) checkFolder(m.dir, '--mount');
 
@@ -85,6 +92,13 @@ export function parseArgs(argv) {
     } else opts.mounts.push({ prefix: '/', dir });
   }
   return opts;
+}
+
+function readPem(file, what) {
+  let text;
+  try { text = fs.readFileSync(file, 'utf8'); } catch { throw new UsageError(`${what}: cannot read ${file}`); }
+  if (!text.includes('-----BEGIN ')) throw new UsageError(`${what}: ${file} is not a PEM file`);
+  return text;
 }
 
 function checkFolder(dir, what) {
@@ -139,11 +153,17 @@ export function main(argv = process.argv.slice(2), { plugins = [], notes = [] } 
     console.log(HELP);
     return;
   }
-  const server = createServer({
-    ...opts,
-    plugins,
-    log: opts.log ? (e) => console.log(`${new Date(e.time).toISOString()} ${e.method} ${e.url} ${e.status}${e.note ? ` (${e.note})` : ''}${e.aborted ? ' aborted' : ''} ${e.ms} ms`) : null,
-  });
+  let server;
+  try {
+    server = createServer({
+      ...opts,
+      plugins,
+      log: opts.log ? (e) => console.log(`${new Date(e.time).toISOString()} ${e.method} ${e.url} ${e.status}${e.note ? ` (${e.note})` : ''}${e.aborted ? ' aborted' : ''} ${e.ms} ms`) : null,
+    });
+  } catch (e) { // a key that does not match its certificate, and the like
+    console.error(`serve: ${e.message}`);
+    process.exit(1);
+  }
   server.on('error', (e) => {
     console.error(`serve: ${e.code === 'EADDRINUSE' ? `port ${opts.port} on ${opts.host} is in use; try --port 0` : e.message}`);
     process.exit(1);
@@ -151,7 +171,7 @@ export function main(argv = process.argv.slice(2), { plugins = [], notes = [] } 
   server.listen(opts.port, opts.host, () => {
     const { port } = server.address();
     const shown = ['0.0.0.0', '::'].includes(opts.host) ? 'localhost' : opts.host.includes(':') ? `[${opts.host}]` : opts.host;
-    const base = `http://${shown}:${port}/`;
+    const base = `${opts.tls ? 'https' : 'http'}://${shown}:${port}/`;
     console.log(`serving on ${base}`);
     for (const m of [...opts.mounts].sort((a, b) => a.prefix.length - b.prefix.length)) {
       console.log(`  ${m.prefix.padEnd(8)} -> ${path.resolve(m.dir)}`);

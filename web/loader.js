@@ -91,7 +91,8 @@ export class ChunkLoader {
     this.attached = !!check;
     this.warmed = this.attached;   // before: the program is still downloading, only the base
     this.programNearlyIn = false;  // its last bytes are coming: the first split chunk too
-    this.unchecked = new Set();    // arrived before attach()
+    this.unchecked = new Set();    // arrived before attach(), or past a provisional limit: parked unchecked
+    this.provisional = false;      // the limit holds until the first plan (attach())
     this.checking = new Set();     // offered to the check, its answer not in yet
     this.total = urls.length;
     this.plan = [];                // chunk indices in the order they are handed over
@@ -168,24 +169,37 @@ export class ChunkLoader {
   // The viewer is ready. check(i, bytes): null when the bytes are chunk i, else what is wrong in
   // words. deliver(i, bytes): hands chunk i over; false = the viewer stopped (it says why
   // itself). allowed: plan places to fetch (fewer than the plan's when memory is short).
-  attach({ check, deliver, allowed = this.urls.length }) {
-    Object.assign(this, { check, deliver, attached: true, warmed: true });
-    this.limitTo(allowed);
-    for (const i of this.inPlanOrder(this.unchecked)) {
-      this.unchecked.delete(i);
+  // provisional: the limit holds until a plan comes (replan), so what is under way or in is
+  // kept for it to judge instead of thrown away.
+  attach({ check, deliver, allowed = this.urls.length, provisional = false }) {
+    Object.assign(this, { check, deliver, attached: true, warmed: true, provisional });
+    if (provisional) this.allowed = allowed;
+    else this.limitTo(allowed);
+    this.acceptParked();
+    this.deliverReady();
+    this.pump();
+  }
+
+  // Chunks that arrived before they could be checked (before attach(), or past a provisional
+  // limit) go to the check in plan order, once their place allows.
+  acceptParked() {
+    if (!this.attached) return;
+    for (const i of this.inPlanOrder([...this.unchecked].filter((j) => this.position.has(j)))) {
       if (this.stopped) return;
+      if (this.provisional && this.position.get(i) >= this.allowed) continue;
+      this.unchecked.delete(i);
       if (this.failure && this.position.get(i) > this.position.get(this.failure.index)) this.arrived.delete(i);
       else if (this.arrived.has(i)) this.accept(i, this.arrived.get(i));
     }
-    this.deliverReady();
-    this.pump();
   }
 
   // Plan places to fetch from now on (more, or fewer: the requests and chunks past them are
   // dropped).
   setAllowed(allowed) {
     if (this.stopped) return;
+    this.provisional = false;
     this.limitTo(allowed);
+    this.acceptParked();
     if (this.nextPos < Math.min(this.allowed, this.plan.length)) this.idle = false;
     this.deliverReady();
     this.pump();
@@ -232,6 +246,8 @@ export class ChunkLoader {
     for (const j of [...this.unavailable.keys()]) if (left(j)) this.unavailable.delete(j);
     for (const set of [this.dropped, this.wokenOnline]) for (const j of [...set]) if (left(j)) set.delete(j);
     if (this.nextPos < Math.min(this.allowed, this.plan.length)) this.idle = false;
+    this.provisional = false; // (the plan has spoken for what was fetched before it)
+    this.acceptParked();
     this.deliverReady();
     this.pump();
   }
@@ -359,7 +375,7 @@ export class ChunkLoader {
       this.inFlight.delete(i);
       this.note({ event: 'response', index: i, bytes: bytes.length });
       this.measure(i, entry, bytes.length);
-      if (this.attached) {
+      if (this.attached && !(this.provisional && this.position.get(i) >= this.allowed)) {
         this.accept(i, bytes);
       } else {
         this.arrived.set(i, bytes);

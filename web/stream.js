@@ -309,6 +309,7 @@ async function stream(manifestUrl) {
   if (surelyWanted < names.length) page.loader.onIdle = () => {}; // the answer brings the rest
   page.loader.attach({
     allowed: surelyWanted,
+    provisional: selective, // the first plan says which of the chunks fetched so far are wanted
     // The one hand-over: transferred to the worker, checked (size, hash) there once, kept by
     // its model and added in order. The answer comes as a message.
     async check(i, bytes) {

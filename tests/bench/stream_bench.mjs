@@ -4,7 +4,9 @@
 // Chromium (SwiftShader: software WebGL, so frame times are those of a machine without a GPU).
 //
 //   node tests/bench/stream_bench.mjs [--rate 10mbit] [--latency 50] [--n 64] [--runs 1] [--timeline] [--sequence]
-//                                     [--mesh FILE ...]
+//                                     [--h2] [--mesh FILE ...]
+// --h2: HTTPS with HTTP/2 (a certificate made with openssl for the run), as static hosts and CDNs
+// serve today; without it, HTTP/1.1 (six connections).
 //
 // For Harmonic N³ and the real post.vtk (postVtk below, when present) it reports:
 //   first surface   ms from navigation start to the first frame drawn with an isosurface,
@@ -25,6 +27,7 @@
 // the window size (default 1280 x 800).
 import fs from 'node:fs';
 import path from 'node:path';
+import { spawnSync } from 'node:child_process';
 import { createServer } from '../support/server.mjs';
 import { parseRate, parseMs } from '../support/link.mjs';
 import { precompressDir } from '../../server/precompress.mjs';
@@ -42,6 +45,18 @@ const runs = Number(opt('runs', '1'));
 const outDir = path.join(root, 'build/bench/stream');
 // The real meshes live in the folder named by TETSTREAM_DATASETS (skipped when absent).
 const postVtk = path.join(process.env.TETSTREAM_DATASETS || path.join(root, 'datasets'), 'post.vtk');
+
+// A certificate for 127.0.0.1 made once into `dir` (openssl), for --h2.
+function selfSignedCertificate(dir) {
+  const key = path.join(dir, 'key.pem'), cert = path.join(dir, 'cert.pem');
+  if (!fs.existsSync(cert)) {
+    fs.mkdirSync(dir, { recursive: true });
+    const r = spawnSync('openssl', ['req', '-x509', '-newkey', 'ec', '-pkeyopt', 'ec_paramgen_curve:prime256v1', '-nodes',
+      '-keyout', key, '-out', cert, '-days', '30', '-subj', '/CN=127.0.0.1', '-addext', 'subjectAltName=IP:127.0.0.1,DNS:localhost'], { encoding: 'utf8' });
+    if (r.status !== 0) throw new Error(`openssl could not make a certificate: ${r.stderr || r.error}`);
+  }
+  return { key: fs.readFileSync(key, 'utf8'), cert: fs.readFileSync(cert, 'utf8') };
+}
 
 // Packs once into build/bench/stream/NAME (kept between runs: packing Harmonic 64 takes ~10 s).
 function packed(name, makeInput, packArgs = []) {
@@ -106,6 +121,7 @@ async function measure(browser, url) {
       wasmEnd: wasm ? wasm.responseEnd : 0, manifestEnd: manifest ? manifest.responseEnd : 0,
       baseStart: base ? base.requestStart : 0, baseEnd: base ? base.responseEnd : 0,
       firstSurfaceMs: s.firstSurfaceMs, lastByteMs: lastByte, completeMs: s.completeMs,
+      protocol: base ? base.nextHopProtocol : '',
       timeline,
       samples: window.__samples,
       frameTimes: window.__frames.map(([t, d]) => [Math.round(t), Math.round(d * 10) / 10]),
@@ -132,7 +148,7 @@ function report(r) {
   const f = (x) => x.toFixed(0);
   return [
     `${r.name}: ${r.chunks} chunks, ${r.splits} splits, ${r.tets} tets, ${(r.bytes / 1048576).toFixed(2)} MB on the wire ` +
-      `(wasm ${(r.wasmBytes / 1024).toFixed(0)} KB); bytes ÷ bandwidth ${f(r.idealMs)} ms`,
+      `(wasm ${(r.wasmBytes / 1024).toFixed(0)} KB, ${r.protocol || 'protocol unknown'}); bytes ÷ bandwidth ${f(r.idealMs)} ms`,
     `  first surface ${f(r.firstSurfaceMs)} ms (wasm in at ${f(r.wasmEnd)}, manifest ${f(r.manifestEnd)}, ` +
       `base chunk ${f(r.baseStart)}-${f(r.baseEnd)} ms)`,
     `  all bytes in ${f(r.lastByteMs)} ms (${(r.lastByteMs / r.idealMs).toFixed(2)}× bytes ÷ bandwidth), ` +
@@ -175,21 +191,24 @@ async function main() {
     datasets.push([name, packed(name.replace(/[^0-9a-z]+/gi, '-').toLowerCase(), () => file, ['--name', name])]);
   });
 
+  const h2 = args.includes('--h2');
   const server = createServer({
     mounts: [{ prefix: '/data', dir: outDir }, { prefix: '/', dir: webDir }],
     throttleBytesPerSec: rate,
     latencyMs,
+    tls: h2 ? selfSignedCertificate(path.join(root, 'build/bench/tls')) : null,
   });
   await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
-  const base = `http://127.0.0.1:${server.address().port}`;
-  const browser = await launchBrowser();
+  const base = `${h2 ? 'https' : 'http'}://127.0.0.1:${server.address().port}`;
+  const browser = await launchBrowser(h2 ? ['--ignore-certificate-errors'] : []);
   // A user's browser is running already: one page with a WebGL context first, so that the
   // figures do not include starting Chromium's GPU process.
   const warm = await browser.newPage();
   await warm.goto(`${base}/index.html`);
   await warm.evaluate(() => !!document.createElement('canvas').getContext('webgl2'));
   await warm.close();
-  console.log(`link: ${(rate * 8 / 1e6).toFixed(1)} Mbit/s, ${latencyMs} ms latency per response; Chromium with SwiftShader`);
+  console.log(`link: ${(rate * 8 / 1e6).toFixed(1)} Mbit/s, ${latencyMs} ms latency per response, ` +
+    `${h2 ? 'HTTPS with HTTP/2' : 'HTTP/1.1'}; Chromium with SwiftShader`);
   const results = [];
   try {
     for (const [name, dir] of datasets) {

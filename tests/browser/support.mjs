@@ -44,8 +44,8 @@ export function checkBuilds() {
   fs.mkdirSync(outDir, { recursive: true });
 }
 
-export function launchBrowser() {
-  return chromium.launch({ executablePath: chromiumPath, args: chromiumArgs });
+export function launchBrowser(extraArgs = []) {
+  return chromium.launch({ executablePath: chromiumPath, args: [...chromiumArgs, ...extraArgs] });
 }
 
 export function cli(...args) {

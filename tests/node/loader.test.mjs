@@ -424,6 +424,28 @@ test('chunks that arrived before attach() are checked and handed over in plan or
   assert.ok(run.result.done);
 });
 
+test('a provisional limit keeps what was fetched before the first plan, for the plan to judge', async () => {
+  const checked = [];
+  const run = makeLoader({ chunks: 5, check: null, deliver: null, onIdle: () => {} });
+  run.loader.warm();
+  await answerAll(run.net, run.size); // the manifest's order, as far as the loader looks ahead
+  const early = requests(run.loader).map((e) => e.index);
+  assert.ok(early.length > 2, `fetched ahead: ${early}`);
+  run.loader.attach({
+    check: (i) => { checked.push(i); return null; },
+    deliver: (i) => run.delivered.push(i) > 0,
+    allowed: 1,
+    provisional: true,
+  });
+  assert.deepEqual(checked, [0], 'only the base is checked before the plan');
+  run.loader.replan([2, 1]); // the plan wants 2 and 1 (not 3 or 4)
+  assert.deepEqual(checked, [0, 2, 1]);
+  assert.deepEqual(run.delivered, [0, 2, 1]);
+  assert.deepEqual(requests(run.loader).map((e) => e.index), early, 'nothing fetched twice');
+  assert.ok(run.loader.log.some((e) => e.event === 'discard' && e.index === 3), 'what the plan left is discarded');
+  run.loader.stop();
+});
+
 test('without onChunkFailed a 404 stops the stream after the chunks before it in the plan', async () => {
   const run = makeLoader({ chunks: 5, order: [0, 3, 1, 4, 2] });
   run.loader.pump();

@@ -6,6 +6,8 @@ import { test, describe, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import crypto from 'node:crypto';
 import fs from 'node:fs';
+import http2 from 'node:http2';
+import https from 'node:https';
 import path from 'node:path';
 import zlib from 'node:zlib';
 import { spawn, spawnSync } from 'node:child_process';
@@ -267,6 +269,87 @@ describe('our server (server/serve.mjs)', () => {
     const [a, b] = server.requestLog.slice(before);
     assert.deepEqual([a.method, a.url, a.status, b.url, b.status], ['GET', '/data/ds/manifest.json', 200, '/nothing-here', 404]);
     assert.ok(a.time > 0 && Number.isFinite(a.time));
+  });
+});
+
+// A certificate for 127.0.0.1 made for the test (openssl, from the project's setup).
+function testCertificate() {
+  const dir = tempDir('tls');
+  fixtures.push(dir);
+  const key = path.join(dir, 'key.pem'), cert = path.join(dir, 'cert.pem');
+  const r = spawnSync('openssl', ['req', '-x509', '-newkey', 'ec', '-pkeyopt', 'ec_paramgen_curve:prime256v1', '-nodes',
+    '-keyout', key, '-out', cert, '-days', '1', '-subj', '/CN=127.0.0.1', '-addext', 'subjectAltName=IP:127.0.0.1,DNS:localhost'], { encoding: 'utf8' });
+  assert.equal(r.status, 0, r.stderr);
+  return { key, cert };
+}
+
+// One GET over HTTP/2 (TLS, the test's certificate trusted): status, headers, body.
+function http2Get(base, target, ca) {
+  return new Promise((resolve, reject) => {
+    const session = http2.connect(base, { ca });
+    session.on('error', reject);
+    const req = session.request({ ':path': target });
+    const parts = [];
+    let headers;
+    req.on('response', (h) => { headers = h; });
+    req.on('data', (d) => parts.push(d));
+    req.on('end', () => {
+      session.close();
+      resolve({ status: headers[':status'], headers, body: Buffer.concat(parts) });
+    });
+    req.on('error', reject);
+    req.end();
+  });
+}
+
+describe('our server over HTTPS (--tls-cert, --tls-key)', () => {
+  test('HTTP/2 for clients that speak it, HTTP/1.1 for the rest, with the same files and headers', async () => {
+    const fx = makeFixture();
+    const files = testCertificate();
+    const tls = { key: fs.readFileSync(files.key, 'utf8'), cert: fs.readFileSync(files.cert, 'utf8') };
+    const server = await listen({ mounts: [{ prefix: '/', dir: fx.www }, { prefix: '/data', dir: fx.data }], tls });
+    try {
+      const base = `https://127.0.0.1:${server.address().port}`;
+      const chunk = await http2Get(base, `/data/ds/chunks/${CHUNK}`, tls.cert);
+      assert.equal(chunk.status, 200);
+      assert.ok(chunk.body.equals(fs.readFileSync(path.join(fx.data, 'ds', 'chunks', CHUNK))));
+      assert.equal(chunk.headers['cache-control'], 'public, max-age=31536000, immutable, no-transform');
+      assert.equal(chunk.headers['access-control-allow-origin'], '*');
+      assert.equal((await http2Get(base, '/data/ds/nothing.tsc', tls.cert)).status, 404);
+      assert.equal((await http2Get(base, '/../secret.txt', tls.cert)).status, 400, 'no way out over HTTP/2 either');
+      const old = await new Promise((resolve, reject) => {
+        https.get(`${base}/data/ds/manifest.json`, { ca: tls.cert }, (res) => {
+          const parts = [];
+          res.on('data', (d) => parts.push(d));
+          res.on('end', () => resolve({ version: res.httpVersion, status: res.statusCode, body: Buffer.concat(parts) }));
+        }).on('error', reject);
+      });
+      assert.deepEqual([old.version, old.status], ['1.1', 200]);
+      assert.ok(old.body.equals(fs.readFileSync(path.join(fx.data, 'ds', 'manifest.json'))));
+    } finally {
+      await close(server);
+    }
+  });
+
+  test('the CLI says https, and refuses a key without a certificate or a file that is not PEM', async () => {
+    const run = (...args) => spawnSync(process.execPath, [path.join(root, 'server/serve.mjs'), ...args], { encoding: 'utf8' });
+    const files = testCertificate();
+    assert.match(run('--tls-key', files.key).stderr, /serve: --tls-cert and --tls-key go together/);
+    assert.match(run('--tls-cert', files.cert, '--tls-key', path.join(root, 'README.md')).stderr, /--tls-key: .* is not a PEM file/);
+    const fx = makeFixture();
+    const child = spawn(process.execPath, [path.join(root, 'server/serve.mjs'), '--port', '0', '--tls-cert', files.cert,
+      '--tls-key', files.key, '--viewer', fx.www, fx.data], { stdio: ['ignore', 'pipe', 'pipe'] });
+    try {
+      let out = '';
+      await new Promise((resolve, reject) => {
+        child.stdout.on('data', (d) => { out += d; if (out.includes('index.html?data=')) resolve(); });
+        child.on('exit', () => reject(new Error(`serve.mjs exited: ${out}`)));
+      });
+      assert.match(out, /serving on https:\/\/127\.0\.0\.1:\d+\//);
+      assert.match(out, /https:\/\/127\.0\.0\.1:\d+\/index\.html\?data=\/data\/ds\/manifest\.json/);
+    } finally {
+      child.kill();
+    }
   });
 });
 
