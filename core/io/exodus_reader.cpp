@@ -14,6 +14,12 @@
 //     block out). Vectors are stored as components (vel_x, vel_y, vel_z): each stays a field
 //     under its own name, and NAME_magnitude is added (the readers' name for a vector's norm).
 // Not read: global, node set and side set variables, sets, attributes.
+//
+// A share for one of several processes (ReadOptions::shareIndex of shareCount, core/dist): the
+// elements from index·N/count to (index + 1)·N/count in file order (all blocks), and the nodes
+// from the smallest to the largest their corners use, with those rows of every variable, all
+// through the library's partial reads; nodes on the cuts are read by both sides and joined later
+// by their coordinates.
 #include <exodusII.h>
 #include <netcdf.h>
 
@@ -94,6 +100,10 @@ struct Block {
   int64_t count = 0, nodesPer = 0;
   ExodusType kind;
   uint64_t firstElement = 0;  // index of its first element among all blocks'
+  // The elements read (all, or those of this process's share): from readFrom (0-based in the
+  // block), readCount of them; their cell data goes from localFirst among the cells read.
+  int64_t readFrom = 0, readCount = 0;
+  uint64_t localFirst = 0;
 };
 
 class ExodusReader {
@@ -126,8 +136,16 @@ class ExodusReader {
 
     TetMesh mesh;
     CellSoup soup;
-    if (Result r = readCoordinates(init, mesh); !r) return r;
-    if (Result r = readBlocks(init, soup); !r) return r;
+    numNodes_ = init.num_nodes;
+    share_ = options_.shareCount > 1;
+    // The cells first: a share's nodes are those its cells span.
+    std::vector<std::vector<int64_t>> conns;
+    if (Result r = readBlocks(init, conns); !r) return r;
+    if (Result r = chooseNodes(conns); !r) return r;
+    for (size_t b = 0; b < blocks_.size(); ++b)
+      if (Result r = addBlockCells(blocks_[b], conns[b], soup); !r) return r;
+    conns.clear();
+    if (Result r = readCoordinates(mesh); !r) return r;
     size_t step = 0;
     if (Result r = readTimes(step); !r) return r;
     std::vector<CellArray> cellArrays;
@@ -192,18 +210,47 @@ class ExodusReader {
     return s;
   }
 
-  Result readCoordinates(const ex_init_params& init, TetMesh& mesh) {
-    numNodes_ = init.num_nodes;
-    const size_t n = size_t(numNodes_);
+  // The nodes read: all of them, or the window a share's cells span.
+  Result chooseNodes(const std::vector<std::vector<int64_t>>& conns) {
+    nodeFirst_ = 0;
+    nodeCount_ = numNodes_;
+    if (!share_) return Result::success();
+    int64_t lo = INT64_MAX, hi = 0;
+    uint64_t cells = 0;
+    for (size_t b = 0; b < blocks_.size(); ++b) {
+      if (!blocks_[b].kind.volume) continue;
+      cells += uint64_t(blocks_[b].readCount);
+      const int corners = kShapeCorners[int(blocks_[b].kind.shape)];
+      for (int64_t k = 0; k < blocks_[b].readCount; ++k)
+        for (int q = 0; q < corners; ++q) {
+          const int64_t v = conns[b][size_t(k * blocks_[b].nodesPer + q)];
+          if (v < 1 || v > numNodes_) continue;  // (refused with its element's name when added)
+          lo = std::min(lo, v - 1);
+          hi = std::max(hi, v);
+        }
+    }
+    if (hi == 0) lo = 0;
+    nodeFirst_ = lo;
+    nodeCount_ = hi - lo;
+    report_.shared = true;
+    report_.notes.push_back("read elements " + std::to_string(shareFrom_) + " to " + std::to_string(shareTo_) + " of " +
+                            std::to_string(numElements_) + " (" + std::to_string(cells) + " of volume) and the " +
+                            std::to_string(nodeCount_) + " nodes they span, this process's share of the file");
+    return Result::success();
+  }
+
+  Result readCoordinates(TetMesh& mesh) {
+    const size_t n = size_t(nodeCount_);
     std::vector<double> x(n), y(n), z(n);
-    if (n && ex_get_coord(file_.id, x.data(), y.data(), z.data()) != kExodusOk)
+    if (n && ex_get_partial_coord(file_.id, nodeFirst_ + 1, nodeCount_, x.data(), y.data(), z.data()) != kExodusOk)
       return fail(Status::Corrupt, path_ + ": cannot read the node coordinates: " + lastExodusError());
     mesh.positions.resize(3 * n);
     for (size_t v = 0; v < n; ++v) {
       if (!std::isfinite(x[v]) || !std::isfinite(y[v]) || !std::isfinite(z[v])) {
         char buf[128];
         std::snprintf(buf, sizeof buf, "(%g, %g, %g)", x[v], y[v], z[v]);
-        return fail(Status::NonFinite, path_ + ": " + nodeName(int64_t(v) + 1) + " has a non-finite coordinate " + buf);
+        return fail(Status::NonFinite,
+                    path_ + ": " + nodeName(nodeFirst_ + int64_t(v) + 1) + " has a non-finite coordinate " + buf);
       }
       mesh.positions[3 * v] = float(x[v]);
       mesh.positions[3 * v + 1] = float(y[v]);
@@ -212,8 +259,16 @@ class ExodusReader {
     return Result::success();
   }
 
-  Result readBlocks(const ex_init_params& init, CellSoup& soup) {
+  // Every block's parameters, and the connectivity of the elements read (per block: readCount
+  // rows of nodesPer 1-based node numbers; none for blocks whose cells are not read).
+  Result readBlocks(const ex_init_params& init, std::vector<std::vector<int64_t>>& conns) {
     numElements_ = init.num_elem;
+    shareFrom_ = 0;
+    shareTo_ = uint64_t(numElements_);
+    if (share_) {
+      shareFrom_ = uint64_t(numElements_) * options_.shareIndex / options_.shareCount;
+      shareTo_ = uint64_t(numElements_) * (options_.shareIndex + 1ull) / options_.shareCount;
+    }
     std::vector<int64_t> ids(size_t(init.num_elem_blk));
     if (!ids.empty() && ex_get_ids(file_.id, EX_ELEM_BLOCK, ids.data()) != kExodusOk)
       return fail(Status::Corrupt, path_ + ": cannot read the element block ids: " + lastExodusError());
@@ -244,56 +299,74 @@ class ExodusReader {
       if (first > uint64_t(init.num_elem))
         return fail(Status::Corrupt, path_ + ": the element blocks hold more elements than the " +
                                          std::to_string(init.num_elem) + " the header declares");
-      if (Result r = readBlockCells(b, where, soup); !r) return r;
+      const uint64_t from = std::clamp(shareFrom_, b.firstElement, first),
+                     to = std::clamp(shareTo_, b.firstElement, first);
+      b.readFrom = int64_t(from - b.firstElement);
+      b.readCount = int64_t(to - from);
+      b.localFirst = from - shareFrom_;
+      conns.emplace_back();
+      if (Result r = readConnectivity(b, where, conns.back()); !r) return r;
       blocks_.push_back(std::move(b));
     }
     return Result::success();
   }
 
-  Result readBlockCells(const Block& b, const std::string& where, CellSoup& soup) {
-    const uint64_t sourceBase = soup.inputCells;
-    soup.inputCells += uint64_t(b.count);
-    if (b.count == 0) return Result::success();
-    const std::string label = "Exodus " + upper(b.type);
-    if (b.kind.special) {  // polyhedra / polygons: not read (their connectivity is not per element)
-      soup.skipped[{0, label}] += uint64_t(b.count);
-      return Result::success();
-    }
+  Result readConnectivity(const Block& b, const std::string& where, std::vector<int64_t>& conn) {
+    if (b.readCount == 0 || b.kind.special || (share_ && !b.kind.volume)) return Result::success();
     const int corners = kShapeCorners[int(b.kind.shape)];
     if (b.kind.volume && b.nodesPer < corners)
       return fail(Status::Corrupt, path_ + ": " + where + " has " + std::to_string(b.nodesPer) +
                                        " nodes per element; the shape needs at least " + std::to_string(corners));
-    std::vector<int64_t> conn(size_t(b.count * b.nodesPer));
-    if (ex_get_conn(file_.id, EX_ELEM_BLOCK, b.id, conn.data(), nullptr, nullptr) != kExodusOk)
+    conn.resize(size_t(b.readCount * b.nodesPer));
+    if (ex_get_partial_conn(file_.id, EX_ELEM_BLOCK, b.id, b.readFrom + 1, b.readCount, conn.data(), nullptr,
+                            nullptr) != kExodusOk)
       return fail(Status::Corrupt, path_ + ": " + where + ": cannot read its connectivity: " + lastExodusError());
-    if (soup.referenced.size() < size_t(numNodes_)) soup.referenced.resize(size_t(numNodes_), 0);
-    if (!b.kind.volume) {
-      soup.skipped[{b.kind.vtkType, label}] += uint64_t(b.count);
-      for (int64_t v : conn)
-        if (v >= 1 && v <= numNodes_) soup.referenced[size_t(v - 1)] = 1;
+    return Result::success();
+  }
+
+  // The block's elements read, into the soup, their nodes numbered from the first node read.
+  Result addBlockCells(const Block& b, const std::vector<int64_t>& conn, CellSoup& soup) {
+    const std::string where = "element block " + std::to_string(b.id) + " (" + b.type + ")";
+    const uint64_t sourceBase = soup.inputCells;
+    soup.inputCells += uint64_t(b.readCount);
+    if (b.readCount == 0) return Result::success();
+    const std::string label = "Exodus " + upper(b.type);
+    if (b.kind.special ||
+        conn.empty()) {  // polyhedra / polygons (connectivity not per element), or a share's lower-dimensional cells
+      soup.skipped[{b.kind.special ? 0 : b.kind.vtkType, label}] += uint64_t(b.readCount);
       return Result::success();
     }
-    soup.shapes.reserve(soup.shapes.size() + size_t(b.count));
-    soup.source.reserve(soup.source.size() + size_t(b.count));
-    soup.corners.reserve(soup.corners.size() + size_t(b.count) * size_t(corners));
-    for (int64_t k = 0; k < b.count; ++k) {
+    if (soup.referenced.size() < size_t(nodeCount_)) soup.referenced.resize(size_t(nodeCount_), 0);
+    auto mark = [&](int64_t v) {  // (a share's nodes outside its window are not read)
+      if (v > nodeFirst_ && v <= nodeFirst_ + nodeCount_) soup.referenced[size_t(v - 1 - nodeFirst_)] = 1;
+    };
+    if (!b.kind.volume) {
+      soup.skipped[{b.kind.vtkType, label}] += uint64_t(b.readCount);
+      for (int64_t v : conn) mark(v);
+      return Result::success();
+    }
+    const int corners = kShapeCorners[int(b.kind.shape)];
+    soup.shapes.reserve(soup.shapes.size() + size_t(b.readCount));
+    soup.source.reserve(soup.source.size() + size_t(b.readCount));
+    soup.corners.reserve(soup.corners.size() + size_t(b.readCount) * size_t(corners));
+    for (int64_t k = 0; k < b.readCount; ++k) {
       const int64_t* nodes = &conn[size_t(k * b.nodesPer)];
       uint32_t ids[8];
       for (int64_t q = 0; q < b.nodesPer; ++q) {
         const int64_t v = nodes[q];
         if (v < 1 || v > numNodes_)
-          return fail(Status::OutOfRange, path_ + ": " + where + " " + elementName(b, k) + " uses node " +
+          return fail(Status::OutOfRange, path_ + ": " + where + " " + elementName(b, b.readFrom + k) + " uses node " +
                                               std::to_string(v) + ", but the nodes are numbered 1.." +
                                               std::to_string(numNodes_));
-        soup.referenced[size_t(v - 1)] = 1;
-        if (q < corners) ids[q] = uint32_t(v - 1);
+        mark(v);
+        if (q < corners) ids[q] = uint32_t(v - 1 - nodeFirst_);
       }
       soup.add(b.kind.shape, ids, sourceBase + uint64_t(k));
     }
     if (b.nodesPer > corners) {
       auto& r = soup.reduced[label + " (" + std::to_string(b.nodesPer) + " nodes)"];
       r.first = corners;
-      r.second += uint64_t(b.count);
+      r.second += uint64_t(b.readCount);
     }
     return Result::success();
   }
@@ -344,11 +417,13 @@ class ExodusReader {
     std::vector<std::string> names;
     if (Result r = variableNames(EX_NODAL, "nodal", names); !r) return r;
     if (names.empty() || noValues(names.size(), "nodal")) return Result::success();
-    const size_t n = size_t(numNodes_);
+    const size_t n = size_t(nodeCount_);
     std::vector<double> values(n);
     const size_t firstField = mesh.fields.size();
     for (size_t k = 0; k < names.size(); ++k) {
-      if (n && ex_get_var(file_.id, int(step + 1), EX_NODAL, int(k + 1), 1, numNodes_, values.data()) != kExodusOk &&
+      if (n &&
+          ex_get_partial_var(file_.id, int(step + 1), EX_NODAL, int(k + 1), 1, nodeFirst_ + 1, nodeCount_,
+                             values.data()) != kExodusOk &&
           !readNodalVariableDirectly(step, k, values))
         return fail(Status::Corrupt, path_ + ": nodal variable '" + names[k] + "' at step " + std::to_string(step) +
                                          ": " + lastExodusError());
@@ -377,7 +452,7 @@ class ExodusReader {
         nc_inq_dimlen(file_.id, dims[1], &length[1]) != NC_NOERR || length[0] <= step ||
         length[1] != uint64_t(numNodes_))
       return false;
-    const size_t start[2] = {step, 0}, count[2] = {1, length[1]};
+    const size_t start[2] = {step, size_t(nodeFirst_)}, count[2] = {1, size_t(nodeCount_)};
     if (nc_get_vara_double(file_.id, var, start, count, values.data()) != NC_NOERR) return false;
     if (!directNoted_) {
       directNoted_ = true;
@@ -404,7 +479,7 @@ class ExodusReader {
       return fail(Status::Corrupt, path_ + ": cannot read the element variable truth table: " + lastExodusError());
     else if (status > 0)
       std::fill(truth.begin(), truth.end(), 1);
-    const uint64_t cells = blocks_.empty() ? 0 : blocks_.back().firstElement + uint64_t(blocks_.back().count);
+    const uint64_t cells = blocks_.empty() ? 0 : blocks_.back().localFirst + uint64_t(blocks_.back().readCount);
     std::vector<double> values;
     for (size_t k = 0; k < nv; ++k) {
       CellArray a;
@@ -412,13 +487,14 @@ class ExodusReader {
       a.values.assign(size_t(cells), std::numeric_limits<double>::quiet_NaN());
       for (size_t bi = 0; bi < nb; ++bi) {
         const Block& b = blocks_[bi];
-        if (!b.kind.volume || b.count == 0 || !truth[bi * nv + k]) continue;
-        values.resize(size_t(b.count));
-        if (ex_get_var(file_.id, int(step + 1), EX_ELEM_BLOCK, int(k + 1), b.id, b.count, values.data()) != kExodusOk)
+        if (!b.kind.volume || b.readCount == 0 || !truth[bi * nv + k]) continue;
+        values.resize(size_t(b.readCount));
+        if (ex_get_partial_var(file_.id, int(step + 1), EX_ELEM_BLOCK, int(k + 1), b.id, b.readFrom + 1, b.readCount,
+                               values.data()) != kExodusOk)
           return fail(Status::Corrupt, path_ + ": element variable '" + names[k] + "' on element block " +
                                            std::to_string(b.id) + " at step " + std::to_string(step) + ": " +
                                            lastExodusError());
-        std::copy(values.begin(), values.end(), a.values.begin() + std::ptrdiff_t(b.firstElement));
+        std::copy(values.begin(), values.end(), a.values.begin() + std::ptrdiff_t(b.localFirst));
       }
       arrays.push_back(std::move(a));
     }
@@ -464,6 +540,9 @@ class ExodusReader {
   uint64_t ioWordSize_ = 8;
   int nameLength_ = 32;
   int64_t numNodes_ = 0, numElements_ = 0;
+  bool share_ = false;                     // reading one process's share (the header comment)
+  uint64_t shareFrom_ = 0, shareTo_ = 0;   // the elements read, in file order over all blocks
+  int64_t nodeFirst_ = 0, nodeCount_ = 0;  // the nodes read (0-based first)
   std::vector<Block> blocks_;
   std::vector<double> times_;
   bool nodeMapRead_ = false, elemMapRead_ = false, directNoted_ = false;

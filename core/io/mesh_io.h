@@ -97,7 +97,8 @@ struct ReadOptions {
   // checked). A share with no file gives an empty mesh. A VTKHDF file of at least shareCount
   // partitions: the partitions likewise. An XDMF file of one grid of one cell type: the cells
   // in those rows of its topology and the points from the smallest to the largest id they use.
-  // Other files ignore it (ReadReport::shared says).
+  // An Exodus II file: the elements in those rows of its blocks (in file order) and the nodes
+  // from the smallest to the largest they use. Other files ignore it (ReadReport::shared says).
   uint32_t shareIndex = 0, shareCount = 1;
 };
 

@@ -10,9 +10,12 @@
 #include <hdf5.h>
 #include <netcdf.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <csignal>
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "io/mesh_io.h"
@@ -546,6 +549,68 @@ TEST(ExodusComponents, TriplesNeedOneSpellingInOrder) {
   EXPECT_EQ(t[1].stem, "Momentum");
   EXPECT_EQ(t[1].first, 4u);
   EXPECT_TRUE(componentTriples({"x", "y", "z"}).empty());  // no stem
+}
+
+// For a process of several (core/dist), the file's elements in shares: each share reads its rows
+// of the blocks and the nodes they span (the library's partial reads), and together they hold
+// every tet of the whole once, with the whole's nodal values at every point.
+TEST(ExodusShares, TheSharesOfAFileHoldEveryTetOnceWithItsValues) {
+  using Corner = std::array<float, 3>;
+  auto tetsOf = [](const TetMesh& m) {
+    std::vector<std::array<Corner, 4>> out;
+    for (uint32_t t = 0; t < m.tetCount(); ++t) {
+      std::array<Corner, 4> tet;
+      for (int k = 0; k < 4; ++k) {
+        const float* p = &m.positions[3 * size_t(m.tets[4 * size_t(t) + size_t(k)])];
+        tet[size_t(k)] = {p[0], p[1], p[2]};
+      }
+      std::sort(tet.begin(), tet.end());
+      out.push_back(tet);
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  // (Element variables become point values by averaging over the cells read: on a cut, over
+  // fewer cells. core/dist averages them over every rank's cells; here they are left out.)
+  for (auto [name, elementVariable] : {std::pair{"exo_blocks.exo", "pressure"}, std::pair{"exo_meshio.exo", ""}}) {
+    SCOPED_TRACE(name);
+    TetMesh whole;
+    ReadReport wr;
+    ASSERT_TRUE(readMesh(hpcPath(name), whole, wr));
+    EXPECT_FALSE(wr.shared);
+    std::map<Corner, std::vector<float>> valueAt;
+    for (uint32_t v = 0; v < whole.vertexCount(); ++v)
+      for (const ScalarField& f : whole.fields)
+        if (f.name != elementVariable)
+          valueAt[{whole.positions[3 * v], whole.positions[3 * v + 1], whole.positions[3 * v + 2]}].push_back(
+              f.values[v]);
+    for (uint32_t count : {2u, 3u, 5u}) {
+      std::vector<std::array<Corner, 4>> all;
+      for (uint32_t k = 0; k < count; ++k) {
+        ReadOptions o;
+        o.shareIndex = k;
+        o.shareCount = count;
+        TetMesh part;
+        ReadReport r;
+        ASSERT_TRUE(readMesh(hpcPath(name), part, r, o)) << "share " << k << " of " << count;
+        EXPECT_TRUE(r.shared);
+        EXPECT_LT(part.vertexCount(), whole.vertexCount()) << "share " << k << " of " << count;
+        ASSERT_EQ(part.fields.size(), whole.fields.size());
+        for (uint32_t v = 0; v < part.vertexCount(); ++v) {
+          std::vector<float> mine;
+          for (const ScalarField& f : part.fields)
+            if (f.name != elementVariable) mine.push_back(f.values[v]);
+          const auto it = valueAt.find({part.positions[3 * v], part.positions[3 * v + 1], part.positions[3 * v + 2]});
+          ASSERT_NE(it, valueAt.end()) << "a point the whole does not have";
+          EXPECT_EQ(mine, it->second);
+        }
+        const auto tets = tetsOf(part);
+        all.insert(all.end(), tets.begin(), tets.end());
+      }
+      std::sort(all.begin(), all.end());
+      EXPECT_EQ(all, tetsOf(whole)) << count << " shares";
+    }
+  }
 }
 
 }  // namespace
