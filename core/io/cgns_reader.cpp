@@ -19,6 +19,10 @@
 //   - time steps: a BaseIterativeData's TimeValues (else IterationValues) -> chooseTimeStep, and
 //     per zone the solution its ZoneIterativeData's FlowSolutionPointers names for that step.
 //     Without BaseIterativeData every FlowSolution of a zone is read (one state).
+// A share for one of several processes (ReadOptions::shareIndex of shareCount, core/dist): of a
+// base with at least as many zones as processes, the zones from index·Z/count to
+// (index + 1)·Z/count, each whole (zones meet where their points coincide, which core/dist joins
+// as one process does). A base of fewer zones is read whole by every process.
 #include <cgnslib.h>
 
 #include <cmath>
@@ -145,6 +149,7 @@ class CgnsReader {
     }
     if (Result r = chooseBase(); !r) return r;
     if (Result r = readZones(); !r) return r;
+    keepShareOfZones();
     size_t step = 0;
     if (Result r = readTimes(step); !r) return r;
 
@@ -272,6 +277,26 @@ class CgnsReader {
     totalSlots_ = slots;
     if (zones_.empty()) return fail(Status::NoTets, path_ + ": base '" + baseName_ + "' has no zones");
     return Result::success();
+  }
+
+  // For one process of several, its zones only (the header comment), numbered from its first.
+  void keepShareOfZones() {
+    const uint64_t n = options_.shareCount, z = zones_.size();
+    if (n < 2 || z < n) return;
+    const uint64_t from = z * options_.shareIndex / n, to = z * (options_.shareIndex + 1) / n;
+    zones_ = std::vector<Zone>(zones_.begin() + std::ptrdiff_t(from), zones_.begin() + std::ptrdiff_t(to));
+    totalVertices_ = totalSlots_ = 0;
+    structured_ = 0;
+    for (Zone& zone : zones_) {
+      zone.vertexBase = totalVertices_;
+      zone.slotBase = totalSlots_;
+      totalVertices_ += zone.vertices;
+      totalSlots_ += zone.cells;
+      structured_ += zone.structured;
+    }
+    report_.shared = true;
+    report_.notes.push_back("read zones " + std::to_string(from + 1) + " to " + std::to_string(to) + " of " +
+                            std::to_string(z) + ", this process's share of the file");
   }
 
   // The step's times from BaseIterativeData, and each zone's solution for it.

@@ -98,7 +98,8 @@ struct ReadOptions {
   // partitions: the partitions likewise. An XDMF file of one grid of one cell type: the cells
   // in those rows of its topology and the points from the smallest to the largest id they use.
   // An Exodus II file: the elements in those rows of its blocks (in file order) and the nodes
-  // from the smallest to the largest they use. Other files ignore it (ReadReport::shared says).
+  // from the smallest to the largest they use. A CGNS base of at least shareCount zones: those
+  // zones, each whole. Other files ignore it (ReadReport::shared says).
   uint32_t shareIndex = 0, shareCount = 1;
 };
 

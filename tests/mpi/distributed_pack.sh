@@ -60,6 +60,22 @@ for input in vtkhdf_parts.vtkhdf:3 vtkhdf_series.vtkhdf:2; do
 done
 echo "ok: VTKHDF partitions packed on 3 and 2 ranks"
 
+# A CGNS base of two zones on 2 ranks: each reads its zone; the zones meet where their points
+# coincide, as in one process; the surfaces equal one process's pack.
+cgns="$HPC/cgns_structured.cgns"
+"$TETSTREAM" pack "$cgns" -o "$WORK/cgns-serial" --base-vertices 8 --leaf-vertices 4 >/dev/null
+timeout 300 "${MPIRUN[@]}" -np 2 "$TETSTREAM" pack "$cgns" -o "$WORK/cgns-np2" --base-vertices 8 --leaf-vertices 4 \
+  --json >"$WORK/cgns-np2.json"
+[ "$(grep -c "this process's share of the file" "$WORK/cgns-np2.json")" -eq 2 ] ||
+  { echo "FAIL: the CGNS zones were not read in shares"; cat "$WORK/cgns-np2.json"; exit 1; }
+for value in 1.05 1.35; do
+  a=$("$TETSTREAM" iso "$WORK/cgns-np2" --value $value --json | tr -d ' \n' | grep -o '"triangles":[0-9]*,"vertices":[0-9]*')
+  b=$("$TETSTREAM" iso "$WORK/cgns-serial" --value $value --json | tr -d ' \n' | grep -o '"triangles":[0-9]*,"vertices":[0-9]*')
+  [ -n "$a" ] && [ "$a" = "$b" ] || { echo "FAIL: CGNS zones, iso $value: $a on 2 ranks, $b on one process"; exit 1; }
+done
+checks="$checks;$WORK/cgns-np2=$cgns"
+echo "ok: a CGNS base of two zones on 2 ranks gives one process's surfaces"
+
 # One XDMF grid with HDF5 heavy data (meshio writes it as DOLFINx and others do: one file for the
 # whole mesh): each rank reads its rows of the cells and the points they span, on 2 and 3 ranks;
 # the surfaces equal one process's pack of the same file.
