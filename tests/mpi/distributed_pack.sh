@@ -60,64 +60,45 @@ for input in vtkhdf_parts.vtkhdf:3 vtkhdf_series.vtkhdf:2; do
 done
 echo "ok: VTKHDF partitions packed on 3 and 2 ranks"
 
-# A CGNS base of two zones on 2 ranks: each reads its zone; the zones meet where their points
-# coincide, as in one process; the surfaces equal one process's pack.
-cgns="$HPC/cgns_structured.cgns"
-"$TETSTREAM" pack "$cgns" -o "$WORK/cgns-serial" --base-vertices 8 --leaf-vertices 4 >/dev/null
-timeout 300 "${MPIRUN[@]}" -np 2 "$TETSTREAM" pack "$cgns" -o "$WORK/cgns-np2" --base-vertices 8 --leaf-vertices 4 \
-  --json >"$WORK/cgns-np2.json"
-[ "$(grep -c "this process's share of the file" "$WORK/cgns-np2.json")" -eq 2 ] ||
-  { echo "FAIL: the CGNS zones were not read in shares"; cat "$WORK/cgns-np2.json"; exit 1; }
-for value in 1.05 1.35; do
-  a=$("$TETSTREAM" iso "$WORK/cgns-np2" --value $value --json | tr -d ' \n' | grep -o '"triangles":[0-9]*,"vertices":[0-9]*')
-  b=$("$TETSTREAM" iso "$WORK/cgns-serial" --value $value --json | tr -d ' \n' | grep -o '"triangles":[0-9]*,"vertices":[0-9]*')
-  [ -n "$a" ] && [ "$a" = "$b" ] || { echo "FAIL: CGNS zones, iso $value: $a on 2 ranks, $b on one process"; exit 1; }
-done
-checks="$checks;$WORK/cgns-np2=$cgns"
-echo "ok: a CGNS base of two zones on 2 ranks gives one process's surfaces"
+# One file read in shares: packed on each rank count of RANKS, every rank says it read its share
+# (NOTE, from its reader), and the isosurfaces at VALUES equal one process's pack of the file.
+#   sharesLikeOneProcess NAME FILE NOTE "RANKS" "VALUES" [pack options...]
+sharesLikeOneProcess() {
+  local name=$1 input=$2 note=$3 ranks=$4 values=$5
+  shift 5
+  "$TETSTREAM" pack "$input" -o "$WORK/$name-serial" "$@" >/dev/null
+  for np in $ranks; do
+    local out="$WORK/$name-np$np"
+    timeout 300 "${MPIRUN[@]}" -np $np "$TETSTREAM" pack "$input" -o "$out" "$@" --json >"$out.json"
+    [ "$(grep -c "$note" "$out.json")" -eq $np ] ||
+      { echo "FAIL: $name was not read in shares on $np ranks"; cat "$out.json"; exit 1; }
+    for value in $values; do
+      local a b
+      a=$("$TETSTREAM" iso "$out" --value $value --json | tr -d ' \n' | grep -o '"triangles":[0-9]*,"vertices":[0-9]*')
+      b=$("$TETSTREAM" iso "$WORK/$name-serial" --value $value --json | tr -d ' \n' | grep -o '"triangles":[0-9]*,"vertices":[0-9]*')
+      [ -n "$a" ] && [ "$a" = "$b" ] || { echo "FAIL: $name on $np ranks, iso $value: $a, one process $b"; exit 1; }
+    done
+    checks="$checks;$out=$input"
+  done
+  echo "ok: $name read in shares on $ranks ranks gives one process's surfaces"
+}
 
-# One XDMF grid with HDF5 heavy data (meshio writes it as DOLFINx and others do: one file for the
-# whole mesh): each rank reads its rows of the cells and the points they span, on 2 and 3 ranks;
-# the surfaces equal one process's pack of the same file.
-/usr/bin/python3 -c "
+# A CGNS base of two zones: each rank reads its zone; the zones meet where their points
+# coincide, as in one process.
+sharesLikeOneProcess cgns "$HPC/cgns_structured.cgns" "this process's share of the file" "2" "1.05 1.35" \
+  --base-vertices 8 --leaf-vertices 4
+
+# One XDMF grid with HDF5 heavy data and one Exodus II file, as meshio writes them (DOLFINx and
+# others write XDMF so: one file for the whole mesh): each rank reads its rows of the cells (HDF5
+# hyperslabs; the Exodus library's partial reads) and the points they span.
+for ext in xdmf exo; do
+  /usr/bin/python3 -c "
 import meshio, sys
 m = meshio.read(sys.argv[1])
-meshio.write(sys.argv[2], meshio.Mesh(m.points, m.cells, point_data=m.point_data))" "$WORK/harmonic.vtu" "$WORK/harmonic.xdmf"
-"$TETSTREAM" "${PACK[@]}" "$WORK/harmonic.xdmf" -o "$WORK/xdmf-serial" >/dev/null
-for np in 2 3; do
-  out="$WORK/xdmf-np$np"
-  timeout 300 "${MPIRUN[@]}" -np $np "$TETSTREAM" "${PACK[@]}" "$WORK/harmonic.xdmf" -o "$out" >"$out.json"
-  [ "$(grep -c "this process's share of the grid" "$out.json")" -eq $np ] ||
-    { echo "FAIL: the XDMF grid was not read in shares on $np ranks"; cat "$out.json"; exit 1; }
-  for value in 0 0.25; do
-    a=$("$TETSTREAM" iso "$out" --value $value --json | tr -d ' \n' | grep -o '"triangles":[0-9]*')
-    b=$("$TETSTREAM" iso "$WORK/xdmf-serial" --value $value --json | tr -d ' \n' | grep -o '"triangles":[0-9]*')
-    [ -n "$a" ] && [ "$a" = "$b" ] || { echo "FAIL: XDMF on $np ranks, iso $value: $a, one process $b"; exit 1; }
-  done
-  checks="$checks;$out=$WORK/harmonic.xdmf"
+meshio.write(sys.argv[2], meshio.Mesh(m.points, m.cells, point_data=m.point_data))" "$WORK/harmonic.vtu" "$WORK/harmonic.$ext"
 done
-echo "ok: one XDMF grid read in shares on 2 and 3 ranks gives one process's surfaces"
-
-# One Exodus II file (meshio writes it): each rank reads its rows of the element blocks and the
-# nodes they span through the library's partial reads; the surfaces equal one process's pack.
-/usr/bin/python3 -c "
-import meshio, sys
-m = meshio.read(sys.argv[1])
-meshio.write(sys.argv[2], meshio.Mesh(m.points, m.cells, point_data=m.point_data))" "$WORK/harmonic.vtu" "$WORK/harmonic.exo"
-"$TETSTREAM" "${PACK[@]}" "$WORK/harmonic.exo" -o "$WORK/exo-serial" >/dev/null
-for np in 2 3; do
-  out="$WORK/exo-np$np"
-  timeout 300 "${MPIRUN[@]}" -np $np "$TETSTREAM" "${PACK[@]}" "$WORK/harmonic.exo" -o "$out" >"$out.json"
-  [ "$(grep -c "this process's share of the file" "$out.json")" -eq $np ] ||
-    { echo "FAIL: the Exodus file was not read in shares on $np ranks"; cat "$out.json"; exit 1; }
-  for value in 0 0.25; do
-    a=$("$TETSTREAM" iso "$out" --value $value --json | tr -d ' \n' | grep -o '"triangles":[0-9]*')
-    b=$("$TETSTREAM" iso "$WORK/exo-serial" --value $value --json | tr -d ' \n' | grep -o '"triangles":[0-9]*')
-    [ -n "$a" ] && [ "$a" = "$b" ] || { echo "FAIL: Exodus on $np ranks, iso $value: $a, one process $b"; exit 1; }
-  done
-  checks="$checks;$out=$WORK/harmonic.exo"
-done
-echo "ok: one Exodus II file read in shares on 2 and 3 ranks gives one process's surfaces"
+sharesLikeOneProcess xdmf "$WORK/harmonic.xdmf" "this process's share of the grid" "2 3" "0 0.25" --leaf-vertices 256 --chunk-kb 8
+sharesLikeOneProcess exodus "$WORK/harmonic.exo" "this process's share of the file" "2 3" "0 0.25" --leaf-vertices 256 --chunk-kb 8
 
 # The same bytes on a second run.
 again="$WORK/again"

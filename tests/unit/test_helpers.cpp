@@ -22,6 +22,7 @@
 #include "chunk.h"
 #include "dataset.h"
 #include "io/generators.h"
+#include "io/mesh_io.h"
 #include "pack/chunk_encode.h"
 #include "split_stream.h"
 #include "validate.h"
@@ -423,6 +424,60 @@ double fieldRms(const TetMesh& in, const TetMesh& coarse, int field) {
     sum += d * d;
   }
   return std::sqrt(sum / in.vertexCount());
+}
+
+std::vector<std::array<Corner, 4>> tetsByCorners(const TetMesh& m) {
+  std::vector<std::array<Corner, 4>> out;
+  for (uint32_t t = 0; t < m.tetCount(); ++t) {
+    std::array<Corner, 4> tet;
+    for (int k = 0; k < 4; ++k) {
+      const float* p = &m.positions[3 * size_t(m.tets[4 * size_t(t) + size_t(k)])];
+      tet[size_t(k)] = {p[0], p[1], p[2]};
+    }
+    std::sort(tet.begin(), tet.end());
+    out.push_back(tet);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+void expectSharesMakeTheWhole(const std::string& path, uint32_t count, const std::string& skipField) {
+  auto skip = [&](const ScalarField& f) { return f.name == skipField || f.name.ends_with("_cell"); };
+  SCOPED_TRACE(path + " in " + std::to_string(count) + " shares");
+  TetMesh whole;
+  ReadReport wr;
+  ASSERT_TRUE(readMesh(path, whole, wr));
+  EXPECT_FALSE(wr.shared);
+  std::map<Corner, std::vector<float>> valueAt;
+  for (uint32_t v = 0; v < whole.vertexCount(); ++v)
+    for (const ScalarField& f : whole.fields)
+      if (!skip(f))
+        valueAt[{whole.positions[3 * v], whole.positions[3 * v + 1], whole.positions[3 * v + 2]}].push_back(
+            f.values[v]);
+  std::vector<std::array<Corner, 4>> all;
+  for (uint32_t k = 0; k < count; ++k) {
+    ReadOptions o;
+    o.shareIndex = k;
+    o.shareCount = count;
+    TetMesh part;
+    ReadReport r;
+    ASSERT_TRUE(readMesh(path, part, r, o)) << "share " << k;
+    EXPECT_TRUE(r.shared);
+    EXPECT_LT(part.vertexCount(), whole.vertexCount()) << "share " << k;
+    ASSERT_EQ(part.fields.size(), whole.fields.size());
+    for (uint32_t v = 0; v < part.vertexCount(); ++v) {
+      std::vector<float> mine;
+      for (const ScalarField& f : part.fields)
+        if (!skip(f)) mine.push_back(f.values[v]);
+      const auto it = valueAt.find({part.positions[3 * v], part.positions[3 * v + 1], part.positions[3 * v + 2]});
+      ASSERT_NE(it, valueAt.end()) << "a point the whole does not have";
+      EXPECT_EQ(mine, it->second);
+    }
+    const auto tets = tetsByCorners(part);
+    all.insert(all.end(), tets.begin(), tets.end());
+  }
+  std::sort(all.begin(), all.end());
+  EXPECT_EQ(all, tetsByCorners(whole));
 }
 
 }  // namespace tetstream::test

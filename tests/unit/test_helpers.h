@@ -1,6 +1,7 @@
 // Helpers shared by the unit tests (compiled once in test_helpers.cpp).
 // Each section belongs to the tests named in its heading; add new sections below.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -158,5 +159,18 @@ void roundTrip(const std::string& name, const TetMesh& m, PackOptions o);
 double bestTet(const TetMesh& coarse, const float* p, uint32_t& tet, double w[4]);
 // RMS over the input's vertices of (coarse field interpolated there − input value).
 double fieldRms(const TetMesh& in, const TetMesh& coarse, int field);
+
+// A mesh's tets by their corners' coordinates (each sorted), sorted: equal for the same tets
+// whatever the vertex numbering.
+using Corner = std::array<float, 3>;
+std::vector<std::array<Corner, 4>> tetsByCorners(const TetMesh& m);
+
+// Reads the file at `path` in `count` shares (ReadOptions::shareIndex, as the processes of a
+// distributed pack do): each is a share (ReadReport::shared) with fewer points than the whole,
+// each point's values are the whole's at that position, and together the shares hold every tet
+// of the whole once. Cell data (`skipField`, and NAME_cell) is left out: it becomes point values
+// by averaging over the cells read, on a cut over fewer cells (core/dist averages it over every
+// rank's cells).
+void expectSharesMakeTheWhole(const std::string& path, uint32_t count, const std::string& skipField = "");
 
 }  // namespace tetstream::test

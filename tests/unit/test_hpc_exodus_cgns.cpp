@@ -551,82 +551,20 @@ TEST(ExodusComponents, TriplesNeedOneSpellingInOrder) {
   EXPECT_TRUE(componentTriples({"x", "y", "z"}).empty());  // no stem
 }
 
-// A mesh's tets by their corners' coordinates (each sorted), sorted: equal for the same tets
-// whatever the vertex numbering.
-using Corner = std::array<float, 3>;
-std::vector<std::array<Corner, 4>> tetsByCorners(const TetMesh& m) {
-  std::vector<std::array<Corner, 4>> out;
-  for (uint32_t t = 0; t < m.tetCount(); ++t) {
-    std::array<Corner, 4> tet;
-    for (int k = 0; k < 4; ++k) {
-      const float* p = &m.positions[3 * size_t(m.tets[4 * size_t(t) + size_t(k)])];
-      tet[size_t(k)] = {p[0], p[1], p[2]};
-    }
-    std::sort(tet.begin(), tet.end());
-    out.push_back(tet);
-  }
-  std::sort(out.begin(), out.end());
-  return out;
-}
-
-// Reads `name` in `count` shares: each is a share (ReadReport::shared) with fewer points than
-// the whole, each point's values are the whole's at that position, and together the shares hold
-// every tet of the whole once. Cell data (`skipField`, and CGNS's NAME_cell) is left out: it
-// becomes point values by averaging over the cells read, on a cut over fewer cells (core/dist
-// averages it over every rank's cells).
-void expectSharesMakeTheWhole(const std::string& name, uint32_t count, const std::string& skipField = "") {
-  auto skip = [&](const ScalarField& f) { return f.name == skipField || f.name.ends_with("_cell"); };
-  SCOPED_TRACE(name + " in " + std::to_string(count) + " shares");
-  TetMesh whole;
-  ReadReport wr;
-  ASSERT_TRUE(readMesh(hpcPath(name), whole, wr));
-  EXPECT_FALSE(wr.shared);
-  std::map<Corner, std::vector<float>> valueAt;
-  for (uint32_t v = 0; v < whole.vertexCount(); ++v)
-    for (const ScalarField& f : whole.fields)
-      if (!skip(f))
-        valueAt[{whole.positions[3 * v], whole.positions[3 * v + 1], whole.positions[3 * v + 2]}].push_back(
-            f.values[v]);
-  std::vector<std::array<Corner, 4>> all;
-  for (uint32_t k = 0; k < count; ++k) {
-    ReadOptions o;
-    o.shareIndex = k;
-    o.shareCount = count;
-    TetMesh part;
-    ReadReport r;
-    ASSERT_TRUE(readMesh(hpcPath(name), part, r, o)) << "share " << k;
-    EXPECT_TRUE(r.shared);
-    EXPECT_LT(part.vertexCount(), whole.vertexCount()) << "share " << k;
-    ASSERT_EQ(part.fields.size(), whole.fields.size());
-    for (uint32_t v = 0; v < part.vertexCount(); ++v) {
-      std::vector<float> mine;
-      for (const ScalarField& f : part.fields)
-        if (!skip(f)) mine.push_back(f.values[v]);
-      const auto it = valueAt.find({part.positions[3 * v], part.positions[3 * v + 1], part.positions[3 * v + 2]});
-      ASSERT_NE(it, valueAt.end()) << "a point the whole does not have";
-      EXPECT_EQ(mine, it->second);
-    }
-    const auto tets = tetsByCorners(part);
-    all.insert(all.end(), tets.begin(), tets.end());
-  }
-  std::sort(all.begin(), all.end());
-  EXPECT_EQ(all, tetsByCorners(whole));
-}
-
 // For a process of several (core/dist), the file's elements in shares: each share reads its rows
 // of the blocks and the nodes they span (the library's partial reads), and together they hold
 // every tet of the whole once, with the whole's nodal values at every point.
 TEST(ExodusShares, TheSharesOfAFileHoldEveryTetOnceWithItsValues) {
   for (uint32_t count : {2u, 3u, 5u}) {
-    expectSharesMakeTheWhole("exo_blocks.exo", count, "pressure");
-    expectSharesMakeTheWhole("exo_meshio.exo", count);
+    test::expectSharesMakeTheWhole(hpcPath("exo_blocks.exo"), count, "pressure");
+    test::expectSharesMakeTheWhole(hpcPath("exo_meshio.exo"), count);
   }
 }
 
 // A CGNS base of as many zones as processes or more: each reads its zones whole.
 TEST(CgnsShares, EachProcessReadsItsZones) {
   for (const char* name : {"cgns_unstructured.cgns", "cgns_structured.cgns", "cgns_structured.adf.cgns"})
-    expectSharesMakeTheWhole(name, 2);
+    test::expectSharesMakeTheWhole(hpcPath(name), 2);
   TetMesh m;
   ReadReport r;
   ReadOptions o;

@@ -168,59 +168,8 @@ TEST(XdmfReader, FormatAndNotesSayWhatWasRead) {
 // with the same point values, from HDF5 (hyperslabs), from raw binary files and through a time
 // series whose steps include their mesh.
 TEST(XdmfShares, TheSharesOfAGridHoldEveryTetOnceWithItsValues) {
-  using Corner = std::array<float, 3>;
-  auto tetsOf = [](const TetMesh& m) {
-    std::vector<std::array<Corner, 4>> out;
-    for (uint32_t t = 0; t < m.tetCount(); ++t) {
-      std::array<Corner, 4> tet;
-      for (int k = 0; k < 4; ++k) {
-        const float* p = &m.positions[3 * size_t(m.tets[4 * size_t(t) + size_t(k)])];
-        tet[size_t(k)] = {p[0], p[1], p[2]};
-      }
-      std::sort(tet.begin(), tet.end());
-      out.push_back(tet);
-    }
-    return out;
-  };
-  for (const char* name : {"xdmf_grid.xdmf", "xdmf_binary.xdmf", "xdmf_series.xdmf"}) {
-    SCOPED_TRACE(name);
-    TetMesh whole;
-    ReadReport wr;
-    ASSERT_TRUE(readMesh(hpcPath(name), whole, wr));
-    EXPECT_FALSE(wr.shared);
-    std::map<Corner, std::vector<float>> valueAt;  // the whole's point values, by position
-    for (uint32_t v = 0; v < whole.vertexCount(); ++v)
-      for (const ScalarField& f : whole.fields)
-        if (f.name != "c")
-          valueAt[{whole.positions[3 * v], whole.positions[3 * v + 1], whole.positions[3 * v + 2]}].push_back(
-              f.values[v]);
-    std::vector<std::array<Corner, 4>> all;
-    for (uint32_t k = 0; k < 3; ++k) {
-      ReadOptions o;
-      o.shareIndex = k;
-      o.shareCount = 3;
-      TetMesh part;
-      ReadReport r;
-      ASSERT_TRUE(readMesh(hpcPath(name), part, r, o)) << "share " << k;
-      EXPECT_TRUE(r.shared);
-      EXPECT_LT(part.tetCount(), whole.tetCount());
-      ASSERT_EQ(part.fields.size(), whole.fields.size());
-      for (uint32_t v = 0; v < part.vertexCount(); ++v) {
-        std::vector<float> mine;
-        for (const ScalarField& f : part.fields)
-          if (f.name != "c") mine.push_back(f.values[v]);
-        const auto it = valueAt.find({part.positions[3 * v], part.positions[3 * v + 1], part.positions[3 * v + 2]});
-        ASSERT_NE(it, valueAt.end()) << "a point the whole does not have";
-        EXPECT_EQ(mine, it->second);
-      }
-      const auto tets = tetsOf(part);
-      all.insert(all.end(), tets.begin(), tets.end());
-    }
-    auto expected = tetsOf(whole);
-    std::sort(all.begin(), all.end());
-    std::sort(expected.begin(), expected.end());
-    EXPECT_EQ(all, expected);
-  }
+  for (const char* name : {"xdmf_grid.xdmf", "xdmf_binary.xdmf", "xdmf_series.xdmf"})
+    test::expectSharesMakeTheWhole(hpcPath(name), 3, "c");
 }
 
 TEST(XdmfTimeSeries, StepsAreListedAndPicked) {
