@@ -22,7 +22,10 @@
 // A share for one of several processes (ReadOptions::shareIndex of shareCount, core/dist): of a
 // base with at least as many zones as processes, the zones from index·Z/count to
 // (index + 1)·Z/count, each whole (zones meet where their points coincide, which core/dist joins
-// as one process does). A base of fewer zones is read whole by every process.
+// as one process does). A base of one unstructured zone of fixed-type sections: the elements
+// numbered from index·N/count + 1 to (index + 1)·N/count and the vertices from the smallest to
+// the largest they use, with those rows of the solutions (the library's partial reads). Other
+// bases of fewer zones than processes are read whole by every process.
 #include <cgnslib.h>
 
 #include <cmath>
@@ -102,7 +105,11 @@ struct Zone {
   uint64_t dims[3] = {0, 0, 0};  // structured: vertices along i, j, k
   uint64_t vertices = 0, cells = 0;
   uint64_t vertexBase = 0, slotBase = 0;  // where its points and its cells' values start
-  bool stepSolution = false;              // the time step names one solution (below), or none
+  // What is read of it (an unstructured zone read in a share: a window; else everything):
+  // vertices from vertexFirst (0-based), elements numbered from cellFirst + 1.
+  uint64_t vertexFirst = 0, vertexCount = 0, cellFirst = 0, cellCount = 0;
+  bool window = false;        // a share's window: only its elements are read (else every section whole)
+  bool stepSolution = false;  // the time step names one solution (below), or none
   std::string solution;
 };
 
@@ -149,7 +156,8 @@ class CgnsReader {
     }
     if (Result r = chooseBase(); !r) return r;
     if (Result r = readZones(); !r) return r;
-    keepShareOfZones();
+    for (Zone& z : zones_) z.vertexCount = z.vertices, z.cellCount = z.cells;
+    if (Result r = keepShareOfZones(); !r) return r;
     size_t step = 0;
     if (Result r = readTimes(step); !r) return r;
 
@@ -279,10 +287,12 @@ class CgnsReader {
     return Result::success();
   }
 
-  // For one process of several, its zones only (the header comment), numbered from its first.
-  void keepShareOfZones() {
+  // For one process of several, its zones only, or its window of a single zone (the header
+  // comment), numbered from its first.
+  Result keepShareOfZones() {
     const uint64_t n = options_.shareCount, z = zones_.size();
-    if (n < 2 || z < n) return;
+    if (n >= 2 && z == 1 && !zones_[0].structured) return keepShareOfZone(zones_[0]);
+    if (n < 2 || z < n) return Result::success();
     const uint64_t from = z * options_.shareIndex / n, to = z * (options_.shareIndex + 1) / n;
     zones_ = std::vector<Zone>(zones_.begin() + std::ptrdiff_t(from), zones_.begin() + std::ptrdiff_t(to));
     totalVertices_ = totalSlots_ = 0;
@@ -297,6 +307,67 @@ class CgnsReader {
     report_.shared = true;
     report_.notes.push_back("read zones " + std::to_string(from + 1) + " to " + std::to_string(to) + " of " +
                             std::to_string(z) + ", this process's share of the file");
+    return Result::success();
+  }
+
+  // The window of one unstructured zone: the share's elements and the vertices they span. The
+  // share's connectivity is read here to find them and again by readSections (a MIXED section,
+  // whose elements have no fixed size, leaves the zone whole).
+  Result keepShareOfZone(Zone& z) {
+    const uint64_t from = z.cells * options_.shareIndex / options_.shareCount,
+                   to = z.cells * (options_.shareIndex + 1ull) / options_.shareCount;
+    int nsections = 0;
+    if (cg_nsections(file_.fn, base_, z.index, &nsections) != CG_OK)
+      return fail(Status::Corrupt, zoneLabel(z) + ": cannot read its element sections: " + lastCgnsError());
+    uint64_t lo = UINT64_MAX, hi = 0;
+    std::vector<cgsize_t> conn;
+    for (int s = 1; s <= nsections; ++s) {
+      SectionRange r;
+      if (Result res = sectionRange(z, s, from, to, r); !res) return res;
+      if (r.type == "MIXED") return Result::success();
+      if (!r.volume || r.first > r.last) continue;
+      conn.resize(size_t(r.last - r.first + 1) * size_t(r.npe));
+      if (cg_elements_partial_read(file_.fn, base_, z.index, s, r.first, r.last, conn.data(), nullptr) != CG_OK)
+        return fail(Status::Corrupt, r.where + ": " + lastCgnsError());
+      for (cgsize_t v : conn)
+        if (v >= 1 && uint64_t(v) <= z.vertices) lo = std::min(lo, uint64_t(v - 1)), hi = std::max(hi, uint64_t(v));
+    }
+    if (hi == 0) lo = 0;
+    z.vertexFirst = lo;
+    z.vertexCount = hi - lo;
+    z.cellFirst = from;
+    z.cellCount = to - from;
+    z.window = true;
+    totalVertices_ = z.vertexCount;
+    totalSlots_ = z.cellCount;
+    report_.shared = true;
+    report_.notes.push_back("read elements " + std::to_string(from + 1) + " to " + std::to_string(to) + " of " +
+                            std::to_string(z.cells) + " and the " + std::to_string(z.vertexCount) +
+                            " vertices they span, this process's share of the file");
+    return Result::success();
+  }
+
+  // A section's elements within a share's numbers [from + 1, to] (first > last: none), with what
+  // reading them needs.
+  struct SectionRange {
+    std::string where, type;
+    bool volume = false;
+    int npe = 0;
+    cgsize_t first = 0, last = -1;
+  };
+  Result sectionRange(const Zone& z, int s, uint64_t from, uint64_t to, SectionRange& out) {
+    char name[64] = {};
+    CGNS_ENUMT(ElementType_t) etype;
+    cgsize_t start = 0, end = 0;
+    int nbndry = 0, parentFlag = 0;
+    if (cg_section_read(file_.fn, base_, z.index, s, name, &etype, &start, &end, &nbndry, &parentFlag) != CG_OK)
+      return fail(Status::Corrupt, zoneLabel(z) + ": section " + std::to_string(s) + ": " + lastCgnsError());
+    out.where = zoneLabel(z) + " section '" + printable(name) + "'";
+    out.type = elementTypeName(int(etype));
+    out.volume = cgnsType(out.type).volume && cg_npe(etype, &out.npe) == CG_OK && out.npe > 0;
+    out.first = std::max<cgsize_t>(start, cgsize_t(from + 1));
+    out.last = std::min<cgsize_t>(end, cgsize_t(to));
+    return Result::success();
   }
 
   // The step's times from BaseIterativeData, and each zone's solution for it.
@@ -399,18 +470,20 @@ class CgnsReader {
 
   Result readCoordinate(const Zone& z, const char* name, std::vector<double>& values) {
     cgsize_t lo[3] = {1, 1, 1}, hi[3] = {1, 1, 1};
-    if (z.structured)
+    if (z.structured) {
       for (int d = 0; d < 3; ++d) hi[d] = cgsize_t(z.dims[d]);
-    else
-      hi[0] = cgsize_t(z.vertices);
-    values.resize(size_t(z.vertices));
+    } else {
+      lo[0] = cgsize_t(z.vertexFirst + 1);
+      hi[0] = cgsize_t(z.vertexFirst + z.vertexCount);
+    }
+    values.resize(size_t(z.vertexCount));
     if (cg_coord_read(file_.fn, base_, z.index, name, CGNS_ENUMV(RealDouble), lo, hi, values.data()) != CG_OK)
       return fail(Status::Corrupt, zoneLabel(z) + ": " + name + ": " + lastCgnsError());
     return Result::success();
   }
 
   Result readCoordinates(const Zone& z, TetMesh& mesh) {
-    if (z.vertices == 0) return Result::success();
+    if (z.vertexCount == 0) return Result::success();
     int ncoords = 0;
     if (cg_ncoords(file_.fn, base_, z.index, &ncoords) != CG_OK)
       return fail(Status::Corrupt, zoneLabel(z) + ": GridCoordinates: " + lastCgnsError());
@@ -440,12 +513,12 @@ class CgnsReader {
       cylindricalNoted_ = true;
       report_.notes.push_back("converted cylindrical coordinates (R, Theta, Z) to Cartesian");
     }
-    for (uint64_t v = 0; v < z.vertices; ++v) {
+    for (uint64_t v = 0; v < z.vertexCount; ++v) {
       double x = a[v], y = b[v];
       if (cyl) x = a[v] * std::cos(b[v]), y = a[v] * std::sin(b[v]);
       if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(c[v]))
-        return fail(Status::NonFinite,
-                    zoneLabel(z) + ": vertex " + std::to_string(v + 1) + " has a non-finite coordinate");
+        return fail(Status::NonFinite, zoneLabel(z) + ": vertex " + std::to_string(z.vertexFirst + v + 1) +
+                                           " has a non-finite coordinate");
       float* p = &mesh.positions[3 * (z.vertexBase + v)];
       p[0] = float(x), p[1] = float(y), p[2] = float(c[v]);
     }
@@ -461,11 +534,13 @@ class CgnsReader {
   // One element of an unstructured zone: e is its element number (1-based within the zone).
   Result addElement(const Zone& z, const std::string& where, const std::string& type, const CgnsType& kind,
                     const cgsize_t* nodes, int count, int64_t e, CellSoup& soup) {
+    auto inWindow = [&](cgsize_t v) {
+      return uint64_t(v) > z.vertexFirst && uint64_t(v) <= z.vertexFirst + z.vertexCount;
+    };
     if (!kind.volume) {
       ++soup.skipped[{kind.vtkType, "CGNS " + type}];
       for (int q = 0; q < count; ++q)
-        if (nodes[q] >= 1 && uint64_t(nodes[q]) <= z.vertices)
-          soup.referenced[z.vertexBase + uint64_t(nodes[q] - 1)] = 1;
+        if (inWindow(nodes[q])) soup.referenced[z.vertexBase + uint64_t(nodes[q] - 1) - z.vertexFirst] = 1;
       return Result::success();
     }
     const int corners = kShapeCorners[int(kind.shape)];
@@ -479,10 +554,15 @@ class CgnsReader {
         return fail(Status::OutOfRange, where + ": element " + std::to_string(e) + " (" + type + ") uses vertex " +
                                             std::to_string(v) + ", but the zone's vertices are numbered 1.." +
                                             std::to_string(z.vertices));
-      soup.referenced[z.vertexBase + uint64_t(v - 1)] = 1;
-      if (q < corners) ids[q] = uint32_t(z.vertexBase + uint64_t(v - 1));
+      if (!inWindow(v))  // (a share's window covers its elements' vertices: not reached)
+        return fail(Status::OutOfRange, where + ": element " + std::to_string(e) + " uses vertex " + std::to_string(v) +
+                                            " outside the vertices read");
+      soup.referenced[z.vertexBase + uint64_t(v - 1) - z.vertexFirst] = 1;
+      if (q < corners) ids[q] = uint32_t(z.vertexBase + uint64_t(v - 1) - z.vertexFirst);
     }
-    const uint64_t source = e >= 1 && uint64_t(e) <= z.cells ? z.slotBase + uint64_t(e - 1) : kNoCellValue;
+    const uint64_t source = uint64_t(e) > z.cellFirst && uint64_t(e) <= z.cellFirst + z.cellCount
+                                ? z.slotBase + uint64_t(e - 1) - z.cellFirst
+                                : kNoCellValue;
     soup.add(kind.shape, ids, source);
     if (count > corners) {
       auto& r = soup.reduced["CGNS " + type];
@@ -510,13 +590,17 @@ class CgnsReader {
         return fail(Status::Corrupt, where + ": element range " + std::to_string(start) + ".." + std::to_string(end));
       const uint64_t count = uint64_t(end) - uint64_t(start) + 1;
       if (Result r = checkCount(where + ": its number of elements", count, 4); !r) return r;
-      soup.inputCells += count;
+      // The elements read: all, or those in a share's window (first > last: none).
+      const cgsize_t first = z.window ? std::max<cgsize_t>(start, cgsize_t(z.cellFirst + 1)) : start,
+                     last = z.window ? std::min<cgsize_t>(end, cgsize_t(z.cellFirst + z.cellCount)) : end;
+      const uint64_t reading = last >= first ? uint64_t(last - first + 1) : 0;
+      soup.inputCells += reading;
       if (type == "NFACE_n")
         return fail(Status::Unsupported, where + ": " + std::to_string(count) +
                                              " NFACE_n cells (polyhedra given by their faces) are not read; "
                                              "convert the zone to standard elements (TETRA_4, HEXA_8, ...)");
       if (type == "NGON_n") {  // faces of polyhedra or a polygonal surface: not volume cells
-        soup.skipped[{7, "CGNS NGON_n"}] += count;
+        soup.skipped[{7, "CGNS NGON_n"}] += reading;
         continue;
       }
       cgsize_t dataSize = 0;
@@ -538,11 +622,13 @@ class CgnsReader {
         return fail(Status::Corrupt, where + ": " + std::to_string(count) + " " + type + " elements need " +
                                          std::to_string(count * uint64_t(npe)) + " node ids, the section has " +
                                          std::to_string(dataSize));
-      if (!conn.empty() && cg_elements_read(file_.fn, base_, z.index, s, conn.data(), nullptr) != CG_OK)
+      if (reading == 0) continue;
+      conn.resize(size_t(reading) * size_t(npe));
+      if (cg_elements_partial_read(file_.fn, base_, z.index, s, first, last, conn.data(), nullptr) != CG_OK)
         return fail(Status::Corrupt, where + ": " + lastCgnsError());
-      for (uint64_t k = 0; k < count; ++k)
+      for (uint64_t k = 0; k < reading; ++k)
         if (Result r = addElement(z, where, type, kind, &conn[size_t(k) * size_t(npe)], npe,
-                                  int64_t(start) + int64_t(k), soup);
+                                  int64_t(first) + int64_t(k), soup);
             !r)
           return r;
     }
@@ -665,12 +751,14 @@ class CgnsReader {
     int nfields = 0;
     if (cg_nfields(file_.fn, base_, z.index, s, &nfields) != CG_OK)
       return fail(Status::Corrupt, where + ": " + lastCgnsError());
-    const uint64_t n = vertex ? z.vertices : z.cells;
+    const uint64_t n = vertex ? z.vertexCount : z.cellCount;
     cgsize_t lo[3] = {1, 1, 1}, hi[3] = {1, 1, 1};
-    if (z.structured)
+    if (z.structured) {
       for (int d = 0; d < 3; ++d) hi[d] = cgsize_t(vertex ? z.dims[d] : z.dims[d] - 1);
-    else
-      hi[0] = cgsize_t(n);
+    } else {
+      lo[0] = cgsize_t((vertex ? z.vertexFirst : z.cellFirst) + 1);
+      hi[0] = cgsize_t((vertex ? z.vertexFirst : z.cellFirst) + n);
+    }
     std::vector<double> values(static_cast<size_t>(n));
     for (int f = 1; f <= nfields; ++f) {
       char fname[64] = {};

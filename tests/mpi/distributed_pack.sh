@@ -87,6 +87,9 @@ sharesLikeOneProcess() {
 # coincide, as in one process.
 sharesLikeOneProcess cgns "$HPC/cgns_structured.cgns" "this process's share of the file" "2" "1.05 1.35" \
   --base-vertices 8 --leaf-vertices 4
+# A CGNS base of one unstructured zone: each rank reads its elements and the vertices they span.
+sharesLikeOneProcess cgns-zone "$HPC/cgns_steps.cgns" "this process's share of the file" "2" "12 14" \
+  --base-vertices 8 --leaf-vertices 4
 
 # One XDMF grid with HDF5 heavy data and one Exodus II file, as meshio writes them (DOLFINx and
 # others write XDMF so: one file for the whole mesh): each rank reads its rows of the cells (HDF5

@@ -561,10 +561,13 @@ TEST(ExodusShares, TheSharesOfAFileHoldEveryTetOnceWithItsValues) {
   }
 }
 
-// A CGNS base of as many zones as processes or more: each reads its zones whole.
-TEST(CgnsShares, EachProcessReadsItsZones) {
+// A CGNS base of as many zones as processes or more: each reads its zones whole. A base of one
+// unstructured zone: each reads its elements and the vertices they span, with its rows of the
+// solutions (a time series here: the step's solution).
+TEST(CgnsShares, EachProcessReadsItsZonesOrItsElements) {
   for (const char* name : {"cgns_unstructured.cgns", "cgns_structured.cgns", "cgns_structured.adf.cgns"})
     test::expectSharesMakeTheWhole(hpcPath(name), 2);
+  for (uint32_t count : {2u, 3u}) test::expectSharesMakeTheWhole(hpcPath("cgns_steps.cgns"), count);
   TetMesh m;
   ReadReport r;
   ReadOptions o;
