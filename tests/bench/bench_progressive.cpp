@@ -7,6 +7,10 @@
 //   tetstream_bench vtu MESH OUT.vtu
 //       any mesh our readers take, written as .vtu in the order read (structured grids and
 //       hexahedra split into tets), so that VTK gets the very tets we pack, numbered as in the file
+//   tetstream_bench regions PACKDIR OUT.vtu --bytes N
+//       the level the viewer holds when it loads everything of a dataset of regions, once N bytes
+//       of chunks are in: regions in its order (most field error first, each after its parent;
+//       wasm/fetch_plan.cpp, every region in view), as .vtu
 //   tetstream_bench isodist ORIGINAL.vtu APPROX.vtu --field F --value V
 //       distance between the isosurfaces of the two meshes (area-weighted mean and max over
 //       triangle centroids and vertices, both directions, relative to ORIGINAL's diagonal)
@@ -17,10 +21,13 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <queue>
 #include <string>
 #include <vector>
 
+#include "dataset.h"
 #include "io/mesh_io.h"
+#include "partial.h"
 #include "isosurface.h"
 #include "tet_quality.h"
 
@@ -345,6 +352,46 @@ int cmdVtu(char** argv) {
   return 0;
 }
 
+int cmdRegions(int argc, char** argv) {
+  const std::string dir = argv[2];
+  const double budget = std::atof(arg(argc, argv, "--bytes", "0"));
+  std::string json;
+  PartialDataset pd;
+  auto source = [&](uint32_t index, std::vector<uint8_t>& file) {
+    return readFileBytes(dir + "/" + pd.manifest.chunks[index].file, pd.manifest.chunks[index].bytes, file);
+  };
+  Result r = readManifestFile(dir, json);
+  if (r) r = openPartial(pd, json, source);
+  const Manifest& m = pd.manifest;
+  // Ready regions (parent applied) by the viewer's priority: measured field error.
+  std::priority_queue<std::pair<double, uint32_t>> ready;
+  auto offer = [&](uint32_t k) {
+    const NodeInfo& n = m.nodes[k];
+    ready.push({n.fieldMax >= 0 ? n.fieldMax : n.fieldError, k});
+  };
+  for (uint32_t k = 0; k < m.nodes.size(); ++k)
+    if (m.nodes[k].parent < 0) offer(k);
+  while (r && !ready.empty()) {
+    const uint32_t k = ready.top().second;
+    uint64_t bytes = 0;
+    for (uint32_t c = m.nodes[k].firstChunk; c < m.nodes[k].firstChunk + m.nodes[k].chunkCount; ++c)
+      bytes += m.chunks[c].bytes;
+    if (double(pd.bytesLoaded + bytes) > budget) break;
+    ready.pop();
+    r = applyNode(pd, k, source);
+    for (uint32_t c = 0; c < m.nodes.size(); ++c)
+      if (m.nodes[c].parent == int32_t(k)) offer(c);
+  }
+  if (r) r = writeMesh(argv[3], pd.pm.mesh);
+  if (!r) {
+    std::fprintf(stderr, "%s\n", r.message.c_str());
+    return 1;
+  }
+  std::printf("{\"bytes\": %llu, \"regions\": %zu, \"vertices\": %u}\n", (unsigned long long)pd.bytesLoaded,
+              pd.applied.size(), pd.pm.vertexCount());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -352,9 +399,10 @@ int main(int argc, char** argv) {
   if (argc >= 4 && !std::strcmp(argv[1], "isodist")) return cmdIsoDistance(argc, argv);
   if (argc >= 4 && !std::strcmp(argv[1], "raw")) return cmdRaw(argv);
   if (argc >= 4 && !std::strcmp(argv[1], "vtu")) return cmdVtu(argv);
+  if (argc >= 4 && !std::strcmp(argv[1], "regions")) return cmdRegions(argc, argv);
   std::fprintf(
       stderr,
       "usage: tetstream_bench error ORIG.vtu APPROX.vtu [--field F] | raw MESH.vtu OUT.bin | vtu MESH OUT.vtu | "
-      "isodist ORIG.vtu APPROX.vtu [--field F] [--value V]\n");
+      "isodist ORIG.vtu APPROX.vtu [--field F] [--value V] | regions PACKDIR OUT.vtu --bytes N\n");
   return 2;
 }
