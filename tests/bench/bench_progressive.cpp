@@ -27,8 +27,8 @@
 
 #include "dataset.h"
 #include "io/mesh_io.h"
-#include "partial.h"
 #include "isosurface.h"
+#include "partial.h"
 #include "tet_quality.h"
 
 using namespace tetstream;
