@@ -108,8 +108,9 @@ struct Zone {
   // What is read of it (an unstructured zone read in a share: a window; else everything):
   // vertices from vertexFirst (0-based), elements numbered from cellFirst + 1.
   uint64_t vertexFirst = 0, vertexCount = 0, cellFirst = 0, cellCount = 0;
-  bool window = false;        // a share's window: only its elements are read (else every section whole)
-  bool stepSolution = false;  // the time step names one solution (below), or none
+  bool window = false;  // a share's window: only its elements are read (else every section whole)
+  std::map<int, std::vector<cgsize_t>> windowConnectivity;  // per section: its window's elements, read once
+  bool stepSolution = false;                                // the time step names one solution (below), or none
   std::string solution;
 };
 
@@ -311,7 +312,7 @@ class CgnsReader {
   }
 
   // The window of one unstructured zone: the share's elements and the vertices they span. The
-  // share's connectivity is read here to find them and again by readSections (a MIXED section,
+  // share's connectivity is read here to find them and kept for readSections (a MIXED section,
   // whose elements have no fixed size, leaves the zone whole).
   Result keepShareOfZone(Zone& z) {
     const uint64_t from = z.cells * options_.shareIndex / options_.shareCount,
@@ -320,15 +321,21 @@ class CgnsReader {
     if (cg_nsections(file_.fn, base_, z.index, &nsections) != CG_OK)
       return fail(Status::Corrupt, zoneLabel(z) + ": cannot read its element sections: " + lastCgnsError());
     uint64_t lo = UINT64_MAX, hi = 0;
-    std::vector<cgsize_t> conn;
     for (int s = 1; s <= nsections; ++s) {
-      SectionRange r;
-      if (Result res = sectionRange(z, s, from, to, r); !res) return res;
-      if (r.type == "MIXED") return Result::success();
-      if (!r.volume || r.first > r.last) continue;
-      conn.resize(size_t(r.last - r.first + 1) * size_t(r.npe));
-      if (cg_elements_partial_read(file_.fn, base_, z.index, s, r.first, r.last, conn.data(), nullptr) != CG_OK)
-        return fail(Status::Corrupt, r.where + ": " + lastCgnsError());
+      Section sec;
+      if (Result r = readSection(z, s, sec); !r) return r;
+      if (sec.type == "MIXED") {
+        z.windowConnectivity.clear();
+        return Result::success();
+      }
+      int npe = 0;
+      const cgsize_t first = std::max<cgsize_t>(sec.start, cgsize_t(from + 1)),
+                     last = std::min<cgsize_t>(sec.end, cgsize_t(to));
+      if (!cgnsType(sec.type).volume || cg_npe(sec.etype, &npe) != CG_OK || npe < 1 || first > last) continue;
+      std::vector<cgsize_t>& conn = z.windowConnectivity[s];
+      conn.resize(size_t(last - first + 1) * size_t(npe));
+      if (cg_elements_partial_read(file_.fn, base_, z.index, s, first, last, conn.data(), nullptr) != CG_OK)
+        return fail(Status::Corrupt, sec.where + ": " + lastCgnsError());
       for (cgsize_t v : conn)
         if (v >= 1 && uint64_t(v) <= z.vertices) lo = std::min(lo, uint64_t(v - 1)), hi = std::max(hi, uint64_t(v));
     }
@@ -347,26 +354,20 @@ class CgnsReader {
     return Result::success();
   }
 
-  // A section's elements within a share's numbers [from + 1, to] (first > last: none), with what
-  // reading them needs.
-  struct SectionRange {
+  // Section s of zone z as the file declares it.
+  struct Section {
     std::string where, type;
-    bool volume = false;
-    int npe = 0;
-    cgsize_t first = 0, last = -1;
-  };
-  Result sectionRange(const Zone& z, int s, uint64_t from, uint64_t to, SectionRange& out) {
-    char name[64] = {};
     CGNS_ENUMT(ElementType_t) etype;
     cgsize_t start = 0, end = 0;
+  };
+  Result readSection(const Zone& z, int s, Section& out) {
+    char name[64] = {};
     int nbndry = 0, parentFlag = 0;
-    if (cg_section_read(file_.fn, base_, z.index, s, name, &etype, &start, &end, &nbndry, &parentFlag) != CG_OK)
+    if (cg_section_read(file_.fn, base_, z.index, s, name, &out.etype, &out.start, &out.end, &nbndry, &parentFlag) !=
+        CG_OK)
       return fail(Status::Corrupt, zoneLabel(z) + ": section " + std::to_string(s) + ": " + lastCgnsError());
     out.where = zoneLabel(z) + " section '" + printable(name) + "'";
-    out.type = elementTypeName(int(etype));
-    out.volume = cgnsType(out.type).volume && cg_npe(etype, &out.npe) == CG_OK && out.npe > 0;
-    out.first = std::max<cgsize_t>(start, cgsize_t(from + 1));
-    out.last = std::min<cgsize_t>(end, cgsize_t(to));
+    out.type = elementTypeName(int(out.etype));
     return Result::success();
   }
 
@@ -572,20 +573,18 @@ class CgnsReader {
     return Result::success();
   }
 
-  Result readSections(const Zone& z, CellSoup& soup) {
+  Result readSections(Zone& z, CellSoup& soup) {
     int nsections = 0;
     if (cg_nsections(file_.fn, base_, z.index, &nsections) != CG_OK)
       return fail(Status::Corrupt, zoneLabel(z) + ": cannot read its element sections: " + lastCgnsError());
     if (soup.referenced.size() < totalVertices_) soup.referenced.resize(size_t(totalVertices_), 0);
     for (int s = 1; s <= nsections; ++s) {
-      char name[64] = {};
-      CGNS_ENUMT(ElementType_t) etype;
-      cgsize_t start = 0, end = 0;
-      int nbndry = 0, parentFlag = 0;
-      if (cg_section_read(file_.fn, base_, z.index, s, name, &etype, &start, &end, &nbndry, &parentFlag) != CG_OK)
-        return fail(Status::Corrupt, zoneLabel(z) + ": section " + std::to_string(s) + ": " + lastCgnsError());
-      const std::string where = zoneLabel(z) + " section '" + printable(name) + "'";
-      const std::string type = elementTypeName(int(etype));
+      Section sec;
+      if (Result r = readSection(z, s, sec); !r) return r;
+      const std::string& where = sec.where;
+      const std::string& type = sec.type;
+      const CGNS_ENUMT(ElementType_t) etype = sec.etype;
+      const cgsize_t start = sec.start, end = sec.end;
       if (end < start)
         return fail(Status::Corrupt, where + ": element range " + std::to_string(start) + ".." + std::to_string(end));
       const uint64_t count = uint64_t(end) - uint64_t(start) + 1;
@@ -623,9 +622,14 @@ class CgnsReader {
                                          std::to_string(count * uint64_t(npe)) + " node ids, the section has " +
                                          std::to_string(dataSize));
       if (reading == 0) continue;
-      conn.resize(size_t(reading) * size_t(npe));
-      if (cg_elements_partial_read(file_.fn, base_, z.index, s, first, last, conn.data(), nullptr) != CG_OK)
-        return fail(Status::Corrupt, where + ": " + lastCgnsError());
+      if (auto kept = z.windowConnectivity.find(s); kept != z.windowConnectivity.end()) {
+        conn = std::move(kept->second);  // (read when the window was chosen)
+        z.windowConnectivity.erase(kept);
+      } else {
+        conn.resize(size_t(reading) * size_t(npe));
+        if (cg_elements_partial_read(file_.fn, base_, z.index, s, first, last, conn.data(), nullptr) != CG_OK)
+          return fail(Status::Corrupt, where + ": " + lastCgnsError());
+      }
       for (uint64_t k = 0; k < reading; ++k)
         if (Result r = addElement(z, where, type, kind, &conn[size_t(k) * size_t(npe)], npe,
                                   int64_t(first) + int64_t(k), soup);

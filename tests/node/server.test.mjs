@@ -286,15 +286,15 @@ function testCertificate() {
 // One GET over HTTP/2 (TLS, the test's certificate trusted): status, headers, body.
 function http2Get(base, target, ca) {
   return new Promise((resolve, reject) => {
-    const session = http2.connect(base, { ca });
-    session.on('error', reject);
-    const req = session.request({ ':path': target });
+    const client = http2.connect(base, { ca });
+    client.on('error', reject);
+    const req = client.request({ ':path': target });
     const parts = [];
     let headers;
     req.on('response', (h) => { headers = h; });
     req.on('data', (d) => parts.push(d));
     req.on('end', () => {
-      session.close();
+      client.close();
       resolve({ status: headers[':status'], headers, body: Buffer.concat(parts) });
     });
     req.on('error', reject);

@@ -417,19 +417,23 @@ StableMesh stableMesh(const Dataset& ds) {
   return stableMesh(ds.pm.mesh, stableOf);
 }
 
+// Harmonic 16³ packed in regions of at most `leafVertices` vertices and chunks of `chunkKb` KB.
+std::string packHarmonic16(const std::string& name, uint32_t leafVertices, uint32_t chunkKb) {
+  PackOptions o;
+  o.leafVertices = leafVertices;
+  o.chunkKb = chunkKb;
+  return pack(name, harmonic(16), o);
+}
+
 }  // namespace
 
 // Chunks of several nodes may arrive interleaved (the loader fetches in parallel): a node of
 // several chunks whose next chunk comes after another node's. Every vertex still gets the place
 // its stable id names, and the level is the same mesh as the nodes loaded one after the other.
 TEST(Partial, ChunksOfSeveralNodesMayInterleave) {
-  PackOptions o;
-  o.leafVertices = 512;
-  o.chunkKb = 1;
-  const std::string dir = pack("partial-interleaved", harmonic(16), o);
-  const std::string json = loadFile(dir + "/manifest.json");
   Dataset ds;
-  ASSERT_TRUE(openDataset(ds, json));
+  const std::string dir = packHarmonic16("partial-interleaved", 512, 1);
+  ASSERT_TRUE(openDataset(ds, loadFile(dir + "/manifest.json")));
   const Manifest& m = ds.manifest;
   uint32_t multiChunk = 0;
   for (const NodeInfo& n : m.nodes) multiChunk += n.parent >= 0 && n.chunkCount > 1;
@@ -476,13 +480,9 @@ TEST(Partial, ChunksOfSeveralNodesMayInterleave) {
 // again. A node with a received child, or with splits applied, is refused and nothing changes.
 TEST(Partial, ADatasetForgetsNodesItNoLongerNeeds) {
   std::mt19937 rng(21);
-  PackOptions o;
-  o.leafVertices = 256;
-  o.chunkKb = 2;
-  const std::string dir = pack("partial-forget", harmonic(16), o);
-  const std::string json = loadFile(dir + "/manifest.json");
   Dataset ds;
-  ASSERT_TRUE(openDataset(ds, json));
+  const std::string dir = packHarmonic16("partial-forget", 256, 2);
+  ASSERT_TRUE(openDataset(ds, loadFile(dir + "/manifest.json")));
   const Manifest& m = ds.manifest;
   auto file = [&](uint32_t index) { return loadBytes(dir + "/" + m.chunks[index].file); };
   std::vector<uint32_t> changed;
