@@ -18,7 +18,7 @@ import { precompressDir } from '../../server/precompress.mjs';
 import { startNginx, startPythonHttpServer } from '../support/nginx.mjs';
 import {
   webDir, outDir, checkBuilds, launchBrowser, makePack, cliIso, readManifest, assertSurfaceMatches, openViewer,
-  waitForState, waitForLevel, frames, frameReport,
+  waitForState, waitForChunksReceived, waitForLevel, frames, frameReport,
 } from './support.mjs';
 
 let tmp, pack, manifest, browser, own, ownUrl, dataServer, dataUrl;
@@ -433,7 +433,7 @@ test('a 404 chunk stops the stream with a message naming the part; the loaded le
     'Showing the last complete level.');
   assert.equal(await page.textContent('#status-text'), s.error);
   assert.equal(requestsFor(6, since).length, 1, 'a 404 is not retried');
-  assert.equal(s.chunksReceived, 6, 'every chunk before it was kept');
+  assert.equal((await waitForChunksReceived(page, 6)).chunksReceived, 6, 'every chunk before it was kept');
   const level = await waitForLevel(page);
   assert.equal(level.vertices, manifest.chunks[5].vertices);
   assertSurfaceMatches(level, reference(level.isovalue, 6), 'the level reached');

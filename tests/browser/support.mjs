@@ -118,6 +118,14 @@ export async function waitForState(page, states, timeout = 120000) {
   return page.evaluate(() => window.tetstream.stats());
 }
 
+// The page shows a failure as soon as the loader gives up; the refinement worker's report of
+// what it holds (the model's figures in stats(), absent before its first report) may come a
+// moment later. Waits for it to hold `count` chunks, or a while; the caller asserts the count.
+export async function waitForChunksReceived(page, count, timeout = 30000) {
+  await page.waitForFunction((n) => window.tetstream.stats().chunksReceived >= n, count, { timeout }).catch(() => {});
+  return page.evaluate(() => window.tetstream.stats());
+}
+
 // Waits until the level has reached its target (the refinement worker applies splits in
 // slices) with the latest view applied (viewCurrent: the worker has answered every change).
 export async function waitForLevel(page, timeout = 120000) {
