@@ -14,8 +14,9 @@
 
 namespace tetstream::dist {
 
-// Reads this rank's share: its files of a listing or partitions of a VTKHDF file, or its slice
-// of the tets of any other file (read whole).
+// Reads this rank's share: what its reader can read of the file alone (files of a listing,
+// partitions, pieces, rows or zones: ReadOptions), or else its slice of the tets of the file
+// read whole.
 Result readShare(Comm& comm, const std::string& input, ReadOptions read, TetMesh& mesh, ReadReport& report);
 
 // The fields every rank read, compared (ranks without tets take them). The same on every rank.

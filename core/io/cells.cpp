@@ -4,17 +4,20 @@
 // 1. Coincident vertices (bit-equal float coordinates, -0 = +0) are merged into the first copy;
 //    point fields are averaged over each group.
 // 2. Cells become tetrahedra. A tetrahedron stays as it is. Every other cell is coned from its
-//    corner with the smallest (merged) vertex id, m, over each face that does not contain m; a
-//    quad face is cut along the diagonal through its own smallest vertex id. Two cells sharing a
-//    quad face therefore cut it the same way (the rule looks at the face's ids only), and the
-//    faces at m are cut through m, which the cone needs. Because the smallest id of the whole cell
-//    always has its three (hexahedron), two (wedge) or one (pyramid) quad faces cut through it,
-//    every hexahedron gets 6 tetrahedra, a wedge 3, a pyramid 2: the diagonal configurations that
-//    need a Steiner point (cyclic diagonals, as in Schoenhardt's prism) cannot arise under this
-//    rule. On a structured grid numbered i fastest, the smallest id of a cell is its (i, j, k)
-//    corner and every face is cut from its lowest to its highest corner: the Kuhn split along the
-//    cell's main diagonal. A split cell's tetrahedra are oriented together by the sign of their
-//    total volume, so a mirrored corner order in the input does not invert them.
+//    lowest corner, m, over each face that does not contain m; a quad face is cut along the
+//    diagonal through its own lowest corner. "Lowest" is first in the order of the corners'
+//    coordinates (x, then y, then z; the merged vertex id only between copies left apart at one
+//    position), not of their ids: the processes of a distributed pack number the pieces they read
+//    each their own way, and a face two of them hold must still be cut the same way. Two cells
+//    sharing a quad face therefore cut it the same way (the rule looks at the face's corners only),
+//    and the faces at m are cut through m, which the cone needs. Because the lowest corner of the
+//    whole cell always has its three (hexahedron), two (wedge) or one (pyramid) quad faces cut
+//    through it, every hexahedron gets 6 tetrahedra, a wedge 3, a pyramid 2: the diagonal
+//    configurations that need a Steiner point (cyclic diagonals, as in Schoenhardt's prism) cannot
+//    arise under this rule. On an axis-aligned grid the lowest corner of a cell is its
+//    (xmin, ymin, zmin) corner and every face is cut from its lowest to its highest corner: the
+//    Kuhn split along the cell's main diagonal. A split cell's tetrahedra are oriented together by
+//    the sign of their total volume, so a mirrored corner order in the input does not invert them.
 // 3. Tetrahedra with a repeated vertex (collapsed cells, or duplicates that were merged) have no
 //    volume and no interior: they are dropped, which keeps the mesh conforming.
 // 4. Cell arrays become point fields: the value at a vertex is the average over the cells around
@@ -63,8 +66,18 @@ constexpr ShapeFaces kFaces[4] = {
 constexpr const char* kShapeNames[4][2] = {
     {"tetrahedron", "tetrahedra"}, {"pyramid", "pyramids"}, {"wedge", "wedges"}, {"hexahedron", "hexahedra"}};
 
-// Splits one cell (corner ids after merging) into tets appended to out (4 ids each).
-void splitCell(CellShape shape, const uint32_t* ids, std::vector<uint32_t>& out) {
+// Whether vertex a comes before b in the split's order: by coordinates (x, y, z), then by id.
+bool lower(const float* pos, uint32_t a, uint32_t b) {
+  const float* p = pos + 3 * size_t(a);
+  const float* q = pos + 3 * size_t(b);
+  for (int k = 0; k < 3; ++k)
+    if (p[k] != q[k]) return p[k] < q[k];
+  return a < b;
+}
+
+// Splits one cell (corner ids after merging; pos: the vertices' coordinates) into tets appended
+// to out (4 ids each).
+void splitCell(CellShape shape, const uint32_t* ids, const float* pos, std::vector<uint32_t>& out) {
   const int nc = kShapeCorners[int(shape)];
   if (shape == CellShape::Tet) {
     out.insert(out.end(), ids, ids + 4);
@@ -72,7 +85,7 @@ void splitCell(CellShape shape, const uint32_t* ids, std::vector<uint32_t>& out)
   }
   int m = 0;
   for (int k = 1; k < nc; ++k)
-    if (ids[k] < ids[m]) m = k;
+    if (lower(pos, ids[k], ids[m])) m = k;
   const uint32_t apex = ids[m];
   const ShapeFaces& sf = kFaces[int(shape)];
   for (int f = 0; f < sf.count; ++f) {
@@ -92,7 +105,7 @@ void splitCell(CellShape shape, const uint32_t* ids, std::vector<uint32_t>& out)
     }
     int k = 0;
     for (int q = 1; q < 4; ++q)
-      if (g[q] < g[k]) k = q;
+      if (lower(pos, g[q], g[k])) k = q;
     if (k == 0 || k == 2)
       out.insert(out.end(), {apex, g[0], g[1], g[2], apex, g[0], g[2], g[3]});
     else
@@ -217,7 +230,7 @@ void splitAll(const CellSoup& soup, const uint32_t* remap, const float* pos, boo
     for (int k = 0; k < nc; ++k) mapped[k] = remap ? remap[ids[k]] : ids[k];
     ids += nc;
     local.clear();
-    splitCell(shape, mapped, local);
+    splitCell(shape, mapped, pos, local);
     const size_t nt = local.size() / 4;
     if (shape != CellShape::Tet) {
       double total = 0;
@@ -428,7 +441,6 @@ uint64_t appendStructuredCells(uint64_t ni, uint64_t nj, uint64_t nk, uint64_t v
         soup.add(CellShape::Hex, ids, sourceBase + i + (ni - 1) * (j + (nj - 1) * k));
         ++added;
       }
-  soup.structuredCells += added;
   return added;
 }
 
@@ -523,9 +535,9 @@ Result finishMesh(const std::string& label, TetMesh& mesh, CellSoup& soup, std::
     for (int sh : {3, 2, 1})
       if (shapeCount[sh])
         what += (what.empty() ? "" : ", ") + plural(shapeCount[sh], kShapeNames[sh][0], kShapeNames[sh][1]);
-    std::string how = soup.structuredCells == shapeCount[3] && !shapeCount[1] && !shapeCount[2]
-                          ? " (grid cells: 6 tetrahedra around each cell's main diagonal, the same in every cell)"
-                          : " (each quad face cut through its smallest vertex id, so neighbouring cells agree)";
+    const std::string how =
+        " (each quad face cut through its corner lowest in x, then y, then z, so neighbouring "
+        "cells agree whoever read them)";
     report.notes.push_back("split " + what + " into " + std::to_string(split.madeFromSplit) + " tetrahedra" + how);
   }
   if (split.degenerateTets)

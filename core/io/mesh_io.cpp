@@ -338,6 +338,9 @@ Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const
     return guarded(path, out, [&] {
       return readListing(bytes, path, pieceFiles(path), out, report, options.shareIndex, options.shareCount);
     });
+  if (fmt == Format::VtkXml)
+    return guarded(path, out,
+                   [&] { return readVtu(bytes, path, out, report, options.shareIndex, options.shareCount); });
   return guarded(path, out, [&] { return readOneFile(fmt, bytes, path, out, report); });
 }
 

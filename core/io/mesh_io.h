@@ -17,8 +17,9 @@
 //
 // What a read produces (TetMesh, core/mesh.h), the same for every format (cells.cpp):
 //   - Tetrahedra stay; hexahedra, wedges and pyramids (and structured grid cells) are split into
-//     6, 3 and 2 tetrahedra, each quad face cut through its smallest vertex id so neighbouring
-//     cells agree (conforming); higher-order cells keep their corners.
+//     6, 3 and 2 tetrahedra, each quad face cut through its corner lowest in (x, y, z) so
+//     neighbouring cells agree (conforming), however the reader numbered them; higher-order
+//     cells keep their corners.
 //   - Coincident vertices (equal coordinates) are merged; tetrahedra that then repeat a vertex are
 //     dropped; vertices no tetrahedron uses (mid-edge nodes, unreferenced points) are dropped.
 //   - 1-component point arrays become scalar fields under their own name; n-component arrays
@@ -95,7 +96,8 @@ struct ReadOptions {
   // the listed files from shareIndex·n/shareCount up to (shareIndex + 1)·n/shareCount, n the
   // files listed (each process of a distributed pack reads its own; every path is still
   // checked). A share with no file gives an empty mesh. A VTKHDF file of at least shareCount
-  // partitions: the partitions likewise. An XDMF file of one grid of one cell type: the cells
+  // partitions, or a VTK XML file of at least shareCount <Piece>s: the partitions or pieces
+  // likewise. An XDMF file of one grid of one cell type: the cells
   // in those rows of its topology and the points from the smallest to the largest id they use.
   // An Exodus II file: the elements in those rows of its blocks (in file order) and the nodes
   // from the smallest to the largest they use. A CGNS base of at least shareCount zones: those

@@ -337,7 +337,6 @@ Result concatenate(const std::string& label, std::vector<MeshPiece>& pieces, con
     for (uint32_t v : p.soup.corners) soup.corners.push_back(uint32_t(j.pointBase[k] + v));
     for (uint32_t c : p.soup.source) soup.source.push_back(uint32_t(j.cellBase[k] + c));
     soup.inputCells += p.soup.inputCells;
-    soup.structuredCells += p.soup.structuredCells;
     for (const auto& [type, r] : p.soup.reduced) {
       auto& into = soup.reduced[type];
       into.first = r.first;

@@ -24,7 +24,9 @@ namespace tetstream {
 // Several Pieces are the pieces of one mesh (PETSc writes one per rank): mergePieces() drops ghost
 // cells and welds the points they share. Point and cell data are read; vtkGhostType and global id
 // arrays describe the partition and are not fields. `label` names the source in messages.
-Result readVtu(std::string_view bytes, const std::string& label, TetMesh& out, ReadReport& report);
+// shareIndex, shareCount: as readVtuPieces (a distributed pack's process reads its pieces).
+Result readVtu(std::string_view bytes, const std::string& label, TetMesh& out, ReadReport& report,
+               uint32_t shareIndex = 0, uint32_t shareCount = 1);
 
 // Legacy VTK (.vtk) DATASET UNSTRUCTURED_GRID, STRUCTURED_POINTS, STRUCTURED_GRID or
 // RECTILINEAR_GRID, ASCII or BINARY (big-endian), versions up to 5.1: classic CELLS n size and
@@ -195,7 +197,6 @@ struct CellSoup {
   // Vertices some input cell lists (any node, also mid-edge nodes and nodes of skipped cells).
   // Readers that cannot leave a vertex out (structured grids) may leave it empty.
   std::vector<uint8_t> referenced;
-  uint64_t structuredCells = 0;  // hexahedra made from a structured grid (noted apart)
 
   void add(CellShape shape, const uint32_t* ids, uint64_t sourceIndex) {
     shapes.push_back(uint8_t(shape));
@@ -409,9 +410,11 @@ Result mergePieces(const std::string& label, std::vector<MeshPiece>& pieces, con
                    ReadReport& report, PieceMergeSummary& summary);
 
 // The pieces of a VTK XML file, one MeshPiece per <Piece> (vtu_reader.cpp); report.format says
-// what was read. readVtu() is this followed by mergePieces().
+// what was read. readVtu() is this followed by mergePieces(). Of a file of at least shareCount
+// pieces only share shareIndex is read: pieces shareIndex·n/shareCount up to
+// (shareIndex + 1)·n/shareCount (ReadReport::shared says).
 Result readVtuPieces(std::string_view bytes, const std::string& label, std::vector<MeshPiece>& pieces,
-                     ReadReport& report);
+                     ReadReport& report, uint32_t shareIndex = 0, uint32_t shareCount = 1);
 // A legacy VTK file as one MeshPiece (vtk_reader.cpp); readLegacyVtk() merges it alone.
 Result readLegacyVtkPiece(std::string_view bytes, const std::string& label, MeshPiece& piece, ReadReport& report);
 // The VTKFile type attribute of a VTK XML file ("UnstructuredGrid"), from its first bytes; empty

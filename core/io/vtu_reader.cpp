@@ -644,7 +644,7 @@ Result locateAppended(std::string_view bytes, const std::string& label, size_t& 
 }  // namespace
 
 Result vtkio::readVtuPieces(std::string_view bytes, const std::string& label, std::vector<MeshPiece>& pieces,
-                            ReadReport& report) {
+                            ReadReport& report, uint32_t shareIndex, uint32_t shareCount) {
   pieces.clear();
   // Sniff before XML parsing so a legacy file or junk gets a clear message.
   size_t start = 0;
@@ -739,13 +739,23 @@ Result vtkio::readVtuPieces(std::string_view bytes, const std::string& label, st
   for (pugi::xml_node p : grid.children("Piece")) nodes.push_back(p);
   if (nodes.empty()) return fail(Status::Corrupt, label + ": <" + type + "> has no <Piece>");
 
+  // A share of the pieces: the others are never decoded (their points are welded to these by
+  // the distributed pack, as the pieces of a listing are).
+  size_t from = 0, to = nodes.size();
+  if (shareCount > 1 && nodes.size() >= shareCount) {
+    from = nodes.size() * shareIndex / shareCount;
+    to = nodes.size() * (shareIndex + 1ull) / shareCount;
+    report.shared = true;
+    report.notes.push_back("read pieces " + std::to_string(from + 1) + " to " + std::to_string(to) + " of " +
+                           std::to_string(nodes.size()) + ", this process's share of the file");
+  }
   pieces.clear();
-  pieces.reserve(nodes.size());  // bounded: each is an element of the file
-  for (size_t k = 0; k < nodes.size(); ++k) {
+  pieces.reserve(to - from);  // bounded: each is an element of the file
+  for (size_t k = from; k < to; ++k) {
     MeshPiece& piece = pieces.emplace_back();
     piece.where = nodes.size() == 1 ? label : label + " Piece " + std::to_string(k);
     piece.name = "Piece " + std::to_string(k);
-    if (Result r = readPiece(vtu, kind, whole, nodes[k], piece.where, piece, report, k == 0); !r) return r;
+    if (Result r = readPiece(vtu, kind, whole, nodes[k], piece.where, piece, report, k == from); !r) return r;
   }
 
   std::string enc;
@@ -759,10 +769,11 @@ Result vtkio::readVtuPieces(std::string_view bytes, const std::string& label, st
   return Result::success();
 }
 
-Result readVtu(std::string_view bytes, const std::string& label, TetMesh& out, ReadReport& report) {
+Result readVtu(std::string_view bytes, const std::string& label, TetMesh& out, ReadReport& report, uint32_t shareIndex,
+               uint32_t shareCount) {
   out = TetMesh{};
   std::vector<MeshPiece> pieces;
-  if (Result r = readVtuPieces(bytes, label, pieces, report); !r) return r;
+  if (Result r = readVtuPieces(bytes, label, pieces, report, shareIndex, shareCount); !r) return r;
   PieceMergeSummary summary;
   if (Result r = mergePieces(label, pieces, PieceMergeRules{}, out, report, summary); !r) return r;
   if (summary.pieces > 1 || summary.ghostCells + summary.hiddenCells) report.format += describeMerge(summary);

@@ -155,7 +155,7 @@ TEST(FormatNotes, EachConversionIsSaid) {
        {"TetGen 10-node tetrahedron cells to their 4 corner"}},
       {"grid43.vti",
        {"VTK XML ImageData (ascii, UInt32 header, 4x3x3)"},
-       {"split 12 hexahedra into 72 tetrahedra (grid cells"}},
+       {"split 12 hexahedra into 72 tetrahedra (each quad face cut through its corner lowest"}},
       {"grid43.vts", {"VTK XML StructuredGrid (appended base64, zlib"}, {"converted cell data 'cid'"}},
       {"grid43_points.vtk", {"legacy VTK 5.1 (BINARY, STRUCTURED_POINTS 4x3x3)"}, {"converted cell data 'cid'"}},
       {"grid43_sgrid.vtk", {"(ASCII, STRUCTURED_GRID 4x3x3)"}, {}},

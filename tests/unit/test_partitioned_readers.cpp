@@ -220,8 +220,8 @@ TEST(PartitionedFixtures, EveryListingIsTested) {
 // A share of the pieces or partitions (what each process of a distributed pack reads): the shares
 // together hold every tet once; a file that cannot be shared says so.
 TEST(PartitionedReaders, SharesOfPiecesAndPartitionsHoldEveryTetOnce) {
-  for (const std::string& path :
-       {partitioned("ghost.pvtu"), partitioned("ids.pvtu"), fixturePath("hpc/vtkhdf_parts.vtkhdf")}) {
+  for (const std::string& path : {partitioned("ghost.pvtu"), partitioned("ids.pvtu"), partitioned("petsc.vtu"),
+                                  fixturePath("hpc/vtkhdf_parts.vtkhdf")}) {
     TetMesh whole;
     ReadReport wr;
     ASSERT_TRUE(readMesh(path, whole, wr)) << path;
@@ -247,6 +247,11 @@ TEST(PartitionedReaders, SharesOfPiecesAndPartitionsHoldEveryTetOnce) {
   ReadReport r;
   ASSERT_TRUE(readMesh(partitioned("box.vtu"), m, r, o));
   EXPECT_FALSE(r.shared) << "one piece: read whole";
+  // One file of several <Piece>s (PETSc's): each share is those pieces, every point as the whole has it.
+  test::expectSharesMakeTheWhole(partitioned("petsc.vtu"), 3, "region");
+  ReadReport pr;
+  ASSERT_TRUE(readMesh(partitioned("petsc.vtu"), m, pr, o));
+  EXPECT_TRUE(hasNote(pr, "read pieces 2 to 3 of 3, this process's share of the file")) << allNotes(pr);
 }
 
 TEST(PartitionedReaders, GhostCellsAreDroppedAndTheirFlagsAreNoField) {
