@@ -28,9 +28,9 @@ NodeFigures nodeFigures(const Unit& u, const RankTree& tree, const RegionFigures
   out.ranges.assign(nodes, std::vector<Range>(F, Range{INFINITY, -INFINITY}));
   if (g.low < 0 && t.depth > 0) {
     const PartMesh& p = u.part;
-    for (uint32_t v = 0; v < p.mesh.vertexCount(); ++v) {
-      if (!p.owned[v] || v >= t.leafOf.size() || t.leafOf[v] == ~0u) continue;
-      const uint32_t n = (1u << t.depth) + t.leafOf[v];
+    // A leaf's own points, and those of its tets in later leaves (RegionTree::rim).
+    auto include = [&](uint32_t leaf, uint32_t v) {
+      const uint32_t n = (1u << t.depth) + leaf;
       for (int k = 0; k < 3; ++k) {
         out.bounds[n].min[k] = std::min(out.bounds[n].min[k], p.mesh.positions[3 * size_t(v) + size_t(k)]);
         out.bounds[n].max[k] = std::max(out.bounds[n].max[k], p.mesh.positions[3 * size_t(v) + size_t(k)]);
@@ -41,7 +41,10 @@ NodeFigures nodeFigures(const Unit& u, const RankTree& tree, const RegionFigures
         out.ranges[n][f].min = std::min(out.ranges[n][f].min, x);
         out.ranges[n][f].max = std::max(out.ranges[n][f].max, x);
       }
-    }
+    };
+    for (uint32_t v = 0; v < p.mesh.vertexCount(); ++v)
+      if (p.owned[v] && v < t.leafOf.size() && t.leafOf[v] != ~0u) include(t.leafOf[v], v);
+    for (const auto& [leaf, v] : t.rim) include(leaf, v);
     for (uint32_t n = nodes; n-- > 2;)
       for (int k = 0; k < 3; ++k) {
         out.bounds[n / 2].min[k] = std::min(out.bounds[n / 2].min[k], out.bounds[n].min[k]);

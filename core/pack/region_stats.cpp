@@ -30,9 +30,8 @@ RegionStats regionStats(const TetMesh& mesh, const SimplifyResult& s, const Mani
   std::vector<uint8_t> used(s.vertexAlive.begin(), s.vertexAlive.end());
   for (uint32_t i : s.log.i) used[i] = 1;
   const uint32_t firstLeaf = 1u << tree.depth;
-  for (uint32_t v = 0; v < mesh.vertexCount(); ++v) {
-    if (!used[v]) continue;
-    const uint32_t n = tree.depth ? firstLeaf + tree.leafOf[v] : 1;
+  // A leaf's own vertices, and those of its tets in later leaves (RegionTree::rim).
+  auto include = [&](uint32_t n, uint32_t v) {
     const float* p = &mesh.positions[3 * size_t(v)];
     for (int k = 0; k < 3; ++k) {
       out.bounds[n].min[k] = std::min(out.bounds[n].min[k], p[k]);
@@ -44,7 +43,10 @@ RegionStats regionStats(const TetMesh& mesh, const SimplifyResult& s, const Mani
       out.ranges[n][f].min = std::min(out.ranges[n][f].min, x);
       out.ranges[n][f].max = std::max(out.ranges[n][f].max, x);
     }
-  }
+  };
+  for (uint32_t v = 0; v < mesh.vertexCount(); ++v)
+    if (used[v]) include(tree.depth ? firstLeaf + tree.leafOf[v] : 1, v);
+  for (const auto& [leaf, v] : tree.rim) include(firstLeaf + leaf, v);
   for (size_t sec = 0, begin = 0; sec < tree.sectionNode.size(); begin = tree.sectionEnd[sec++]) {
     float& e = out.fieldError[tree.sectionNode[sec]];
     for (size_t c = begin; c < tree.sectionEnd[sec]; ++c) e = std::max(e, s.log.fieldError[c]);

@@ -220,7 +220,8 @@ class Simplifier {
     }
     uint32_t stamp = 0;
     uint64_t evaluations = 0;
-    double fitLo = 0, fitHi = 0;  // the range fitted values keep to: the region's (fitted())
+    double fitLo = 0, fitHi = 0;                             // the range fitted values keep to: the region's (fitted())
+    std::vector<std::pair<uint32_t, uint32_t>> cutErasures;  // (vertex, tet) left to settleCuts
   };
 
   // A small open-addressing table of edge keys with a byte of state, emptied in O(1) by
@@ -286,6 +287,10 @@ class Simplifier {
   struct Queue {
     uint32_t node = 1;    // the region (RegionTree numbering); 1: the whole mesh
     bool region = false;  // a region below the root: collapses only inner_ vertices
+    // A region of a level whose regions run at once (runTree): the vertices on its cuts (not
+    // inner_) have tets in other regions too, so their stars and quality sums are left as they are
+    // during the level and settled after it (settleCuts).
+    bool sharedCuts = false;
     Heap heap;
     CollapseLog ownLog;  // a region's collapses (appended to out_.log after its level)
     CollapseLog* log = &ownLog;
@@ -302,6 +307,8 @@ class Simplifier {
   };
 
   void prepareStar(Scratch& sc, uint32_t i);
+  // Vertex v lies on a cut that Q's region shares with regions running at the same time.
+  bool onSharedCut(const Queue& Q, uint32_t v) const { return Q.sharedCuts && !inner_[v]; }
 
   // Whether the new tet (P and the others of st) is flat, judged by its own longest edge.
   static bool isFlat(const StarTet& st, const double* P, double det) {
@@ -400,7 +407,8 @@ class Simplifier {
   void runTree(uint32_t target);
   // (At most maxCollapses of them: a part's top keeps its share of the base, runTop.)
   void runRegion(Queue& Q, float tau, uint32_t maxCollapses = ~0u);
-  void markInner(const std::vector<uint32_t>& region);
+  void markInner(const std::vector<uint32_t>& region, uint32_t halo);
+  void settleCuts();
   bool levelTau(std::vector<float>& keys, uint32_t target, float& tau) const;
   void markTopInner();
   void runTop(Queue& Q, uint32_t target);

@@ -172,6 +172,10 @@ struct SimplifyOptions {
 struct RegionTree {
   uint32_t depth = 0;            // levels below the root (0: the root alone)
   std::vector<uint32_t> leafOf;  // per input vertex: its leaf 0 .. 2^depth − 1 (empty at depth 0)
+  // A tet lies in the first leaf (lowest number) that holds one of its vertices: (leaf, vertex)
+  // for each vertex of a leaf's input tets that lies in a later leaf, sorted. A leaf's range and
+  // bounds hold these too, as its tets reach them.
+  std::vector<std::pair<uint32_t, uint32_t>> rim;
   // The log in sections, each the collapses of one node: section s is
   // [sectionEnd[s − 1] (0 for s = 0), sectionEnd[s]), made by node sectionNode[s]. Leaves
   // first, the root last; nodes without collapses have no section.

@@ -61,9 +61,15 @@ void Simplifier::collapse(Queue& Q, uint32_t i, uint32_t j, float fieldErr) {
     if (kappa_[t] >= kKappaCap) ++Q.flatTetsRemoved;
     out_.tetAlive[t] = 0;
     ++Q.tetsRemoved;
-    for (int k = 0; k < 4; ++k) qualitySum_[v[k]] -= 3.0 / kappa_[t];
     for (int k = 0; k < 4; ++k)
-      if (v[k] != i) eraseFrom(star_[v[k]], t);
+      if (!onSharedCut(Q, v[k])) qualitySum_[v[k]] -= 3.0 / kappa_[t];
+    for (int k = 0; k < 4; ++k) {
+      if (v[k] == i) continue;
+      if (onSharedCut(Q, v[k]))
+        Q.scratch->cutErasures.push_back({v[k], t});
+      else
+        eraseFrom(star_[v[k]], t);
+    }
   }
   {  // j's star grows by a quarter beyond what it needs, not by doubling (a lower peak memory)
     std::vector<uint32_t>& sj = star_[j];
@@ -80,7 +86,8 @@ void Simplifier::collapse(Queue& Q, uint32_t i, uint32_t j, float fieldErr) {
     star_[j].push_back(t);
     float before = kappa_[t];
     kappa_[t] = tetKappa(t);
-    for (int k = 0; k < 4; ++k) qualitySum_[v[k]] += 3.0 / kappa_[t] - (v[k] == j ? 0.0 : 3.0 / before);
+    for (int k = 0; k < 4; ++k)
+      if (!onSharedCut(Q, v[k])) qualitySum_[v[k]] += 3.0 / kappa_[t] - (v[k] == j ? 0.0 : 3.0 / before);
   }
   log.appendTets(record, j);
   if (opt_.recordReadSets) {
@@ -127,6 +134,10 @@ void Simplifier::collapse(Queue& Q, uint32_t i, uint32_t j, float fieldErr) {
     for (uint32_t v : Q.touched) changed_[v] = roundStamp_;
   }
   for (uint32_t v : Q.touched) {
+    if (onSharedCut(Q, v)) {  // left to the regions above; a neighbouring region may mark it too
+      std::atomic_ref<uint8_t>(queued_[v]).store(1, std::memory_order_relaxed);
+      continue;
+    }
     if (queued_[v]) continue;  // its entry stays: it is evaluated afresh when popped
     queued_[v] = 1;
     if (Q.region && !inner_[v]) continue;  // left to the regions above

@@ -1,15 +1,23 @@
 // The tree of regions below the root (simplify.h): the vertices bisected recursively, then
 // simplified level by level from the leaves up, the regions of a level on two threads.
 //
-// A region owns its vertices; a vertex is inner when every tet around it has all four vertices
-// in its region. A region collapses i → j only when both are inner: the collapse changes the tets
-// around i and j and the stars, quadrics and values of their vertices, all the region's own, and
-// an evaluation reads no more. So the regions of a level touch disjoint data and may run on any
-// thread in any order (one thread gives the same result), and a region's collapses need only what
-// the levels above leave in place: its splits depend on its ancestors' alone (FORMAT.md §1.1).
-// What a region leaves (its vertices next to another region's) is inner one level up, where the
-// cut between two children runs through the middle of their parent; the root, the queue of the
-// whole mesh, has no cut at all.
+// A region owns its vertices, and a tet lies in the region of its vertices that comes first (the
+// lowest number at that level), so a tet across a cut belongs to one side. A vertex is inner
+// when every tet around it lies in its own region: along a cut the first side's vertices stay
+// inner, and only the second side's vertices on the cut (those with a tet across it) are left to
+// the level above. A region collapses i → j only when both are inner: the collapse changes the
+// tets around i and j (its own) and the stars, quadrics and values of their vertices, and an
+// evaluation reads no more. The vertices on a cut are the one thing two regions share: their
+// stars lose the tets either side removes, and their quality sums change. Those are left as they
+// are while the level runs (neither region evaluates them, and they stay put) and settled after
+// it (settleCuts), in an order that does not depend on the threads. So the regions of a level
+// may run on any thread in any order (one thread gives the same result), and a region's
+// collapses need only what the levels above leave in place: its splits depend on its ancestors'
+// alone (FORMAT.md §1.1). What a region leaves on its cuts is inner one level up, where the cut
+// between two children runs through the middle of their parent; the root, the queue of the
+// whole mesh, has no cut at all. (With a vertex inner only when its tets have all four vertices
+// in its region, both sides of every cut were left to the level above: the upper levels, which
+// every view needs, held about twice the vertices.)
 //
 // The cut: at the median along the longest side of the region's bounding box, ties by vertex id,
 // so the tree is perfect (every leaf at the same depth) and each leaf holds at most leafVertices.
@@ -94,15 +102,30 @@ void Simplifier::buildTree() {
     stack.push_back({part.begin, mid, part.level + 1, 2 * part.index});
     stack.push_back({mid, part.end, part.level + 1, 2 * part.index + 1});
   }
-  // Each region's range of the steering field (fitted values keep to it), from the leaves up.
+  // The vertices a leaf's tets reach in later leaves (a tet lies in its first leaf).
+  for (uint32_t t = 0; t < T_; ++t) {
+    if (!out_.tetAlive[t]) continue;
+    const uint32_t* v = &out_.tets[4 * size_t(t)];
+    const uint32_t l[4] = {tree.leafOf[v[0]], tree.leafOf[v[1]], tree.leafOf[v[2]], tree.leafOf[v[3]]};
+    const uint32_t first = std::min({l[0], l[1], l[2], l[3]}), last = std::max({l[0], l[1], l[2], l[3]});
+    if (first == last || last == ~0u) continue;  // (a tet with a halo vertex lies in no region)
+    for (int k = 0; k < 4; ++k)
+      if (l[k] != first) tree.rim.push_back({first, v[k]});
+  }
+  std::sort(tree.rim.begin(), tree.rim.end());
+  tree.rim.erase(std::unique(tree.rim.begin(), tree.rim.end()), tree.rim.end());
+  // Each region's range of the steering field (fitted values keep to it), from the leaves up:
+  // the values of its tets' vertices.
   nodeRange_.assign(tree.nodes(), Range{INFINITY, -INFINITY});
   const uint32_t firstLeaf = 1u << tree.depth;
-  for (uint32_t v : order)
-    if (std::isfinite(field_[v])) {
-      Range& r = nodeRange_[firstLeaf + tree.leafOf[v]];
-      r.min = std::min(r.min, field_[v]);
-      r.max = std::max(r.max, field_[v]);
-    }
+  auto include = [&](uint32_t leaf, uint32_t v) {
+    if (!std::isfinite(field_[v])) return;
+    Range& r = nodeRange_[firstLeaf + leaf];
+    r.min = std::min(r.min, field_[v]);
+    r.max = std::max(r.max, field_[v]);
+  };
+  for (uint32_t v : order) include(tree.leafOf[v], v);
+  for (const auto& [leaf, v] : tree.rim) include(leaf, v);
   for (uint32_t n = firstLeaf; n-- > 1;) {
     if (n < firstLeaf)
       nodeRange_[n] = {std::min(nodeRange_[2 * n].min, nodeRange_[2 * n + 1].min),
@@ -130,7 +153,7 @@ void Simplifier::runTree(uint32_t target) {
     // most, as depth < 32: the halo is a region of its own, so no owned vertex next to it is inner.)
     for (uint32_t v = 0; v < V_; ++v)
       if (out_.vertexAlive[v]) region[v] = tree.leafOf[v] >> level;
-    markInner(region);
+    markInner(region, ~0u >> level);
     std::vector<std::vector<Entry>> entries(regions);
     std::vector<float> keys;
     for (uint32_t v = 0; v < V_; ++v) {
@@ -164,6 +187,7 @@ void Simplifier::runTree(uint32_t target) {
         Queue Q;
         Q.node = (1u << (tree.depth - level)) + k;
         Q.region = true;
+        Q.sharedCuts = true;
         Q.scratch = &sc;
         Q.heap = Heap(EntryAfter(), std::move(entries[k]));
         sc.fitLo = nodeLo(Q.node);
@@ -178,6 +202,7 @@ void Simplifier::runTree(uint32_t target) {
       }
     });
     for (Scratch& sc : scratches_) sc.fitLo = topLo_, sc.fitHi = topHi_;
+    settleCuts();
     // The regions' collapses, region after region, each a section of the log.
     for (uint32_t k = 0; k < regions; ++k) {
       if (logs[k].size() == 0) continue;
@@ -219,7 +244,7 @@ bool Simplifier::levelTau(std::vector<float>& keys, uint32_t target, float& tau)
 void Simplifier::markTopInner() {
   std::vector<uint32_t> region(V_);
   for (uint32_t v = 0; v < V_; ++v) region[v] = owned(v) ? 0 : 1;
-  markInner(region);
+  markInner(region, 1);
   for (uint32_t v = 0; v < V_; ++v) inner_[v] &= uint8_t(owned(v));
 }
 
@@ -262,21 +287,54 @@ void Simplifier::runRegion(Queue& Q, float tau, uint32_t maxCollapses) {
   }
 }
 
-// inner_[v]: every alive tet around v has all four vertices in v's region.
+// inner_[v]: every alive tet around v lies in v's region (this file's head): a tet lies in the
+// first region of its vertices', one with a vertex in `halo` (a part's halo) in none.
 // Every level scans all tets: on large meshes (kTwoThreadScan) in two halves at once. Both
 // halves only ever write 0, relaxed: the result is the same.
-void Simplifier::markInner(const std::vector<uint32_t>& region) {
+void Simplifier::markInner(const std::vector<uint32_t>& region, uint32_t halo) {
   inner_.assign(V_, 1);
   auto scan = [&](uint32_t begin, uint32_t end) {
     for (uint32_t t = begin; t < end; ++t) {
       if (!out_.tetAlive[t]) continue;
       const uint32_t* v = &out_.tets[4 * size_t(t)];
-      if (region[v[0]] != region[v[1]] || region[v[0]] != region[v[2]] || region[v[0]] != region[v[3]])
-        for (int k = 0; k < 4; ++k) std::atomic_ref<uint8_t>(inner_[v[k]]).store(0, std::memory_order_relaxed);
+      const uint32_t r[4] = {region[v[0]], region[v[1]], region[v[2]], region[v[3]]};
+      const uint32_t first = std::min({r[0], r[1], r[2], r[3]}), last = std::max({r[0], r[1], r[2], r[3]});
+      if (first == last) continue;
+      for (int k = 0; k < 4; ++k)
+        if (r[k] != first || last == halo) std::atomic_ref<uint8_t>(inner_[v[k]]).store(0, std::memory_order_relaxed);
     }
   };
   if (T_ < kTwoThreadScan) return scan(0, T_);
   onBoth([&](int half) { scan(half ? T_ / 2 : 0, half ? T_ : T_ / 2); });
+}
+
+// After a level: the vertices on the cuts lose the tets their regions removed (their stars keep
+// the order of the others: whichever thread removed what, the result is the same), and their
+// quality sums are counted again from their stars.
+void Simplifier::settleCuts() {
+  std::vector<std::pair<uint32_t, uint32_t>> erasures;
+  for (Scratch& sc : scratches_) {
+    erasures.insert(erasures.end(), sc.cutErasures.begin(), sc.cutErasures.end());
+    sc.cutErasures.clear();
+  }
+  std::sort(erasures.begin(), erasures.end());
+  for (size_t a = 0; a < erasures.size();) {
+    const uint32_t v = erasures[a].first;
+    size_t b = a;
+    while (b < erasures.size() && erasures[b].first == v) ++b;
+    auto gone = [&](uint32_t t) {
+      return std::binary_search(erasures.begin() + ptrdiff_t(a), erasures.begin() + ptrdiff_t(b), std::pair{v, t});
+    };
+    std::vector<uint32_t>& star = star_[v];
+    star.erase(std::remove_if(star.begin(), star.end(), gone), star.end());
+    a = b;
+  }
+  for (uint32_t v = 0; v < V_; ++v) {
+    if (!out_.vertexAlive[v] || inner_[v]) continue;
+    double sum = 0;
+    for (uint32_t t : star_[v]) sum += 3.0 / kappa_[t];
+    qualitySum_[v] = sum;
+  }
 }
 
 }  // namespace tetstream::simplify_detail
