@@ -20,12 +20,14 @@ function listen(server) {
   return new Promise((resolve) => server.listen(0, '127.0.0.1', () => resolve(`http://127.0.0.1:${server.address().port}`)));
 }
 
-// The viewer's state once the surface is exact for the current isovalue and nothing is coming.
-async function waitForExact(page) {
-  await page.waitForFunction(() => {
+// The viewer's state once the surface is exact for the current isovalue, or for `iso` once it
+// has been set (exact is false until the worker has applied the latest view), and nothing is
+// coming. (Waiting for exact to turn false first would miss a change made between two polls.)
+async function waitForExact(page, iso = null) {
+  await page.waitForFunction((v) => {
     const s = window.tetstream && window.tetstream.stats();
-    return s && s.exact && s.state === 'complete';
-  }, null, { timeout: 120000 });
+    return s && s.exact && s.state === 'complete' && (v === null || s.isovalue === v);
+  }, iso === null ? null : Math.fround(iso), { timeout: 120000 });
   return page.evaluate(() => window.tetstream.stats());
 }
 
@@ -66,8 +68,7 @@ test('only the nodes the isovalue needs are fetched; the surface is exact, and a
 
     // Dragging the isovalue re-plans: more nodes come and the surface is exact again.
     await page.evaluate((v) => window.tetstream.setIsovalue(v), low);
-    await page.waitForFunction(() => !window.tetstream.stats().exact || window.tetstream.stats().state !== 'complete');
-    s = await waitForExact(page);
+    s = await waitForExact(page, low);
     assertSurfaceMatches(s, cliIso(s.isovalue, { dir }), `exact at ${s.isovalue}`);
     assert.ok(s.bytesReceived > first, 'the new isovalue needed more nodes');
     const log = s.requestLog;
@@ -172,8 +173,7 @@ test('short of memory, the regions the view no longer needs are given back and e
       alone.push((await waitForExact(page)).memory.budgetedBytes);
       if (iso === far) {
         await page.evaluate((v) => window.tetstream.setIsovalue(v), near);
-        await page.waitForFunction(() => !window.tetstream.stats().exact);
-        alone.push((await waitForExact(page)).memory.budgetedBytes);
+        alone.push((await waitForExact(page, near)).memory.budgetedBytes);
       }
       await page.close();
     }
@@ -186,8 +186,7 @@ test('short of memory, the regions the view no longer needs are given back and e
     assertSurfaceMatches(s, cliIso(s.isovalue, { dir: shells.dir }), `exact at ${s.isovalue}`);
     for (const iso of [near, far]) {
       await page.evaluate((v) => window.tetstream.setIsovalue(v), iso);
-      await page.waitForFunction(() => !window.tetstream.stats().exact);
-      s = await waitForExact(page);
+      s = await waitForExact(page, iso);
       assertSurfaceMatches(s, cliIso(s.isovalue, { dir: shells.dir }), `exact at ${s.isovalue} within ${limitMB} MB`);
       assert.ok(s.memory.budgetedBytes <= s.memory.limitBytes, `${s.memory.budgetedBytes} of ${s.memory.limitBytes}`);
       assert.equal(s.memory.full, false);
