@@ -16,8 +16,10 @@
 //    configurations that need a Steiner point (cyclic diagonals, as in Schoenhardt's prism) cannot
 //    arise under this rule. On an axis-aligned grid the lowest corner of a cell is its
 //    (xmin, ymin, zmin) corner and every face is cut from its lowest to its highest corner: the
-//    Kuhn split along the cell's main diagonal. A split cell's tetrahedra are oriented together by
-//    the sign of their total volume, so a mirrored corner order in the input does not invert them.
+//    Kuhn split along the cell's main diagonal. (On a curvilinear grid the split does not follow
+//    the grid: Blunt Fin's one warped cell gives an inverted tet, where the order of ids happened
+//    not to; the reader says so.) A split cell's tetrahedra are oriented together by the sign of
+//    their total volume, so a mirrored corner order in the input does not invert them.
 // 3. Tetrahedra with a repeated vertex (collapsed cells, or duplicates that were merged) have no
 //    volume and no interior: they are dropped, which keeps the mesh conforming.
 // 4. Cell arrays become point fields: the value at a vertex is the average over the cells around
