@@ -102,7 +102,12 @@ void Simplifier::buildTree() {
     stack.push_back({part.begin, mid, part.level + 1, 2 * part.index});
     stack.push_back({mid, part.end, part.level + 1, 2 * part.index + 1});
   }
-  // The vertices a leaf's tets reach in later leaves (a tet lies in its first leaf).
+  // The vertices a leaf's tets reach in later leaves (a tet lies in its first leaf). A vertex
+  // is reached by several tets of the same leaf, one after another in a grid's order: the leaf
+  // last recorded for each vertex (in a scratch's per-vertex array, cleared after) keeps the list
+  // near its final size (at Harmonic 256³, tens of MB instead of hundreds).
+  std::vector<uint32_t>& recorded = scratches_[0].seen;
+  std::fill(recorded.begin(), recorded.end(), ~0u);
   for (uint32_t t = 0; t < T_; ++t) {
     if (!out_.tetAlive[t]) continue;
     const uint32_t* v = &out_.tets[4 * size_t(t)];
@@ -110,10 +115,15 @@ void Simplifier::buildTree() {
     const uint32_t first = std::min({l[0], l[1], l[2], l[3]}), last = std::max({l[0], l[1], l[2], l[3]});
     if (first == last || last == ~0u) continue;  // (a tet with a halo vertex lies in no region)
     for (int k = 0; k < 4; ++k)
-      if (l[k] != first) tree.rim.push_back({first, v[k]});
+      if (l[k] != first && recorded[v[k]] != first) {
+        recorded[v[k]] = first;
+        tree.rim.push_back({first, v[k]});
+      }
   }
+  std::fill(recorded.begin(), recorded.end(), 0u);  // (stamps start again: nothing seen)
   std::sort(tree.rim.begin(), tree.rim.end());
   tree.rim.erase(std::unique(tree.rim.begin(), tree.rim.end()), tree.rim.end());
+  tree.rim.shrink_to_fit();
   // Each region's range of the steering field (fitted values keep to it), from the leaves up:
   // the values of its tets' vertices.
   nodeRange_.assign(tree.nodes(), Range{INFINITY, -INFINITY});
