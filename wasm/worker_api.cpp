@@ -184,7 +184,9 @@ EMSCRIPTEN_KEEPALIVE int tw_delta_size() { return int(g_delta.size()); }
 // The model's figures as JSON (statsJson), valid until the next call.
 EMSCRIPTEN_KEEPALIVE const char* tw_stats() {
   g_model.memory.heapBytes = emscripten_get_heap_size();
-  g_model.memory.allocatedBytes = uint64_t(mallinfo().uordblks);
+  // mallinfo's fields are ints: past 2 GB the count wraps negative. The heap is at most 4 GB
+  // (wasm32), so its 32 bits read unsigned are the count.
+  g_model.memory.allocatedBytes = uint64_t(uint32_t(mallinfo().uordblks));
   g_stats = statsJson(g_model);
   return g_stats.c_str();
 }
