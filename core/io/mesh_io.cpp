@@ -13,6 +13,7 @@
 #include <new>
 
 #include "io/hdf5_file.h"
+#include "io/mapped_file.h"
 #include "io/readers.h"
 
 namespace tetstream {
@@ -286,6 +287,16 @@ Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const
   if (fmt == Format::Exodus) return guarded(path, out, [&] { return readExodus(path, options, out, report); });
   if (fmt == Format::Cgns) return guarded(path, out, [&] { return readCgns(path, options, out, report); });
 
+  // A process's share of a VTK XML file decodes only its pieces: mapped, the file's other pieces
+  // (with appended data) are never read from disk (MappedFile).
+  if (fmt == Format::VtkXml && options.shareCount > 1) {
+    MappedFile file;
+    if (Result r = file.open(path); !r) return r;
+    const std::string_view mapped = file.bytes();
+    if (listingKind(mapped.substr(0, 4096)) == ListingKind::None)
+      return guarded(path, out,
+                     [&] { return readVtu(mapped, path, out, report, options.shareIndex, options.shareCount); });
+  }
   std::string bytes, second;
   std::string secondPath;
   try {
