@@ -24,10 +24,14 @@
 // (index + 1)·Z/count, each whole (zones meet where their points coincide, which core/dist joins
 // as one process does). A base of one unstructured zone of fixed-type sections: the elements
 // numbered from index·N/count + 1 to (index + 1)·N/count and the vertices from the smallest to
-// the largest they use, with those rows of the solutions (the library's partial reads). Other
-// bases of fewer zones than processes are read whole by every process.
+// the largest they use, with those rows of the solutions (the library's partial reads). A base
+// of fewer structured zones than processes, each at least `count` cells deep along its longest
+// index direction: of every zone the cells of layers index·L/count to (index + 1)·L/count along it
+// and their points (the layer where two processes' slabs meet is read by both, and joined by
+// core/dist). Other bases of fewer zones than processes are read whole by every process.
 #include <cgnslib.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -98,11 +102,20 @@ std::string elementTypeName(int code) {
   return n ? n : "";
 }
 
+// "1 structured zone", "12 unstructured zones".
+std::string zonesText(size_t n, const char* kind) {
+  return std::to_string(n) + " " + kind + (n == 1 ? " zone" : " zones");
+}
+
 struct Zone {
   int index = 0;
   std::string name;
   bool structured = false;
-  uint64_t dims[3] = {0, 0, 0};  // structured: vertices along i, j, k
+  uint64_t dims[3] = {0, 0, 0};  // structured: vertices along i, j, k (of the slab read, below)
+  // Structured, a share's slab: the index direction it is cut along and its first layer of points
+  // (0-based); the whole zone is the slab from 0 along k.
+  int slabAxis = 2;
+  uint64_t slabFirst = 0;
   uint64_t vertices = 0, cells = 0;
   uint64_t vertexBase = 0, slotBase = 0;  // where its points and its cells' values start
   // What is read of it (an unstructured zone read in a share: a window; else everything):
@@ -293,7 +306,8 @@ class CgnsReader {
   Result keepShareOfZones() {
     const uint64_t n = options_.shareCount, z = zones_.size();
     if (n >= 2 && z == 1 && !zones_[0].structured) return keepShareOfZone(zones_[0]);
-    if (n < 2 || z < n) return Result::success();
+    if (n >= 2 && z < n) return keepSlabsOfZones();
+    if (n < 2) return Result::success();
     const uint64_t from = z * options_.shareIndex / n, to = z * (options_.shareIndex + 1) / n;
     zones_ = std::vector<Zone>(zones_.begin() + std::ptrdiff_t(from), zones_.begin() + std::ptrdiff_t(to));
     totalVertices_ = totalSlots_ = 0;
@@ -308,6 +322,38 @@ class CgnsReader {
     report_.shared = true;
     report_.notes.push_back("read zones " + std::to_string(from + 1) + " to " + std::to_string(to) + " of " +
                             std::to_string(z) + ", this process's share of the file");
+    return Result::success();
+  }
+
+  // Of fewer structured zones than processes, each process's slab of every zone (the header
+  // comment), when every zone is deep enough for a layer of cells each; else all whole.
+  Result keepSlabsOfZones() {
+    const uint64_t n = options_.shareCount, k = options_.shareIndex;
+    auto longest = [](const Zone& z) { return int(std::max_element(z.dims, z.dims + 3) - z.dims); };
+    for (const Zone& z : zones_)
+      if (!z.structured || z.dims[longest(z)] - 1 < n) return Result::success();
+    totalVertices_ = totalSlots_ = 0;
+    uint64_t layers = 0, cellLayers = 0;
+    for (Zone& z : zones_) {
+      const int a = longest(z);
+      const uint64_t K = z.dims[a] - 1, from = K * k / n, to = K * (k + 1) / n;
+      z.slabAxis = a;
+      z.slabFirst = from;
+      z.dims[a] = to - from + 1;
+      z.vertices = z.vertexCount = z.dims[0] * z.dims[1] * z.dims[2];
+      z.cells = z.cellCount = (z.dims[0] - 1) * (z.dims[1] - 1) * (z.dims[2] - 1);
+      z.vertexBase = totalVertices_;
+      z.slotBase = totalSlots_;
+      totalVertices_ += z.vertices;
+      totalSlots_ += z.cells;
+      layers += K;
+      cellLayers += to - from;
+    }
+    report_.shared = true;
+    report_.notes.push_back("read slab " + std::to_string(k + 1) + " of " + std::to_string(n) + " of " +
+                            (zones_.size() == 1 ? "the " : "each of the ") + zonesText(zones_.size(), "structured") +
+                            " (" + std::to_string(cellLayers) + " of " + std::to_string(layers) +
+                            " layers of cells), this process's share of the file");
     return Result::success();
   }
 
@@ -473,6 +519,8 @@ class CgnsReader {
     cgsize_t lo[3] = {1, 1, 1}, hi[3] = {1, 1, 1};
     if (z.structured) {
       for (int d = 0; d < 3; ++d) hi[d] = cgsize_t(z.dims[d]);
+      lo[z.slabAxis] = cgsize_t(z.slabFirst + 1);
+      hi[z.slabAxis] += cgsize_t(z.slabFirst);
     } else {
       lo[0] = cgsize_t(z.vertexFirst + 1);
       hi[0] = cgsize_t(z.vertexFirst + z.vertexCount);
@@ -759,6 +807,8 @@ class CgnsReader {
     cgsize_t lo[3] = {1, 1, 1}, hi[3] = {1, 1, 1};
     if (z.structured) {
       for (int d = 0; d < 3; ++d) hi[d] = cgsize_t(vertex ? z.dims[d] : z.dims[d] - 1);
+      lo[z.slabAxis] = cgsize_t(z.slabFirst + 1);
+      hi[z.slabAxis] += cgsize_t(z.slabFirst);
     } else {
       lo[0] = cgsize_t((vertex ? z.vertexFirst : z.cellFirst) + 1);
       hi[0] = cgsize_t((vertex ? z.vertexFirst : z.cellFirst) + n);
@@ -789,9 +839,6 @@ class CgnsReader {
     cg_get_file_type(file_.fn, &type);
     const char* container = type == CG_FILE_HDF5 ? "HDF5" : (type == CG_FILE_ADF || type == CG_FILE_ADF2) ? "ADF" : "?";
     const size_t unstructured = zones_.size() - structured_;
-    auto zonesText = [](size_t n, const char* kind) {
-      return std::to_string(n) + " " + kind + (n == 1 ? " zone" : " zones");
-    };
     std::string s = std::string("CGNS (") + container + "), base '" + baseName_ + "', ";
     if (unstructured && structured_)
       s += zonesText(unstructured, "unstructured") + " + " + zonesText(structured_, "structured");

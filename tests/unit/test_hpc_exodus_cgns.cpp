@@ -563,10 +563,13 @@ TEST(ExodusShares, TheSharesOfAFileHoldEveryTetOnceWithItsValues) {
 
 // A CGNS base of as many zones as processes or more: each reads its zones whole. A base of one
 // unstructured zone: each reads its elements and the vertices they span, with its rows of the
-// solutions (a time series here: the step's solution).
+// solutions (a time series here: the step's solution). Fewer structured zones than processes:
+// each reads its slab of k-layers of every zone, with those layers of the solutions.
 TEST(CgnsShares, EachProcessReadsItsZonesOrItsElements) {
   for (const char* name : {"cgns_unstructured.cgns", "cgns_structured.cgns", "cgns_structured.adf.cgns"})
     test::expectSharesMakeTheWhole(hpcPath(name), 2);
+  for (const char* name : {"cgns_structured.cgns", "cgns_structured.adf.cgns"})
+    test::expectSharesMakeTheWhole(hpcPath(name), 3);  // (each zone is 3 cells deep along k)
   for (uint32_t count : {2u, 3u}) test::expectSharesMakeTheWhole(hpcPath("cgns_steps.cgns"), count);
   TetMesh m;
   ReadReport r;
