@@ -301,8 +301,8 @@ class CgnsReader {
     return Result::success();
   }
 
-  // For one process of several, its zones only, or its window of a single zone (the header
-  // comment), numbered from its first.
+  // For one process of several, its zones only, its window of a single unstructured zone, or its
+  // slab of each of fewer structured zones (the header comment), numbered from its first.
   Result keepShareOfZones() {
     const uint64_t n = options_.shareCount, z = zones_.size();
     if (n >= 2 && z == 1 && !zones_[0].structured) return keepShareOfZone(zones_[0]);
