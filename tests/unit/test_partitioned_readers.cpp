@@ -252,6 +252,13 @@ TEST(PartitionedReaders, SharesOfPiecesAndPartitionsHoldEveryTetOnce) {
   ReadReport pr;
   ASSERT_TRUE(readMesh(partitioned("petsc.vtu"), m, pr, o));
   EXPECT_TRUE(hasNote(pr, "read pieces 2 to 3 of 3, this process's share of the file")) << allNotes(pr);
+  // A share's file is mapped, not read: what cannot be mapped is said as a read would say it.
+  ReadReport er;
+  EXPECT_FAILS(readMesh(partitioned("missing.vtu"), m, er, o), Status::IoError, "cannot open");
+  const std::string folder = (fs::temp_directory_path() / "tetstream-share-folder.vtu").string();
+  fs::create_directories(folder);
+  EXPECT_FAILS(readMesh(folder, m, er, o), Status::IoError, "not a file");
+  fs::remove(folder);
 }
 
 TEST(PartitionedReaders, GhostCellsAreDroppedAndTheirFlagsAreNoField) {
