@@ -18,10 +18,14 @@ Result MappedFile::open(const std::string& path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) return fail(Status::IoError, path + ": cannot open (" + std::strerror(errno) + ")");
   struct stat st {};
-  if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+  if (fstat(fd, &st) != 0) {
     const int e = errno;
     ::close(fd);
-    return fail(Status::IoError, path + ": " + (S_ISREG(st.st_mode) ? std::strerror(e) : "not a file"));
+    return fail(Status::IoError, path + ": cannot read (" + std::strerror(e) + ")");
+  }
+  if (!S_ISREG(st.st_mode)) {
+    ::close(fd);
+    return fail(Status::IoError, path + ": not a file");
   }
   size_ = size_t(st.st_size);
   if (size_ > 0) {
