@@ -310,6 +310,16 @@ class CgnsReader {
     if (n < 2) return Result::success();
     const uint64_t from = z * options_.shareIndex / n, to = z * (options_.shareIndex + 1) / n;
     zones_ = std::vector<Zone>(zones_.begin() + std::ptrdiff_t(from), zones_.begin() + std::ptrdiff_t(to));
+    numberZones();
+    report_.shared = true;
+    report_.notes.push_back("read zones " + std::to_string(from + 1) + " to " + std::to_string(to) + " of " +
+                            std::to_string(z) + ", this process's share of the file");
+    return Result::success();
+  }
+
+  // Where each zone's points and cells' values start once the zones read are chosen, and the
+  // totals.
+  void numberZones() {
     totalVertices_ = totalSlots_ = 0;
     structured_ = 0;
     for (Zone& zone : zones_) {
@@ -319,10 +329,6 @@ class CgnsReader {
       totalSlots_ += zone.cells;
       structured_ += zone.structured;
     }
-    report_.shared = true;
-    report_.notes.push_back("read zones " + std::to_string(from + 1) + " to " + std::to_string(to) + " of " +
-                            std::to_string(z) + ", this process's share of the file");
-    return Result::success();
   }
 
   // Of fewer structured zones than processes, each process's slab of every zone (the header
@@ -332,7 +338,6 @@ class CgnsReader {
     auto longest = [](const Zone& z) { return int(std::max_element(z.dims, z.dims + 3) - z.dims); };
     for (const Zone& z : zones_)
       if (!z.structured || z.dims[longest(z)] - 1 < n) return Result::success();
-    totalVertices_ = totalSlots_ = 0;
     uint64_t layers = 0, cellLayers = 0;
     for (Zone& z : zones_) {
       const int a = longest(z);
@@ -342,13 +347,10 @@ class CgnsReader {
       z.dims[a] = to - from + 1;
       z.vertices = z.vertexCount = z.dims[0] * z.dims[1] * z.dims[2];
       z.cells = z.cellCount = (z.dims[0] - 1) * (z.dims[1] - 1) * (z.dims[2] - 1);
-      z.vertexBase = totalVertices_;
-      z.slotBase = totalSlots_;
-      totalVertices_ += z.vertices;
-      totalSlots_ += z.cells;
       layers += K;
       cellLayers += to - from;
     }
+    numberZones();
     report_.shared = true;
     report_.notes.push_back("read slab " + std::to_string(k + 1) + " of " + std::to_string(n) + " of " +
                             (zones_.size() == 1 ? "the " : "each of the ") + zonesText(zones_.size(), "structured") +
