@@ -223,17 +223,17 @@ std::vector<std::string> plot3dSolutionCandidates(const std::string& path) {
   return existing;
 }
 
-// Reads the pieces a listing at `listingPath` names from its folder (readListing has checked
+// Maps the pieces a listing at `listingPath` names from its folder (readListing has checked
 // that each path stays inside it).
 PieceLoader pieceFiles(const std::string& listingPath) {
   namespace fs = std::filesystem;
-  return [listingPath](const std::string& relative, std::string& bytes) {
+  return [listingPath](const std::string& relative, PieceBytes& piece) {
     const fs::path full = fs::path(listingPath).parent_path() / relative;
     std::error_code ec;
     if (fs::equivalent(full, listingPath, ec)) return fail(Status::Corrupt, full.string() + " is the listing itself");
-    if (fs::exists(full, ec) && !fs::is_regular_file(full, ec))
-      return fail(Status::IoError, full.string() + ": not a file");
-    return readWholeFile(full.string(), bytes);
+    if (Result r = piece.file.open(full.string()); !r) return r;
+    piece.bytes = piece.file.bytes();
+    return Result::success();
   };
 }
 

@@ -95,9 +95,12 @@ struct ReadOptions {
   // Of a listing of pieces (.pvtu, .vtm, .pvtk), read only share `shareIndex` of `shareCount`:
   // the listed files from shareIndex·n/shareCount up to (shareIndex + 1)·n/shareCount, n the
   // files listed (each process of a distributed pack reads its own; every path is still
-  // checked). A share with no file gives an empty mesh. A VTKHDF file of at least shareCount
-  // partitions, or a VTK XML file of at least shareCount <Piece>s: the partitions or pieces
-  // likewise. An XDMF file of one grid of one cell type: the cells
+  // checked); of fewer files than processes, the processes of one file each read a share of its
+  // cells, as below (of a legacy piece the first of them reads it, the others nothing). A VTKHDF
+  // file of at least shareCount partitions, or a VTK XML file of at least shareCount <Piece>s:
+  // the partitions or pieces likewise. A .vtu of fewer pieces: the cells in those rows of each
+  // piece and the points from the smallest to the largest id they use. An XDMF file of one grid
+  // of one cell type: the cells
   // in those rows of its topology and the points from the smallest to the largest id they use.
   // An Exodus II file: the elements in those rows of its blocks (in file order) and the nodes
   // from the smallest to the largest they use. A CGNS base of at least shareCount zones: those

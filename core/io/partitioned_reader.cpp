@@ -236,11 +236,21 @@ Result readListing(std::string_view listing, const std::string& label, const Pie
   }
 
   report.filesListed = listed.size();
+  // Of more processes than files, the processes that share a file each read a share of its
+  // cells (a .vtu file's; of another file the first of them reads it all).
+  uint32_t fileShare = 0, fileShares = 1;
   if (shareCount > 1) {
-    const uint64_t n = listed.size(), from = shareIndex * n / shareCount, to = (shareIndex + 1ull) * n / shareCount;
+    const uint64_t n = listed.size(), from = shareIndex * n / shareCount;
+    uint64_t to = (shareIndex + 1ull) * n / shareCount;
+    if (n < shareCount && n > 0) {  // file `from` is read by the processes p with p·n/shareCount = from
+      auto firstProcess = [&](uint64_t file) { return uint32_t((file * shareCount + n - 1) / n); };
+      fileShare = shareIndex - firstProcess(from);
+      fileShares = firstProcess(from + 1) - firstProcess(from);
+      to = from + 1;
+    }
     listed = std::vector<Listed>(listed.begin() + ptrdiff_t(from), listed.begin() + ptrdiff_t(to));
     report.shared = true;
-    if (listed.empty()) return Result::success();  // (more processes than files)
+    if (listed.empty()) return Result::success();
   }
 
   std::vector<MeshPiece> pieces;
@@ -248,11 +258,13 @@ Result readListing(std::string_view listing, const std::string& label, const Pie
   std::vector<std::string> skipped;
   for (const Listed& l : listed) {
     const std::string where = label + " " + l.name;
-    std::string bytes;
-    if (Result r = load(l.path, bytes); !r) return fail(r.status, where + ": " + r.message);
+    PieceBytes piece;
+    if (Result r = load(l.path, piece); !r) return fail(r.status, where + ": " + r.message);
+    const std::string_view bytes = piece.bytes;
     ReadReport pieceReport;
     const size_t before = pieces.size();
     if (kind == ListingKind::Pvtk) {
+      if (fileShare > 0) continue;
       if (Result r = readLegacyVtkPiece(bytes, where, pieces.emplace_back(), pieceReport); !r) return r;
     } else {
       const std::string pieceType = vtkXmlFileType(std::string_view(bytes).substr(0, 4096));
@@ -266,7 +278,8 @@ Result readListing(std::string_view listing, const std::string& label, const Pie
         return fail(Status::Corrupt, where + ": is a VTK XML " + printable(pieceType) +
                                          " file; the pieces of a PUnstructuredGrid are UnstructuredGrid (.vtu)");
       std::vector<MeshPiece> sub;
-      if (Result r = readVtuPieces(bytes, where, sub, pieceReport); !r) return r;
+      if (Result r = readVtuPieces(bytes, where, sub, pieceReport, fileShare, fileShares); !r) return r;
+      if (fileShares > 1 && !pieceReport.shared && fileShare > 0) sub.clear();  // (read whole by the first)
       for (MeshPiece& p : sub) pieces.push_back(std::move(p));
     }
     for (size_t k = before; k < pieces.size(); ++k) {
@@ -289,6 +302,7 @@ Result readListing(std::string_view listing, const std::string& label, const Pie
                            "inside a listing is not read): " +
                            list);
   }
+  if (pieces.empty() && fileShare > 0) return Result::success();  // (the file's first process reads it)
   if (pieces.empty())
     return fail(Status::NoTets,
                 label + ": no block is a volume mesh (" + std::to_string(skipped.size()) + " skipped: see the notes)");

@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "io/mapped_file.h"
 #include "io/mesh_io.h"
 #include "mesh.h"
 #include "status.h"
@@ -99,7 +100,14 @@ Result readCgns(const std::string& path, const ReadOptions& options, TetMesh& ou
 enum class ListingKind { None, Pvtu, Vtm, Pvtk };
 // What a file's first bytes say it is: a listing, or None for anything else (a .vtu, junk).
 ListingKind listingKind(std::string_view head);
-using PieceLoader = std::function<Result(const std::string& relativePath, std::string& bytes)>;
+// A piece file's bytes: read into `text` or mapped (`file`: a process that reads a share of the
+// file then touches only that share's pages); `bytes` views whichever holds them.
+struct PieceBytes {
+  std::string text;
+  MappedFile file;
+  std::string_view bytes;
+};
+using PieceLoader = std::function<Result(const std::string& relativePath, PieceBytes& piece)>;
 // Reads the files of share `shareIndex` of `shareCount` only (ReadOptions).
 Result readListing(std::string_view listing, const std::string& label, const PieceLoader& load, TetMesh& out,
                    ReadReport& report, uint32_t shareIndex = 0, uint32_t shareCount = 1);
@@ -412,7 +420,8 @@ Result mergePieces(const std::string& label, std::vector<MeshPiece>& pieces, con
 // The pieces of a VTK XML file, one MeshPiece per <Piece> (vtu_reader.cpp); report.format says
 // what was read. readVtu() is this followed by mergePieces(). Of a file of at least shareCount
 // pieces only share shareIndex is read: pieces shareIndex·n/shareCount up to
-// (shareIndex + 1)·n/shareCount (ReadReport::shared says).
+// (shareIndex + 1)·n/shareCount; of fewer unstructured pieces, the same share of every piece's
+// cells and the points they span (ReadReport::shared says; structured pieces are read whole).
 Result readVtuPieces(std::string_view bytes, const std::string& label, std::vector<MeshPiece>& pieces,
                      ReadReport& report, uint32_t shareIndex = 0, uint32_t shareCount = 1);
 // A legacy VTK file as one MeshPiece (vtk_reader.cpp); readLegacyVtk() merges it alone.

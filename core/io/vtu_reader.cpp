@@ -77,6 +77,26 @@ class ByteSource {
     return true;
   }
 
+  // Passes over the next n bytes. Base64 text is decoded on the way (white space or padding
+  // may sit anywhere in it, so a character offset cannot be computed), into a small buffer.
+  bool skip(uint64_t n) {
+    if (!b64_) {
+      if (data_.size() - pos_ < n) {
+        error_ = "data ends " + std::to_string(n - (data_.size() - pos_)) + " bytes early";
+        return false;
+      }
+      pos_ += size_t(n);
+      return true;
+    }
+    uint8_t scratch[3 * 4096];
+    for (; n > 0;) {
+      const size_t take = size_t(std::min<uint64_t>(n, sizeof scratch));
+      if (!read(scratch, take)) return false;
+      n -= take;
+    }
+    return true;
+  }
+
   // The next n bytes where they are, for a raw source that holds them (no copy); else null,
   // and read() copies them.
   const uint8_t* inPlace(size_t n) {
@@ -200,11 +220,12 @@ bool readHeaderWord(const Vtu& vtu, ByteSource& src, uint64_t& out) {
   return true;
 }
 
-// Reads one binary payload (header + data, compressed or not): exactly expectedBytes bytes at
-// `data`, still in the file's byte order. Raw appended data stays where it is in the file's
-// bytes (a large mesh's arrays were copied once more for nothing); the rest goes to `bytes`.
-Result readPayload(const Vtu& vtu, ByteSource& src, const ArrayRef& ref, uint64_t expectedBytes,
-                   std::vector<uint8_t>& bytes, const uint8_t*& data) {
+// Reads one binary payload (header + data, compressed or not) of expectedBytes bytes, and puts
+// its bytes [begin, end) at `data`, still in the file's byte order. Raw appended data stays where
+// it is in the file's bytes (a large mesh's arrays were copied once more for nothing); the rest
+// goes to `bytes`. Of compressed data only the blocks that hold [begin, end) are inflated.
+Result readPayload(const Vtu& vtu, ByteSource& src, const ArrayRef& ref, uint64_t expectedBytes, uint64_t begin,
+                   uint64_t end, std::vector<uint8_t>& bytes, const uint8_t*& data) {
   auto srcError = [&](const char* stage) {
     Status s = src.error().find("invalid") != std::string::npos || src.error().find("padding") != std::string::npos
                    ? Status::Corrupt
@@ -223,9 +244,10 @@ Result readPayload(const Vtu& vtu, ByteSource& src, const ArrayRef& ref, uint64_
     if (n > src.available())
       return fail(Status::Truncated, ref.str() + ": needs " + std::to_string(n) + " bytes, at most " +
                                          std::to_string(src.available()) + " remain");
-    if ((data = src.inPlace(n))) return Result::success();
-    bytes.resize(n);
-    if (!src.read(bytes.data(), n)) return srcError("reading the data");
+    if (!src.skip(begin)) return srcError("reading the data");
+    if ((data = src.inPlace(end - begin))) return Result::success();
+    bytes.resize(end - begin);
+    if (!src.read(bytes.data(), end - begin)) return srcError("reading the data");
     data = bytes.data();
     return Result::success();
   }
@@ -272,11 +294,16 @@ Result readPayload(const Vtu& vtu, ByteSource& src, const ArrayRef& ref, uint64_
                                        " compressed, beyond what zlib can produce");
   }
 
-  bytes.resize(total);
+  // The blocks that hold [begin, end): those before are passed over, those after never read.
+  const uint64_t firstBlock = end > begin ? begin / blockSize : 0,
+                 endBlock = end > begin ? (end - 1) / blockSize + 1 : 0;
+  for (uint64_t b = 0; b < firstBlock; ++b)
+    if (!src.skip(csize[b])) return srcError("reading a compressed block");
+  bytes.resize(size_t((endBlock == nblocks ? total : endBlock * blockSize) - firstBlock * blockSize));
   std::vector<uint8_t> packed;
   uint64_t at = 0;
-  for (uint64_t b = 0; b < nblocks; ++b) {
-    uint64_t usize = (b + 1 == nblocks) ? total - at : blockSize;
+  for (uint64_t b = firstBlock; b < endBlock; ++b) {
+    uint64_t usize = (b + 1 == nblocks) ? total - b * blockSize : blockSize;
     packed.resize(csize[b]);
     if (!src.read(packed.data(), csize[b])) return srcError("reading a compressed block");
     uLongf got = uLongf(usize);
@@ -292,7 +319,7 @@ Result readPayload(const Vtu& vtu, ByteSource& src, const ArrayRef& ref, uint64_
     }
     at += usize;
   }
-  data = bytes.data();
+  data = end > begin ? bytes.data() + (begin - firstBlock * blockSize) : bytes.data();
   return Result::success();
 }
 
@@ -312,10 +339,22 @@ std::string_view arrayText(pugi::xml_node da, std::string& storage) {
   return parts <= 1 ? single : std::string_view(storage);
 }
 
-// Reads a DataArray holding expectedValues numbers into out (int64_t or double).
+// Values [first, first + count) of an array, for a process that reads a share of a piece.
+struct ValueRange {
+  uint64_t first = 0;
+  uint64_t count = UINT64_MAX;  // (all from first)
+};
+
+// Reads a DataArray holding expectedValues numbers into out (int64_t or double): all of them, or
+// those of `range` (the others are passed over; of compressed data only the blocks that hold the
+// range are inflated).
 template <class T>
-Result readDataArray(Vtu& vtu, pugi::xml_node da, const ArrayRef& ref, uint64_t expectedValues, std::vector<T>& out) {
+Result readDataArray(Vtu& vtu, pugi::xml_node da, const ArrayRef& ref, uint64_t expectedValues, std::vector<T>& out,
+                     ValueRange range = {}) {
   constexpr bool wantInts = std::is_same_v<T, int64_t>;
+  range.first = std::min(range.first, expectedValues);
+  range.count = std::min(range.count, expectedValues - range.first);
+  const bool whole = range.first == 0 && range.count == expectedValues;
   ScalarType type;
   const char* typeName = da.attribute("type").value();
   if (!parseXmlScalarType(typeName, type))
@@ -333,9 +372,9 @@ Result readDataArray(Vtu& vtu, pugi::xml_node da, const ArrayRef& ref, uint64_t 
     std::string_view text = arrayText(da, storage);
     // Each value takes at least one character and a separator, so this bound is real data.
     out.clear();
-    out.reserve(size_t(std::min<uint64_t>(expectedValues, text.size() / 2 + 1)));
+    out.reserve(size_t(std::min<uint64_t>(range.count, text.size() / 2 + 1)));
     size_t pos = 0;
-    for (uint64_t i = 0; i < expectedValues; ++i) {
+    for (uint64_t i = 0; i < range.first + range.count; ++i) {
       T v;
       int r;
       if constexpr (wantInts)
@@ -350,10 +389,10 @@ Result readDataArray(Vtu& vtu, pugi::xml_node da, const ArrayRef& ref, uint64_t 
         return fail(Status::Corrupt, ref.str() + ": value " + std::to_string(i) + " '" + printable(tok) + "' is not " +
                                          (wantInts ? "an integer" : "a number"));
       }
-      out.push_back(v);
+      if (i >= range.first) out.push_back(v);
     }
     double extra;
-    if (parseNextDouble(text, pos, extra) != 0)
+    if (whole && parseNextDouble(text, pos, extra) != 0)
       return fail(Status::Corrupt,
                   ref.str() + ": has more than the expected " + std::to_string(expectedValues) + " values");
     return Result::success();
@@ -383,14 +422,19 @@ Result readDataArray(Vtu& vtu, pugi::xml_node da, const ArrayRef& ref, uint64_t 
 
   std::vector<uint8_t> bytes;
   const uint8_t* data = nullptr;
-  if (Result r = readPayload(vtu, src, ref, expectedBytes, bytes, data); !r) return r;
-  out.resize(expectedValues);
+  const uint64_t size = scalarSize(type);
+  if (Result r = readPayload(vtu, src, ref, expectedBytes, range.first * size, (range.first + range.count) * size,
+                             bytes, data);
+      !r)
+    return r;
+  out.resize(range.count);
   if constexpr (wantInts) {
-    size_t ok = decodeInts(data, expectedValues, type, vtu.bigEndian, out.data());
-    if (ok != expectedValues)
-      return fail(Status::OutOfRange, ref.str() + ": value " + std::to_string(ok) + " exceeds the Int64 range");
+    size_t ok = decodeInts(data, range.count, type, vtu.bigEndian, out.data());
+    if (ok != range.count)
+      return fail(Status::OutOfRange,
+                  ref.str() + ": value " + std::to_string(range.first + ok) + " exceeds the Int64 range");
   } else {
-    decodeDoubles(data, expectedValues, type, vtu.bigEndian, out.data());
+    decodeDoubles(data, range.count, type, vtu.bigEndian, out.data());
   }
   return Result::success();
 }
@@ -456,10 +500,17 @@ Result readExtent(pugi::xml_node node, const char* attr, const std::string& wher
   return Result::success();
 }
 
+// The rows of a piece one process reads: a run of its cells and the run of points they span.
+struct PieceRows {
+  uint64_t pointFirst = 0, points = UINT64_MAX;
+  uint64_t cellFirst = 0, cells = UINT64_MAX;
+};
+
 // Reads the PointData and CellData arrays of one piece (np points, nc cells) into it: fields,
-// cell arrays, and the arrays that describe the partition (vtkGhostType, global ids).
+// cell arrays, and the arrays that describe the partition (vtkGhostType, global ids). Of `rows`
+// only (all of them by default).
 Result readPieceData(Vtu& vtu, pugi::xml_node piece, const std::string& where, uint64_t np, uint64_t nc,
-                     ReadReport& report, bool notePieceConversions, MeshPiece& out) {
+                     ReadReport& report, bool notePieceConversions, MeshPiece& out, const PieceRows& rows = {}) {
   for (const char* section : {"PointData", "CellData"}) {
     const bool cells = section[0] == 'C';
     const char* kind = cells ? "cell" : "point";
@@ -480,7 +531,9 @@ Result readPieceData(Vtu& vtu, pugi::xml_node piece, const std::string& where, u
       uint64_t comps;
       if (Result r = readComponents(da, ref, comps); !r) return r;
       std::vector<double> values;
-      if (Result r = readDataArray(vtu, da, ref, (cells ? nc : np) * comps, values); !r) return r;
+      const uint64_t first = cells ? rows.cellFirst : rows.pointFirst, count = cells ? rows.cells : rows.points;
+      const ValueRange range{first * comps, count == UINT64_MAX ? UINT64_MAX : count * comps};
+      if (Result r = readDataArray(vtu, da, ref, (cells ? nc : np) * comps, values, range); !r) return r;
       if (const PartitionArray p = partitionArrayKind(name, cells, idsAttribute); p != PartitionArray::None) {
         if (Result r = takePartitionArray(p, name, ref.str(), values, comps, cells, out); !r) return r;
         continue;
@@ -593,6 +646,95 @@ Result readPiece(Vtu& vtu, GridKind kind, const Grid& whole, pugi::xml_node piec
   return readPieceData(vtu, piece, where, np, nc, report, notePieceConversions, out);
 }
 
+// Reads share `index` of `count` of an unstructured piece: its cells from index·nc/count up to
+// (index + 1)·nc/count and the points from the smallest to the largest id they use, with those
+// rows of every array. The other rows are passed over (raw appended data is not even read from
+// the mapped file, compressed blocks not inflated); the points on the cuts are read by both
+// sides and joined by the distributed pack like the points pieces share.
+Result readPieceShare(Vtu& vtu, pugi::xml_node piece, const std::string& label, uint32_t index, uint32_t count,
+                      MeshPiece& out, ReadReport& report, bool notePieceConversions, uint64_t& cellsTotal) {
+  uint64_t np = 0, nc = 0;
+  if (Result r = readCount(piece, "NumberOfPoints", label, np); !r) return r;
+  if (Result r = readCount(piece, "NumberOfCells", label, nc); !r) return r;
+  cellsTotal = nc;
+  PieceRows rows;
+  rows.cellFirst = nc * index / count;
+  rows.cells = nc * (index + 1ull) / count - rows.cellFirst;
+  out.where = label + " (cells " + std::to_string(rows.cellFirst) + " to " +
+              std::to_string(rows.cellFirst + rows.cells) + " of " + std::to_string(nc) + ")";
+  const std::string& where = out.where;
+  if (np > kMaxVertices)
+    return fail(Status::TooLarge,
+                where + ": " + std::to_string(np) + " points; tetstream indexes vertices with 32 bits");
+
+  std::vector<int64_t> ends, types, conn;
+  if (rows.cells > 0) {
+    pugi::xml_node cells = piece.child("Cells");
+    pugi::xml_node daOff = findArray(cells, "offsets"), daTypes = findArray(cells, "types"),
+                   daConn = findArray(cells, "connectivity");
+    for (auto [node, name] : {std::pair{daOff, "offsets"}, {daTypes, "types"}, {daConn, "connectivity"}})
+      if (!node)
+        return fail(Status::Corrupt,
+                    where + ": NumberOfCells=" + std::to_string(nc) + " but <Cells> has no DataArray '" + name + "'");
+    // The cell before the first ends where the first starts; the last cell's end is the
+    // connectivity's length.
+    const uint64_t before = rows.cellFirst > 0 ? 1 : 0;
+    if (Result r =
+            readDataArray(vtu, daOff, {where, "offsets"}, nc, ends, {rows.cellFirst - before, rows.cells + before});
+        !r)
+      return r;
+    std::vector<int64_t> last{ends.back()};
+    if (rows.cellFirst + rows.cells < nc)
+      if (Result r = readDataArray(vtu, daOff, {where, "offsets"}, nc, last, {nc - 1, 1}); !r) return r;
+    const int64_t start = before ? ends.front() : 0, stop = ends.back(), connSize = last.back();
+    if (start < 0 || stop < start || stop > connSize)
+      return fail(Status::Corrupt, where + ": DataArray 'offsets': the cells span connectivity " +
+                                       std::to_string(start) + ".." + std::to_string(stop) + ", outside 0.." +
+                                       std::to_string(connSize) + " or going backwards");
+    if (Result r = readDataArray(vtu, daTypes, {where, "types"}, nc, types, {rows.cellFirst, rows.cells}); !r) return r;
+    if (Result r = readDataArray(vtu, daConn, {where, "connectivity"}, uint64_t(connSize), conn,
+                                 {uint64_t(start), uint64_t(stop - start)});
+        !r)
+      return r;
+    // Offsets relative to the run read, with the first cell's start in front.
+    if (before) ends.erase(ends.begin());
+    for (int64_t& e : ends) e -= start;
+    ends.insert(ends.begin(), 0);
+  } else {
+    ends = {0};
+  }
+
+  int64_t lo = INT64_MAX, hi = -1;
+  for (int64_t id : conn) {
+    if (id < 0 || uint64_t(id) >= np)
+      return fail(Status::Corrupt, where + ": a cell names point " + std::to_string(id) + " of a piece of " +
+                                       std::to_string(np) + " points");
+    lo = std::min(lo, id);
+    hi = std::max(hi, id);
+  }
+  rows.pointFirst = hi < 0 ? 0 : uint64_t(lo);
+  rows.points = hi < 0 ? 0 : uint64_t(hi + 1 - lo);
+  for (int64_t& id : conn) id -= int64_t(rows.pointFirst);
+
+  TetMesh& mesh = out.mesh;
+  const uint64_t vertexBase = mesh.positions.size() / 3;
+  if (rows.points > 0) {
+    pugi::xml_node da = piece.child("Points").child("DataArray");
+    ArrayRef ref{where, da ? da.attribute("Name").as_string("Points") : "Points"};
+    if (!da) return fail(Status::Corrupt, where + ": " + std::to_string(np) + " points but no <Points> DataArray");
+    uint64_t comps;
+    if (Result r = readComponents(da, ref, comps); !r) return r;
+    if (comps != 3)
+      return fail(Status::Corrupt, ref.str() + ": points have " + std::to_string(comps) + " components, expected 3");
+    std::vector<double> p;
+    if (Result r = readDataArray(vtu, da, ref, np * 3, p, {3 * rows.pointFirst, 3 * rows.points}); !r) return r;
+    mesh.positions.reserve(mesh.positions.size() + p.size());
+    for (double x : p) mesh.positions.push_back(float(x));
+  }
+  if (Result r = appendVtkCells(where, conn, ends, types, vertexBase, rows.points, out.soup); !r) return r;
+  return readPieceData(vtu, piece, where, np, nc, report, notePieceConversions, out, rows);
+}
+
 // Locates <AppendedData ...> and its '_' marker in the raw bytes. xmlEnd is where the parsable XML
 // stops; dataBegin/dataEnd bound the payload area.
 Result locateAppended(std::string_view bytes, const std::string& label, size_t& xmlEnd, bool& found, bool& base64,
@@ -638,6 +780,56 @@ Result locateAppended(std::string_view bytes, const std::string& label, size_t& 
   if (after == std::string_view::npos || bytes.substr(after, 10) != "</VTKFile>")
     return fail(Status::Truncated, label + ": file ends before </VTKFile>");
   data = bytes.substr(p, close - p);
+  return Result::success();
+}
+
+// Reads the pieces, or of at least shareCount pieces share shareIndex of them: the others are
+// never decoded (their points are welded to these by the distributed pack, as the pieces of a
+// listing are).
+Result readPieces(Vtu& vtu, GridKind kind, const Grid& whole, const std::vector<pugi::xml_node>& nodes,
+                  const std::string& label, uint32_t shareIndex, uint32_t shareCount, std::vector<MeshPiece>& pieces,
+                  ReadReport& report) {
+  size_t from = 0, to = nodes.size();
+  if (shareCount > 1 && nodes.size() >= shareCount) {
+    from = nodes.size() * shareIndex / shareCount;
+    to = nodes.size() * (shareIndex + 1ull) / shareCount;
+    report.shared = true;
+    report.notes.push_back("read pieces " + std::to_string(from + 1) + " to " + std::to_string(to) + " of " +
+                           std::to_string(nodes.size()) + ", this process's share of the file");
+  }
+  pieces.reserve(to - from);  // bounded: each is an element of the file
+  for (size_t k = from; k < to; ++k) {
+    MeshPiece& piece = pieces.emplace_back();
+    piece.where = nodes.size() == 1 ? label : label + " Piece " + std::to_string(k);
+    piece.name = "Piece " + std::to_string(k);
+    if (Result r = readPiece(vtu, kind, whole, nodes[k], piece.where, piece, report, k == from); !r) return r;
+  }
+  return Result::success();
+}
+
+// Of fewer unstructured pieces than processes, share shareIndex of the cells of every piece.
+Result readCellShares(Vtu& vtu, const std::vector<pugi::xml_node>& nodes, const std::string& label, uint32_t shareIndex,
+                      uint32_t shareCount, std::vector<MeshPiece>& pieces, ReadReport& report) {
+  uint64_t cells = 0, cellsRead = 0, points = 0;
+  pieces.reserve(nodes.size());  // bounded: each is an element of the file
+  for (size_t k = 0; k < nodes.size(); ++k) {
+    MeshPiece& piece = pieces.emplace_back();
+    piece.name = "Piece " + std::to_string(k);
+    uint64_t total = 0;
+    if (Result r = readPieceShare(vtu, nodes[k], nodes.size() == 1 ? label : label + " Piece " + std::to_string(k),
+                                  shareIndex, shareCount, piece, report, k == 0, total);
+        !r)
+      return r;
+    cells += total;
+    cellsRead += piece.soup.inputCells;
+    points += piece.mesh.positions.size() / 3;
+  }
+  report.shared = true;
+  const std::string which = nodes.size() == 1
+                                ? "share " + std::to_string(shareIndex + 1) + " of " + std::to_string(shareCount)
+                                : "a share of each of the " + std::to_string(nodes.size()) + " pieces";
+  report.notes.push_back("read " + std::to_string(cellsRead) + " of the " + std::to_string(cells) + " cells (" + which +
+                         ") and the " + std::to_string(points) + " points they span, this process's share of the file");
   return Result::success();
 }
 
@@ -739,24 +931,12 @@ Result vtkio::readVtuPieces(std::string_view bytes, const std::string& label, st
   for (pugi::xml_node p : grid.children("Piece")) nodes.push_back(p);
   if (nodes.empty()) return fail(Status::Corrupt, label + ": <" + type + "> has no <Piece>");
 
-  // A share of the pieces: the others are never decoded (their points are welded to these by
-  // the distributed pack, as the pieces of a listing are).
-  size_t from = 0, to = nodes.size();
-  if (shareCount > 1 && nodes.size() >= shareCount) {
-    from = nodes.size() * shareIndex / shareCount;
-    to = nodes.size() * (shareIndex + 1ull) / shareCount;
-    report.shared = true;
-    report.notes.push_back("read pieces " + std::to_string(from + 1) + " to " + std::to_string(to) + " of " +
-                           std::to_string(nodes.size()) + ", this process's share of the file");
-  }
   pieces.clear();
-  pieces.reserve(to - from);  // bounded: each is an element of the file
-  for (size_t k = from; k < to; ++k) {
-    MeshPiece& piece = pieces.emplace_back();
-    piece.where = nodes.size() == 1 ? label : label + " Piece " + std::to_string(k);
-    piece.name = "Piece " + std::to_string(k);
-    if (Result r = readPiece(vtu, kind, whole, nodes[k], piece.where, piece, report, k == from); !r) return r;
-  }
+  const bool shareCells = shareCount > 1 && nodes.size() < shareCount && kind == GridKind::Unstructured;
+  if (Result r = shareCells ? readCellShares(vtu, nodes, label, shareIndex, shareCount, pieces, report)
+                            : readPieces(vtu, kind, whole, nodes, label, shareIndex, shareCount, pieces, report);
+      !r)
+    return r;
 
   std::string enc;
   for (const std::string& e : vtu.encodings) enc += (enc.empty() ? "" : ", ") + e;

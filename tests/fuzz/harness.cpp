@@ -372,11 +372,11 @@ void listing(const uint8_t* data, size_t size) {
     first = false;
   }
   int loads = 0;
-  const PieceLoader load = [&](const std::string& path, std::string& bytes) {
+  const PieceLoader load = [&](const std::string& path, PieceBytes& piece) {
     ++loads;
     auto it = files.find(path);
     if (it == files.end()) return fail(Status::IoError, path + ": no such file");
-    bytes = it->second;
+    piece.bytes = it->second;
     return Result::success();
   };
   TetMesh m;

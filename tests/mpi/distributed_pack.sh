@@ -101,6 +101,17 @@ sharesLikeOneProcess multi "$WORK/pieces/multi.vtu" "this process's share of the
 sharesLikeOneProcess petsc "$FIXTURES/petsc.vtu" "this process's share of the file" "3" "2 3.5" \
   --base-vertices 8 --leaf-vertices 4
 
+# One .vtu of one piece, as most solvers and ParaView write it: each rank reads its run of the
+# cells and the points they span (appended raw data as tetstream writes it; inline base64 with
+# zlib blocks as meshio writes it).
+sharesLikeOneProcess vtu "$WORK/harmonic.vtu" "this process's share of the file" "2 3" "0 0.25" \
+  --leaf-vertices 256 --chunk-kb 8
+/usr/bin/python3 -c "
+import meshio, sys
+meshio.read(sys.argv[1]).write(sys.argv[2], compression='zlib')" "$WORK/harmonic.vtu" "$WORK/harmonic-zlib.vtu"
+sharesLikeOneProcess vtu-zlib "$WORK/harmonic-zlib.vtu" "this process's share of the file" "2" "0 0.25" \
+  --leaf-vertices 256 --chunk-kb 8
+
 # One XDMF grid with HDF5 heavy data and one Exodus II file, as meshio writes them (DOLFINx and
 # others write XDMF so: one file for the whole mesh): each rank reads its rows of the cells (HDF5
 # hyperslabs; the Exodus library's partial reads) and the points they span.
