@@ -11,6 +11,10 @@
 //       the level the viewer holds when it loads everything of a dataset of regions, once N bytes
 //       of chunks are in: regions in its order (most field error first, each after its parent;
 //       wasm/fetch_plan.cpp, every region in view), as .vtu
+//   tetstream_bench closure PACKDIR --values A,B,C
+//       what each isovalue needs (fraction of the stream's bytes): whole nodes as the viewer
+//       fetches them ("tree"), and with each split's exact dependencies on earlier splits, split
+//       by split ("splitClosure") or node by node ("nodeClosure")
 //   tetstream_bench isodist ORIGINAL.vtu APPROX.vtu --field F --value V
 //       distance between the isosurfaces of the two meshes (area-weighted mean and max over
 //       triangle centroids and vertices, both directions, relative to ORIGINAL's diagonal)
@@ -25,10 +29,12 @@
 #include <string>
 #include <vector>
 
+#include "chunk.h"
 #include "dataset.h"
 #include "io/mesh_io.h"
 #include "isosurface.h"
 #include "partial.h"
+#include "split_stream.h"
 #include "tet_quality.h"
 
 using namespace tetstream;
@@ -392,6 +398,169 @@ int cmdRegions(int argc, char** argv) {
   return 0;
 }
 
+// What an isovalue would need if the ancestors of the regions it selects could be fetched split
+// by split instead of whole: every node applied in stream order, each split's reads (the tets
+// around its kept vertex) and writes (the stars of every vertex of the tets it moves or makes)
+// give its exact dependencies on earlier splits; the splits needed are the selected leaves'
+// and, of the other nodes, those whose tets straddle the isovalue at full resolution, closed
+// under those dependencies. A bound on what patches of the upper levels could give.
+int cmdClosure(int argc, char** argv) {
+  const std::string dir = argv[2];
+  std::vector<double> values;
+  for (const char* p = arg(argc, argv, "--values", ""); *p;) {
+    char* end;
+    const double v = std::strtod(p, &end);
+    if (end == p) break;  // (not a number: the list ends)
+    values.push_back(v);
+    p = *end == ',' ? end + 1 : end;
+  }
+  std::string json;
+  PartialDataset pd;
+  auto source = [&](uint32_t index, std::vector<uint8_t>& file) {
+    return readFileBytes(dir + "/" + pd.manifest.chunks[index].file, pd.manifest.chunks[index].bytes, file);
+  };
+  Result r = readManifestFile(dir, json);
+  if (r) r = openPartial(pd, json, source);
+  if (!r) {
+    std::fprintf(stderr, "%s\n", r.message.c_str());
+    return 1;
+  }
+  const Manifest& m = pd.manifest;
+  ProgressiveMesh& pm = pd.pm;
+  std::vector<uint32_t> splitNode;
+  std::vector<double> splitBytes;
+  std::vector<uint32_t> depStart{0}, deps, touched;  // per split: its dependencies; tets it touched
+  std::vector<uint32_t> touchedStart{0};
+  // Per vertex (its star): the splits that wrote it since it was last read, and those that read
+  // it since it was last written.
+  std::vector<std::vector<uint32_t>> writers(pm.vertexCount()), readers(pm.vertexCount());
+  std::vector<uint32_t> changed, star, mine, writes;
+  std::vector<uint8_t> file;
+  for (uint32_t k = 0; k < m.nodes.size() && r; ++k) {
+    const NodeInfo& node = m.nodes[k];
+    for (uint32_t c = node.firstChunk; c < node.firstChunk + node.chunkCount && r; ++c) {
+      const ChunkInfo& info = m.chunks[c];
+      std::span<const uint8_t> payload;
+      if (!(r = source(c, file)) || !(r = openChunk(pd.decoder, info, c, file, payload)) ||
+          !(r = beginSplits(pd.reader, payload, info, m)))
+        break;
+      for (uint32_t s = 0; s < info.splits; ++s) {
+        const uint32_t g = uint32_t(splitNode.size());
+        const uint32_t tetsBefore = pm.tetCount();
+        changed.clear();
+        if (!(r = applyNextSplit(pd.reader, pm, pd.quant, changed))) break;
+        const uint32_t j = pm.splitJ.back(), i = pm.vertexCount() - 1;
+        writers.emplace_back();
+        readers.emplace_back();
+        mine.clear();
+        writes.clear();
+        auto has = [&](uint32_t t, uint32_t v) {
+          const uint32_t* q = &pm.mesh.tets[4 * size_t(t)];
+          return q[0] == v || q[1] == v || q[2] == v || q[3] == v;
+        };
+        for (uint32_t t : changed)
+          if (t >= tetsBefore || has(t, i)) {
+            touched.push_back(t);
+            for (int a = 0; a < 4; ++a) writes.push_back(pm.mesh.tets[4 * size_t(t) + size_t(a)]);
+          }
+        touchedStart.push_back(uint32_t(touched.size()));
+        std::sort(writes.begin(), writes.end());
+        writes.erase(std::unique(writes.begin(), writes.end()), writes.end());
+        // Reads star(j): after the writers of it since its last read.
+        for (uint32_t w : writers[j]) mine.push_back(w);
+        readers[j].push_back(g);
+        for (uint32_t v : writes) {
+          for (uint32_t q : readers[v])
+            if (q != g) mine.push_back(q);
+          if (!readers[v].empty() && !(readers[v].size() == 1 && readers[v][0] == g)) {
+            writers[v].clear();
+            readers[v].clear();
+          }
+          writers[v].push_back(g);
+        }
+        std::sort(mine.begin(), mine.end());
+        mine.erase(std::unique(mine.begin(), mine.end()), mine.end());
+        for (uint32_t d : mine)
+          if (d != g) deps.push_back(d);
+        depStart.push_back(uint32_t(deps.size()));
+        splitNode.push_back(k);
+        splitBytes.push_back(double(info.bytes) / info.splits);
+      }
+      if (r) r = endSplits(pd.reader);
+    }
+  }
+  if (!r) {
+    std::fprintf(stderr, "%s\n", r.message.c_str());
+    return 1;
+  }
+  const int f = std::max(0, m.findField(m.isoField));
+  const std::vector<float>& value = pm.mesh.fields[size_t(f)].values;
+  std::vector<bool> isLeaf(m.nodes.size(), true);
+  for (const NodeInfo& n : m.nodes)
+    if (n.parent >= 0) isLeaf[size_t(n.parent)] = false;
+  double total = m.chunks[0].bytes;
+  for (double b : splitBytes) total += b;
+  std::printf("{\"splits\": %zu, \"dependencies\": %zu, \"bytesTotal\": %.0f, \"values\": [", splitNode.size(),
+              deps.size(), total);
+  for (size_t vi = 0; vi < values.size(); ++vi) {
+    const double v = values[vi];
+    std::vector<uint8_t> need(splitNode.size(), 0);
+    std::vector<uint32_t> stack;
+    std::vector<bool> nodeSelected(m.nodes.size());
+    for (uint32_t k = 0; k < m.nodes.size(); ++k)
+      nodeSelected[k] = m.nodes[k].ranges[size_t(f)].min <= v && v <= m.nodes[k].ranges[size_t(f)].max;
+    for (uint32_t g = 0; g < splitNode.size(); ++g) {
+      bool seed = false;
+      if (!nodeSelected[splitNode[g]]) continue;
+      if (isLeaf[splitNode[g]]) {
+        seed = true;
+      } else {  // the full-resolution tets it touched straddle v
+        float lo = INFINITY, hi = -INFINITY;
+        for (uint32_t e = touchedStart[g]; e < touchedStart[g + 1]; ++e)
+          for (int a = 0; a < 4; ++a) {
+            const float x = value[pm.mesh.tets[4 * size_t(touched[e]) + size_t(a)]];
+            lo = std::min(lo, x), hi = std::max(hi, x);
+          }
+        seed = lo <= v && v <= hi;
+      }
+      if (seed && !need[g]) need[g] = 1, stack.push_back(g);
+    }
+    auto close = [&] {
+      while (!stack.empty()) {
+        const uint32_t g = stack.back();
+        stack.pop_back();
+        for (uint32_t e = depStart[g]; e < depStart[g + 1]; ++e)
+          if (!need[deps[e]]) need[deps[e]] = 1, stack.push_back(deps[e]);
+      }
+    };
+    close();
+    double bytes = m.chunks[0].bytes, treeBytes = m.chunks[0].bytes;
+    for (uint32_t g = 0; g < splitNode.size(); ++g) {
+      if (need[g]) bytes += splitBytes[g];
+      if (nodeSelected[splitNode[g]]) treeBytes += splitBytes[g];
+    }
+    // Whole nodes: a node with a needed split is needed whole, until nothing changes.
+    std::vector<uint8_t> nodeNeeded(m.nodes.size(), 0);
+    for (bool grew = true; grew;) {
+      grew = false;
+      for (uint32_t g = 0; g < splitNode.size(); ++g)
+        if (need[g]) nodeNeeded[splitNode[g]] = 1;
+      for (uint32_t g = 0; g < splitNode.size(); ++g)
+        if (!need[g] && nodeNeeded[splitNode[g]]) need[g] = 1, stack.push_back(g), grew = true;
+      close();
+    }
+    double nodeBytes = m.chunks[0].bytes;
+    size_t nodesNeeded = 0;
+    for (uint32_t g = 0; g < splitNode.size(); ++g)
+      if (need[g]) nodeBytes += splitBytes[g];
+    for (uint8_t x : nodeNeeded) nodesNeeded += x;
+    std::printf("%s{\"value\": %g, \"tree\": %.4f, \"splitClosure\": %.4f, \"nodeClosure\": %.4f, \"nodes\": %zu}",
+                vi ? ", " : "", v, treeBytes / total, bytes / total, nodeBytes / total, nodesNeeded);
+  }
+  std::printf("]}\n");
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -400,9 +569,11 @@ int main(int argc, char** argv) {
   if (argc >= 4 && !std::strcmp(argv[1], "raw")) return cmdRaw(argv);
   if (argc >= 4 && !std::strcmp(argv[1], "vtu")) return cmdVtu(argv);
   if (argc >= 4 && !std::strcmp(argv[1], "regions")) return cmdRegions(argc, argv);
+  if (argc >= 3 && !std::strcmp(argv[1], "closure")) return cmdClosure(argc, argv);
   std::fprintf(
       stderr,
       "usage: tetstream_bench error ORIG.vtu APPROX.vtu [--field F] | raw MESH.vtu OUT.bin | vtu MESH OUT.vtu | "
-      "isodist ORIG.vtu APPROX.vtu [--field F] [--value V] | regions PACKDIR OUT.vtu --bytes N\n");
+      "isodist ORIG.vtu APPROX.vtu [--field F] [--value V] | regions PACKDIR OUT.vtu --bytes N | "
+      "closure PACKDIR --values A,B,C\n");
   return 2;
 }
