@@ -155,6 +155,10 @@ class XdmfReader {
   Result sameMesh(pugi::xml_node a, pugi::xml_node b, const std::string& what, bool& same);
   Result readPiece(pugi::xml_node grid, const std::vector<pugi::xml_node>& companions, const std::string& where,
                    bool first, PieceArrays& arrays, bool& skipped, bool& sharedPoints);
+  Result shareGrids(const std::vector<pugi::xml_node>& pieces, const std::vector<pugi::xml_node>& companions,
+                    std::vector<bool>& readHere);
+  Result gridShape(pugi::xml_node grid, const std::vector<pugi::xml_node>& companions, const std::string& where,
+                   bool& volume, bool& byRows, const void*& geometry);
   Result readShareOfGrid(pugi::xml_node topo, pugi::xml_node geo, const TopologyKind& kind,
                          const std::vector<pugi::xml_node>& attributes, const std::string& where, PieceArrays& arrays,
                          bool& done);
@@ -177,7 +181,7 @@ class XdmfReader {
   TetMesh mesh_;
   CellSoup soup_;
   std::vector<std::string> topologies_;  // read, in order, for ReadReport::format
-  bool shareGrid_ = false;               // the file is one grid read by several processes, each its share
+  bool shareGrid_ = false;               // each process reads a share of the rows of every volume grid
   // Geometry elements read so far (after references): their first vertex and point count. A
   // grid on the points of an earlier one adds its cells to those points.
   std::map<const void*, std::pair<uint64_t, uint64_t>> geometries_;
@@ -486,7 +490,7 @@ Result XdmfReader::readShareOfGrid(pugi::xml_node topo, pugi::xml_node geo, cons
   const std::vector<uint64_t> dims = doc_.declaredDims(item);
   const uint64_t nodes = uint64_t(kind.nodes);
   const bool cellRows = dims.size() == 2 && dims[1] == nodes;
-  if (!cellRows && !(dims.size() == 1 && dims[0] % nodes == 0)) return Result::success();
+  if (!cellRows && !(nodes > 0 && dims.size() == 1 && dims[0] % nodes == 0)) return Result::success();
   const uint64_t cellsTotal = cellRows ? dims[0] : dims[0] / nodes;
   const uint64_t from = cellsTotal * options_.shareIndex / options_.shareCount,
                  to = cellsTotal * (options_.shareIndex + 1ull) / options_.shareCount;
@@ -528,6 +532,79 @@ Result XdmfReader::readShareOfGrid(pugi::xml_node topo, pugi::xml_node geo, cons
                           std::to_string(cellsTotal) + " and the " + std::to_string(points) +
                           " points they span, this process's share of the grid");
   done = true;
+  return Result::success();
+}
+
+// What a grid is, for sharing it: a grid of volume cells tetstream reads, one that can be read
+// in rows (readShareOfGrid: one cell type, a declared size, no attribute of a function space),
+// and its Geometry element (after references).
+Result XdmfReader::gridShape(pugi::xml_node grid, const std::vector<pugi::xml_node>& companions,
+                             const std::string& where, bool& volume, bool& byRows, const void*& geometry) {
+  volume = byRows = false;
+  geometry = nullptr;
+  std::vector<pugi::xml_node> topos, geos, attributes;
+  if (Result r = doc_.children(grid, "Topology", where, topos); !r) return r;
+  if (topos.size() != 1) return Result::success();  // (readPiece says what is wrong)
+  std::string_view typeName = topos[0].attribute("TopologyType").value();
+  if (typeName.empty()) typeName = topos[0].attribute("Type").value();
+  const bool mixed = iequals(typeName, "Mixed");
+  const TopologyKind* kind = mixed ? nullptr : kindByName(typeName);
+  volume = mixed || (kind && kind->read);
+  if (!volume) return Result::success();
+  if (Result r = doc_.children(grid, "Geometry", where, geos); !r) return r;
+  if (geos.size() == 1) geometry = geos[0].internal_object();
+  if (mixed) return Result::success();
+  if (Result r = doc_.children(grid, "Attribute", where, attributes); !r) return r;
+  for (pugi::xml_node c : companions) {
+    std::vector<pugi::xml_node> more;
+    if (Result r = doc_.children(c, "Attribute", where, more); !r) return r;
+    attributes.insert(attributes.end(), more.begin(), more.end());
+  }
+  for (pugi::xml_node a : attributes)
+    if (iequals(a.attribute("Center").value(), "Other")) return Result::success();
+  pugi::xml_node item;
+  if (Result r = doc_.dataItem(topos[0], where + " Topology", item); !r) return r;
+  const std::vector<uint64_t> dims = doc_.declaredDims(item);
+  const uint64_t nodes = uint64_t(kind->nodes);
+  byRows = (dims.size() == 2 && dims[1] == nodes) || (nodes > 0 && dims.size() == 1 && dims[0] % nodes == 0);
+  return Result::success();
+}
+
+// Which grids this process reads (ReadOptions::shareIndex of shareCount). Of at least as many
+// volume grids as processes (a spatial collection of one grid per rank), its share of them, each
+// whole; of fewer, every one, each a share of its rows, when all can be read so. Otherwise, or
+// when two volume grids stand on one Geometry (a grid of tags repeats the mesh's cells: on two
+// processes the repeats would be kept twice), every grid is read whole and the caller keeps its
+// share of the tets.
+Result XdmfReader::shareGrids(const std::vector<pugi::xml_node>& pieces, const std::vector<pugi::xml_node>& companions,
+                              std::vector<bool>& readHere) {
+  std::vector<size_t> volumes;
+  std::set<const void*> geometries;
+  bool rows = true;
+  for (size_t k = 0; k < pieces.size(); ++k) {
+    bool volume, byRows;
+    const void* geometry;
+    if (Result r = gridShape(pieces[k], k == 0 ? companions : std::vector<pugi::xml_node>{},
+                             doc_.label() + " Grid " + std::to_string(k), volume, byRows, geometry);
+        !r)
+      return r;
+    if (!volume) continue;
+    volumes.push_back(k);
+    rows = rows && byRows;
+    if (geometry && !geometries.insert(geometry).second) return Result::success();
+  }
+  const uint64_t n = volumes.size(), count = options_.shareCount, index = options_.shareIndex;
+  if (n >= count) {
+    const uint64_t from = n * index / count, to = n * (index + 1) / count;
+    for (size_t v = 0; v < n; ++v) readHere[volumes[v]] = v >= from && v < to;
+    report_.shared = true;
+    const std::string which = to == from + 1 ? "grid " + std::to_string(to)
+                                             : "grids " + std::to_string(from + 1) + " to " + std::to_string(to);
+    report_.notes.push_back("read " + which + " of the " + std::to_string(n) +
+                            " volume grids, this process's share of the file");
+  } else if (n > 0 && rows) {
+    shareGrid_ = true;
+  }
   return Result::success();
 }
 
@@ -836,15 +913,16 @@ Result XdmfReader::read(TetMesh& out) {
     }
   }
 
-  // One grid on several processes: each reads its share of it (more pieces are shared as files
-  // are by core/dist: each process keeps its share of the tets).
-  shareGrid_ = options_.shareCount > 1 && pieces.size() == 1;
+  std::vector<bool> readHere(pieces.size(), true);
+  if (options_.shareCount > 1)
+    if (Result r = shareGrids(pieces, companions, readHere); !r) return r;
 
   // Pieces, their arrays merged: an array survives only if every piece that was read has it.
   PieceArrays merged;
   std::vector<bool> keepField, keepCell;
   size_t read = 0;
   for (size_t k = 0; k < pieces.size(); ++k) {
+    if (!readHere[k]) continue;
     const std::string name = gridName(pieces[k]);
     std::string where = label + " Grid" + (name.empty() ? " " + std::to_string(k) : " '" + name + "'");
     PieceArrays pa;

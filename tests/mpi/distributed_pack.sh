@@ -122,6 +122,11 @@ m = meshio.read(sys.argv[1])
 meshio.write(sys.argv[2], meshio.Mesh(m.points, m.cells, point_data=m.point_data))" "$WORK/harmonic.vtu" "$WORK/harmonic.$ext"
 done
 sharesLikeOneProcess xdmf "$WORK/harmonic.xdmf" "this process's share of the grid" "2 3" "0 0.25" --leaf-vertices 256 --chunk-kb 8
+# An XDMF spatial collection of one grid per rank of the run that wrote it (each its own points,
+# in one HDF5 file): each rank reads its grids.
+/usr/bin/python3 "$HERE/write_grids.py" "$WORK/harmonic.vtu" "$WORK/grids" 4
+sharesLikeOneProcess xdmf-grids "$WORK/grids.xdmf" "this process's share of the file" "2 4" "0 0.25" \
+  --leaf-vertices 256 --chunk-kb 8
 sharesLikeOneProcess exodus "$WORK/harmonic.exo" "this process's share of the file" "2 3" "0 0.25" --leaf-vertices 256 --chunk-kb 8
 
 # The same bytes on a second run.

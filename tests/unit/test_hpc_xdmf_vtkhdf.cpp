@@ -172,6 +172,23 @@ TEST(XdmfShares, TheSharesOfAGridHoldEveryTetOnceWithItsValues) {
     test::expectSharesMakeTheWhole(hpcPath(name), 3, "c");
 }
 
+// A spatial collection of grids (one per rank of the run that wrote it): on as many processes as
+// volume grids each reads its own grids whole; on more, each reads its rows of every grid. The
+// grid of triangles beside them is skipped either way.
+TEST(XdmfShares, TheGridsOfACollectionAreSharedByGridOrByRows) {
+  for (uint32_t count : {2u, 3u}) test::expectSharesMakeTheWhole(hpcPath("xdmf_inline.xmf"), count, "c");
+  ReadOptions o;
+  o.shareIndex = 1;
+  o.shareCount = 2;
+  TetMesh m;
+  ReadReport r;
+  ASSERT_TRUE(readMesh(hpcPath("xdmf_inline.xmf"), m, r, o));
+  EXPECT_TRUE(hasNote(r, "read grid 2 of the 2 volume grids, this process's share of the file")) << allNotes(r);
+  o.shareCount = 3;
+  ASSERT_TRUE(readMesh(hpcPath("xdmf_inline.xmf"), m, r = ReadReport{}, o));
+  EXPECT_TRUE(hasNote(r, "this process's share of the grid")) << allNotes(r);
+}
+
 TEST(XdmfTimeSeries, StepsAreListedAndPicked) {
   const std::string file = hpcPath("xdmf_series.xdmf");
   const nlohmann::json& e = expected()["xdmf_series.xdmf"];
@@ -677,6 +694,15 @@ TEST(XdmfReader, GridsOnTheSamePoints) {
   EXPECT_TRUE(hasNote(r, "Grid 'cell_tags': 2 cells repeat cells of an earlier grid")) << allNotes(r);
   EXPECT_TRUE(hasNote(r, "Grid 'facet_tags': 1 Triangle cells")) << allNotes(r);
   expectValid(m, "mesh with tags");
+  // On two processes the tags grid is not another process's share: every process reads both grids
+  // (and keeps its share of the tets), so the repeated cells are still recognised.
+  ReadOptions o;
+  o.shareIndex = 1;
+  o.shareCount = 2;
+  r = ReadReport{};
+  ASSERT_TRUE(readXdmf(tags, "t.xdmf", std::nullopt, o, m, r));
+  EXPECT_FALSE(r.shared);
+  EXPECT_EQ(m.tetCount(), 2u) << allNotes(r);
 
   // Two blocks of different cells on one shared Geometry: both are read, on the same points.
   const std::string blocks = R"x(<Xdmf Version="2.0"><Domain>
