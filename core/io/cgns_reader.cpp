@@ -24,7 +24,8 @@
 // (index + 1)·Z/count, each whole (zones meet where their points coincide, which core/dist joins
 // as one process does). A base of one unstructured zone of fixed-type sections: the elements
 // numbered from index·N/count + 1 to (index + 1)·N/count and the vertices from the smallest to
-// the largest they use, with those rows of the solutions (the library's partial reads). A base
+// the largest they use, with those rows of the solutions (the library's partial reads); of
+// several (fewer than processes), the same of each, unless one has a MIXED section. A base
 // of fewer structured zones than processes, each at least `count` cells deep along its longest
 // index direction: of every zone the cells of layers index·L/count to (index + 1)·L/count along it
 // and their points (the layer where two processes' slabs meet is read by both, and joined by
@@ -305,7 +306,9 @@ class CgnsReader {
   // slab of each of fewer structured zones (the header comment), numbered from its first.
   Result keepShareOfZones() {
     const uint64_t n = options_.shareCount, z = zones_.size();
-    if (n >= 2 && z == 1 && !zones_[0].structured) return keepShareOfZone(zones_[0]);
+    const bool unstructured =
+        std::none_of(zones_.begin(), zones_.end(), [](const Zone& zone) { return zone.structured; });
+    if (n >= 2 && z < n && unstructured) return keepWindowsOfZones();
     if (n >= 2 && z < n) return keepSlabsOfZones();
     if (n < 2) return Result::success();
     const uint64_t from = z * options_.shareIndex / n, to = z * (options_.shareIndex + 1) / n;
@@ -359,10 +362,47 @@ class CgnsReader {
     return Result::success();
   }
 
+  // Of fewer unstructured zones than processes, each process's window of every zone (the header
+  // comment), when every zone can be read so; else all whole.
+  Result keepWindowsOfZones() {
+    for (Zone& z : zones_) {
+      if (Result r = windowOfZone(z); !r) return r;
+      if (z.window) continue;
+      for (Zone& y : zones_) {
+        y.window = false;
+        y.windowConnectivity.clear();
+        y.vertexFirst = y.cellFirst = 0;
+        y.vertexCount = y.vertices;
+        y.cellCount = y.cells;
+      }
+      return Result::success();
+    }
+    totalVertices_ = totalSlots_ = 0;
+    uint64_t cells = 0;
+    for (Zone& z : zones_) {
+      z.vertexBase = totalVertices_;
+      z.slotBase = totalSlots_;
+      totalVertices_ += z.vertexCount;
+      totalSlots_ += z.cellCount;
+      cells += z.cells;
+    }
+    report_.shared = true;
+    const Zone& z = zones_[0];
+    report_.notes.push_back(
+        zones_.size() == 1
+            ? "read elements " + std::to_string(z.cellFirst + 1) + " to " + std::to_string(z.cellFirst + z.cellCount) +
+                  " of " + std::to_string(z.cells) + " and the " + std::to_string(z.vertexCount) +
+                  " vertices they span, this process's share of the file"
+            : "read " + std::to_string(totalSlots_) + " of the " + std::to_string(cells) +
+                  " elements (a share of each of the " + zonesText(zones_.size(), "unstructured") + ") and the " +
+                  std::to_string(totalVertices_) + " vertices they span, this process's share of the file");
+    return Result::success();
+  }
+
   // The window of one unstructured zone: the share's elements and the vertices they span. The
-  // share's connectivity is read here to find them and kept for readSections (a MIXED section,
-  // whose elements have no fixed size, leaves the zone whole).
-  Result keepShareOfZone(Zone& z) {
+  // share's connectivity is read here to find them and kept for readSections. A MIXED section,
+  // whose elements have no fixed size, leaves the zone whole (z.window stays false).
+  Result windowOfZone(Zone& z) {
     const uint64_t from = z.cells * options_.shareIndex / options_.shareCount,
                    to = z.cells * (options_.shareIndex + 1ull) / options_.shareCount;
     int nsections = 0;
@@ -393,12 +433,6 @@ class CgnsReader {
     z.cellFirst = from;
     z.cellCount = to - from;
     z.window = true;
-    totalVertices_ = z.vertexCount;
-    totalSlots_ = z.cellCount;
-    report_.shared = true;
-    report_.notes.push_back("read elements " + std::to_string(from + 1) + " to " + std::to_string(to) + " of " +
-                            std::to_string(z.cells) + " and the " + std::to_string(z.vertexCount) +
-                            " vertices they span, this process's share of the file");
     return Result::success();
   }
 

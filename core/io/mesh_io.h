@@ -105,8 +105,8 @@ struct ReadOptions {
   // in those rows of its topology and the points from the smallest to the largest id they use.
   // An Exodus II file: the elements in those rows of its blocks (in file order) and the nodes
   // from the smallest to the largest they use. A CGNS base of at least shareCount zones: those
-  // zones, each whole; of one unstructured zone of fixed-type sections: its elements in those
-  // rows and the vertices they span; of fewer structured zones, each deep enough: a slab of
+  // zones, each whole; of fewer unstructured zones of fixed-type sections: their elements in
+  // those rows and the vertices they span; of fewer structured zones, each deep enough: a slab of
   // layers of cells of each zone and their points. Other files ignore it (ReadReport::shared says).
   uint32_t shareIndex = 0, shareCount = 1;
 };

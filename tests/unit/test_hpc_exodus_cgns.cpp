@@ -5,6 +5,7 @@
 // counts, volume, boundary area (a seam between blocks or zones leaves inner faces on the
 // boundary and adds area), field values, the point values of converted cell data, time steps;
 // then damaged copies (truncated, bytes changed) must give a Result naming the file.
+#include <cgnslib.h>
 #include <exodusII.h>
 #include <gtest/gtest.h>
 #include <hdf5.h>
@@ -559,6 +560,67 @@ TEST(ExodusShares, TheSharesOfAFileHoldEveryTetOnceWithItsValues) {
     test::expectSharesMakeTheWhole(hpcPath("exo_blocks.exo"), count, "pressure");
     test::expectSharesMakeTheWhole(hpcPath("exo_meshio.exo"), count);
   }
+}
+
+// Writes `mesh` through the CGNS library as a base of `zones` unstructured zones of TETRA_4
+// elements, each a run of the tets with its own copy of the vertices they use, and the fields as
+// Vertex solutions: the layout of a solver that writes one zone per rank.
+void writeCgnsZones(const TetMesh& mesh, int zones, const std::string& path) {
+  int fn = -1, base = 0;
+  ASSERT_EQ(cg_open(path.c_str(), CG_MODE_WRITE, &fn), CG_OK) << cg_get_error();
+  ASSERT_EQ(cg_base_write(fn, "Base", 3, 3, &base), CG_OK);
+  const uint32_t T = mesh.tetCount();
+  for (int z = 0; z < zones; ++z) {
+    const uint32_t from = uint32_t(uint64_t(T) * uint32_t(z) / uint32_t(zones)),
+                   to = uint32_t(uint64_t(T) * uint32_t(z + 1) / uint32_t(zones));
+    std::map<uint32_t, cgsize_t> local;  // mesh vertex -> 1-based zone vertex
+    std::vector<cgsize_t> conn;
+    for (uint32_t t = from; t < to; ++t)
+      for (int k = 0; k < 4; ++k) {
+        const uint32_t v = mesh.tets[4 * size_t(t) + size_t(k)];
+        auto [it, added] = local.emplace(v, cgsize_t(local.size() + 1));
+        conn.push_back(it->second);
+      }
+    std::vector<uint32_t> order(local.size());
+    for (const auto& [v, id] : local) order[size_t(id - 1)] = v;
+    cgsize_t size[3] = {cgsize_t(order.size()), cgsize_t(to - from), 0};
+    int zone = 0, coord = 0, section = 0, sol = 0, field = 0;
+    ASSERT_EQ(cg_zone_write(fn, base, ("rank" + std::to_string(z)).c_str(), size, CGNS_ENUMV(Unstructured), &zone),
+              CG_OK);
+    for (int a = 0; a < 3; ++a) {
+      std::vector<double> x;
+      for (uint32_t v : order) x.push_back(mesh.positions[3 * size_t(v) + size_t(a)]);
+      const char* name[3] = {"CoordinateX", "CoordinateY", "CoordinateZ"};
+      ASSERT_EQ(cg_coord_write(fn, base, zone, CGNS_ENUMV(RealDouble), name[a], x.data(), &coord), CG_OK);
+    }
+    ASSERT_EQ(
+        cg_section_write(fn, base, zone, "Tets", CGNS_ENUMV(TETRA_4), 1, cgsize_t(to - from), 0, conn.data(), &section),
+        CG_OK);
+    ASSERT_EQ(cg_sol_write(fn, base, zone, "Solution", CGNS_ENUMV(Vertex), &sol), CG_OK);
+    for (const ScalarField& f : mesh.fields) {
+      std::vector<double> values;
+      for (uint32_t v : order) values.push_back(f.values[v]);
+      ASSERT_EQ(cg_field_write(fn, base, zone, sol, CGNS_ENUMV(RealDouble), f.name.c_str(), values.data(), &field),
+                CG_OK);
+    }
+  }
+  ASSERT_EQ(cg_close(fn), CG_OK);
+}
+
+// A CGNS base of fewer unstructured zones than processes (one zone per rank of a smaller run):
+// each process reads its window of every zone, the elements and the vertices they span.
+TEST(CgnsShares, FewerUnstructuredZonesThanProcessesAreReadInWindows) {
+  ScratchDir dir("cgns-zones");
+  const std::string path = dir.path + "/zones.cgns";
+  writeCgnsZones(test::harmonicMesh(6), 3, path);
+  for (uint32_t count : {3u, 4u, 7u}) test::expectSharesMakeTheWhole(path, count);
+  TetMesh m;
+  ReadReport r;
+  ReadOptions o;
+  o.shareIndex = 1;
+  o.shareCount = 4;
+  ASSERT_TRUE(readMesh(path, m, r, o));
+  EXPECT_TRUE(hasNote(r, "(a share of each of the 3 unstructured zones) and the")) << allNotes(r);
 }
 
 // A CGNS base of as many zones as processes or more: each reads its zones whole. A base of one
