@@ -99,7 +99,8 @@ struct ReadOptions {
   // cells, as below (of a legacy piece the first of them reads it, the others nothing). A VTKHDF
   // file of at least shareCount partitions, or a VTK XML file of at least shareCount <Piece>s:
   // the partitions or pieces likewise. A .vtu of fewer pieces: the cells in those rows of each
-  // piece and the points from the smallest to the largest id they use. An XDMF file of at least
+  // piece and the points from the smallest to the largest id they use; a .vti or .vts of fewer
+  // pieces, each at least shareCount cells deep along k: those layers of cells of each piece. An XDMF file of at least
   // shareCount volume grids (a spatial collection): those grids, each whole. Of fewer grids, each
   // of one cell type: the cells
   // in those rows of its topology and the points from the smallest to the largest id they use.

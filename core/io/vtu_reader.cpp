@@ -551,12 +551,20 @@ Result readPieceData(Vtu& vtu, pugi::xml_node piece, const std::string& where, u
 }
 
 // Reads one Piece: its points, its cells (numbered within the piece) and its arrays.
+// Of a structured piece, `slab` (when given) names the share of its layers of cells along k
+// (the slowest index, so that its points and cells are runs of the arrays) to read: layers
+// index·L/count to (index + 1)·L/count and their points.
+struct Slab {
+  uint32_t index = 0, count = 1;
+};
+
 Result readPiece(Vtu& vtu, GridKind kind, const Grid& whole, pugi::xml_node piece, const std::string& where,
-                 MeshPiece& out, ReadReport& report, bool notePieceConversions) {
+                 MeshPiece& out, ReadReport& report, bool notePieceConversions, const Slab* slab = nullptr) {
   TetMesh& mesh = out.mesh;
   CellSoup& soup = out.soup;
   uint64_t np = 0, nc = 0;
   Grid g = whole;
+  PieceRows rows;
   if (kind == GridKind::Unstructured) {
     if (Result r = readCount(piece, "NumberOfPoints", where, np); !r) return r;
     if (Result r = readCount(piece, "NumberOfCells", where, nc); !r) return r;
@@ -575,7 +583,17 @@ Result readPiece(Vtu& vtu, GridKind kind, const Grid& whole, pugi::xml_node piec
     if (kind == GridKind::Image && np > std::max<uint64_t>(uint64_t(1) << 20, 16 * uint64_t(vtu.fileBytes)))
       return fail(Status::Truncated, where + ": Extent declares " + std::to_string(np) + " points, far more than a " +
                                          std::to_string(vtu.fileBytes) + "-byte file can carry data for");
+    if (slab) {
+      const uint64_t layers = g.n(2) - 1, from = layers * slab->index / slab->count,
+                     to = layers * (slab->index + 1) / slab->count, plane = g.n(0) * g.n(1);
+      rows = {from * plane, (to - from + 1) * plane, from * (g.n(0) - 1) * (g.n(1) - 1),
+              (to - from) * (g.n(0) - 1) * (g.n(1) - 1)};
+      g.extent[4] += int64_t(from);
+      g.extent[5] = g.extent[4] + int64_t(to - from);
+    }
   }
+  // What is read of the piece: all of it, or a slab's rows.
+  const uint64_t npRead = slab ? rows.points : np, ncRead = slab ? rows.cells : nc;
   const uint64_t vertexBase = mesh.positions.size() / 3;
   if (np > kMaxVertices || vertexBase + np > kMaxVertices)
     return fail(Status::TooLarge,
@@ -584,14 +602,14 @@ Result readPiece(Vtu& vtu, GridKind kind, const Grid& whole, pugi::xml_node piec
   // ImageData's geometry costs nothing to declare: read its arrays first, so a file that does not
   // carry the values for its extent stops before a grid is built for it.
   if (kind == GridKind::Image) {
-    if (Result r = readPieceData(vtu, piece, where, np, nc, report, notePieceConversions, out); !r) return r;
+    if (Result r = readPieceData(vtu, piece, where, np, nc, report, notePieceConversions, out, rows); !r) return r;
     if (mesh.fields.empty() && out.cellArrays.empty())
       return fail(Status::MissingField, where + ": the image has no numeric PointData or CellData arrays to show");
   }
 
   // Points
   if (kind == GridKind::Image) {
-    mesh.positions.reserve(mesh.positions.size() + 3 * np);
+    mesh.positions.reserve(mesh.positions.size() + 3 * npRead);
     for (int64_t k = g.extent[4]; k <= g.extent[5]; ++k)
       for (int64_t j = g.extent[2]; j <= g.extent[3]; ++j)
         for (int64_t i = g.extent[0]; i <= g.extent[1]; ++i) {
@@ -609,7 +627,9 @@ Result readPiece(Vtu& vtu, GridKind kind, const Grid& whole, pugi::xml_node piec
     if (comps != 3)
       return fail(Status::Corrupt, ref.str() + ": points have " + std::to_string(comps) + " components, expected 3");
     std::vector<double> p;
-    if (Result r = readDataArray(vtu, da, ref, np * 3, p); !r) return r;
+    if (Result r = readDataArray(vtu, da, ref, np * 3, p, {3 * rows.pointFirst, slab ? 3 * rows.points : UINT64_MAX});
+        !r)
+      return r;
     mesh.positions.reserve(mesh.positions.size() + p.size());
     for (double x : p) mesh.positions.push_back(float(x));
   }
@@ -617,7 +637,7 @@ Result readPiece(Vtu& vtu, GridKind kind, const Grid& whole, pugi::xml_node piec
   // Cells
   if (kind != GridKind::Unstructured) {
     appendStructuredCells(g.n(0), g.n(1), g.n(2), vertexBase, soup.inputCells, soup);
-    soup.inputCells += nc;
+    soup.inputCells += ncRead;
   } else if (nc > 0) {
     // Offsets first, since the last offset is the connectivity length.
     pugi::xml_node cells = piece.child("Cells");
@@ -643,7 +663,7 @@ Result readPiece(Vtu& vtu, GridKind kind, const Grid& whole, pugi::xml_node piec
     if (Result r = appendVtkCells(where, conn, offsets, types, vertexBase, np, soup); !r) return r;
   }
   if (kind == GridKind::Image) return Result::success();
-  return readPieceData(vtu, piece, where, np, nc, report, notePieceConversions, out);
+  return readPieceData(vtu, piece, where, np, nc, report, notePieceConversions, out, rows);
 }
 
 // Reads share `index` of `count` of an unstructured piece: its cells from index·nc/count up to
@@ -807,6 +827,31 @@ Result readPieces(Vtu& vtu, GridKind kind, const Grid& whole, const std::vector<
   return Result::success();
 }
 
+// Of fewer structured pieces than processes, each at least shareCount cells deep along k: the
+// slab `slab` of every piece (readPiece).
+Result readSlabShares(Vtu& vtu, GridKind kind, const Grid& whole, const std::vector<pugi::xml_node>& nodes,
+                      const std::string& label, const Slab& slab, std::vector<MeshPiece>& pieces, ReadReport& report) {
+  uint64_t cells = 0, cellsRead = 0;
+  pieces.reserve(nodes.size());  // bounded: each is an element of the file
+  for (size_t k = 0; k < nodes.size(); ++k) {
+    MeshPiece& piece = pieces.emplace_back();
+    piece.where = nodes.size() == 1 ? label : label + " Piece " + std::to_string(k);
+    piece.name = "Piece " + std::to_string(k);
+    if (Result r = readPiece(vtu, kind, whole, nodes[k], piece.where, piece, report, k == 0, &slab); !r) return r;
+    Grid g;
+    readExtent(nodes[k], "Extent", label, g);  // (read above)
+    cells += (g.n(0) - 1) * (g.n(1) - 1) * (g.n(2) - 1);
+    cellsRead += piece.soup.inputCells;
+  }
+  report.shared = true;
+  report.notes.push_back(
+      "read slab " + std::to_string(slab.index + 1) + " of " + std::to_string(slab.count) + " of " +
+      (nodes.size() == 1 ? std::string("the grid") : "each of the " + std::to_string(nodes.size()) + " pieces") +
+      " along k (" + std::to_string(cellsRead) + " of " + std::to_string(cells) +
+      " cells), this process's share of the file");
+  return Result::success();
+}
+
 // Of fewer unstructured pieces than processes, share shareIndex of the cells of every piece.
 Result readCellShares(Vtu& vtu, const std::vector<pugi::xml_node>& nodes, const std::string& label, uint32_t shareIndex,
                       uint32_t shareCount, std::vector<MeshPiece>& pieces, ReadReport& report) {
@@ -932,11 +977,17 @@ Result vtkio::readVtuPieces(std::string_view bytes, const std::string& label, st
   if (nodes.empty()) return fail(Status::Corrupt, label + ": <" + type + "> has no <Piece>");
 
   pieces.clear();
-  const bool shareCells = shareCount > 1 && nodes.size() < shareCount && kind == GridKind::Unstructured;
-  if (Result r = shareCells ? readCellShares(vtu, nodes, label, shareIndex, shareCount, pieces, report)
-                            : readPieces(vtu, kind, whole, nodes, label, shareIndex, shareCount, pieces, report);
-      !r)
-    return r;
+  const bool fewer = shareCount > 1 && nodes.size() < shareCount;
+  bool slabs = fewer && kind != GridKind::Unstructured;
+  for (pugi::xml_node p : nodes) {
+    Grid g;
+    slabs = slabs && readExtent(p, "Extent", label, g) && g.n(2) - 1 >= shareCount;
+  }
+  Result r = fewer && kind == GridKind::Unstructured
+                 ? readCellShares(vtu, nodes, label, shareIndex, shareCount, pieces, report)
+             : slabs ? readSlabShares(vtu, kind, whole, nodes, label, {shareIndex, shareCount}, pieces, report)
+                     : readPieces(vtu, kind, whole, nodes, label, shareIndex, shareCount, pieces, report);
+  if (!r) return r;
 
   std::string enc;
   for (const std::string& e : vtu.encodings) enc += (enc.empty() ? "" : ", ") + e;

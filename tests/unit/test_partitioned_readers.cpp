@@ -228,6 +228,27 @@ TEST(PartitionedReaders, SharesOfTheCellsOfAVtuMakeTheWhole) {
   test::expectSharesMakeTheWhole(partitioned("petsc.vtu"), 5, "region");  // 3 pieces on 5 processes
 }
 
+// A .vti or .vts of fewer pieces than processes: each reads a slab of layers of cells along k
+// and their points, when every piece has a layer for each process; else the whole file.
+TEST(PartitionedReaders, SlabsOfAStructuredGridMakeTheWhole) {
+  for (const char* name : {"formats/grid43.vti", "formats/grid43.vts", "formats/grid43_binary.vts"}) {
+    test::expectSharesMakeTheWhole(fixturePath(name), 2, "cid");  // (2 layers of cells along k)
+    ReadOptions o;
+    o.shareIndex = 1;
+    o.shareCount = 3;
+    TetMesh m;
+    ReadReport r;
+    ASSERT_TRUE(readMesh(fixturePath(name), m, r, o));
+    EXPECT_FALSE(r.shared) << name << ": 3 processes, 2 layers: read whole";
+  }
+  ReadOptions o;
+  o.shareCount = 2;
+  TetMesh m;
+  ReadReport r;
+  ASSERT_TRUE(readMesh(fixturePath("formats/grid43.vti"), m, r, o));
+  EXPECT_TRUE(hasNote(r, "read slab 1 of 2 of the grid along k (6 of 12 cells)")) << allNotes(r);
+}
+
 // A listing of fewer files than processes: the processes of a file each read a share of its cells
 // (of a legacy piece, the first of them reads it all), and together they hold every tet once.
 TEST(PartitionedReaders, MoreProcessesThanFilesShareTheFiles) {
