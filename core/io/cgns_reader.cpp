@@ -328,8 +328,8 @@ class CgnsReader {
     for (Zone& zone : zones_) {
       zone.vertexBase = totalVertices_;
       zone.slotBase = totalSlots_;
-      totalVertices_ += zone.vertices;
-      totalSlots_ += zone.cells;
+      totalVertices_ += zone.vertexCount;  // (what is read of it: all, a slab or a window)
+      totalSlots_ += zone.cellCount;
       structured_ += zone.structured;
     }
   }
@@ -377,15 +377,9 @@ class CgnsReader {
       }
       return Result::success();
     }
-    totalVertices_ = totalSlots_ = 0;
+    numberZones();
     uint64_t cells = 0;
-    for (Zone& z : zones_) {
-      z.vertexBase = totalVertices_;
-      z.slotBase = totalSlots_;
-      totalVertices_ += z.vertexCount;
-      totalSlots_ += z.cellCount;
-      cells += z.cells;
-    }
+    for (const Zone& z : zones_) cells += z.cells;
     report_.shared = true;
     const Zone& z = zones_[0];
     report_.notes.push_back(

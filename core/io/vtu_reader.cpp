@@ -551,6 +551,38 @@ Result readPieceData(Vtu& vtu, pugi::xml_node piece, const std::string& where, u
 }
 
 // Reads one Piece: its points, its cells (numbered within the piece) and its arrays.
+// The <Cells> arrays of a piece of nc cells, each required.
+Result findCellArrays(pugi::xml_node piece, const std::string& where, uint64_t nc, pugi::xml_node& offsets,
+                      pugi::xml_node& types, pugi::xml_node& connectivity) {
+  pugi::xml_node cells = piece.child("Cells");
+  offsets = findArray(cells, "offsets");
+  types = findArray(cells, "types");
+  connectivity = findArray(cells, "connectivity");
+  for (auto [node, name] : {std::pair{offsets, "offsets"}, {types, "types"}, {connectivity, "connectivity"}})
+    if (!node)
+      return fail(Status::Corrupt,
+                  where + ": NumberOfCells=" + std::to_string(nc) + " but <Cells> has no DataArray '" + name + "'");
+  return Result::success();
+}
+
+// Reads the points [first, first + count) of a piece of np points into mesh.positions.
+Result readPointRows(Vtu& vtu, pugi::xml_node piece, const std::string& where, uint64_t np, ValueRange rows,
+                     TetMesh& mesh) {
+  pugi::xml_node da = piece.child("Points").child("DataArray");
+  ArrayRef ref{where, da ? da.attribute("Name").as_string("Points") : "Points"};
+  if (!da) return fail(Status::Corrupt, where + ": " + std::to_string(np) + " points but no <Points> DataArray");
+  uint64_t comps;
+  if (Result r = readComponents(da, ref, comps); !r) return r;
+  if (comps != 3)
+    return fail(Status::Corrupt, ref.str() + ": points have " + std::to_string(comps) + " components, expected 3");
+  std::vector<double> p;
+  const ValueRange values{3 * rows.first, rows.count == UINT64_MAX ? UINT64_MAX : 3 * rows.count};
+  if (Result r = readDataArray(vtu, da, ref, np * 3, p, values); !r) return r;
+  mesh.positions.reserve(mesh.positions.size() + p.size());
+  for (double x : p) mesh.positions.push_back(float(x));
+  return Result::success();
+}
+
 // Of a structured piece, `slab` (when given) names the share of its layers of cells along k
 // (the slowest index, so that its points and cells are runs of the arrays) to read: layers
 // index·L/count to (index + 1)·L/count and their points.
@@ -619,19 +651,7 @@ Result readPiece(Vtu& vtu, GridKind kind, const Grid& whole, pugi::xml_node piec
                                            g.direction[3 * c + 2] * d[2]));
         }
   } else if (np > 0) {
-    pugi::xml_node da = piece.child("Points").child("DataArray");
-    ArrayRef ref{where, da ? da.attribute("Name").as_string("Points") : "Points"};
-    if (!da) return fail(Status::Corrupt, where + ": " + std::to_string(np) + " points but no <Points> DataArray");
-    uint64_t comps;
-    if (Result r = readComponents(da, ref, comps); !r) return r;
-    if (comps != 3)
-      return fail(Status::Corrupt, ref.str() + ": points have " + std::to_string(comps) + " components, expected 3");
-    std::vector<double> p;
-    if (Result r = readDataArray(vtu, da, ref, np * 3, p, {3 * rows.pointFirst, slab ? 3 * rows.points : UINT64_MAX});
-        !r)
-      return r;
-    mesh.positions.reserve(mesh.positions.size() + p.size());
-    for (double x : p) mesh.positions.push_back(float(x));
+    if (Result r = readPointRows(vtu, piece, where, np, {rows.pointFirst, rows.points}, mesh); !r) return r;
   }
 
   // Cells
@@ -640,13 +660,8 @@ Result readPiece(Vtu& vtu, GridKind kind, const Grid& whole, pugi::xml_node piec
     soup.inputCells += ncRead;
   } else if (nc > 0) {
     // Offsets first, since the last offset is the connectivity length.
-    pugi::xml_node cells = piece.child("Cells");
-    pugi::xml_node daOff = findArray(cells, "offsets"), daTypes = findArray(cells, "types"),
-                   daConn = findArray(cells, "connectivity");
-    for (auto [node, name] : {std::pair{daOff, "offsets"}, {daTypes, "types"}, {daConn, "connectivity"}})
-      if (!node)
-        return fail(Status::Corrupt,
-                    where + ": NumberOfCells=" + std::to_string(nc) + " but <Cells> has no DataArray '" + name + "'");
+    pugi::xml_node daOff, daTypes, daConn;
+    if (Result r = findCellArrays(piece, where, nc, daOff, daTypes, daConn); !r) return r;
     std::vector<int64_t> ends, offsets, types, conn;
     if (Result r = readDataArray(vtu, daOff, {where, "offsets"}, nc, ends); !r) return r;
     int64_t connSize = ends.back();
@@ -689,13 +704,8 @@ Result readPieceShare(Vtu& vtu, pugi::xml_node piece, const std::string& label, 
 
   std::vector<int64_t> ends, types, conn;
   if (rows.cells > 0) {
-    pugi::xml_node cells = piece.child("Cells");
-    pugi::xml_node daOff = findArray(cells, "offsets"), daTypes = findArray(cells, "types"),
-                   daConn = findArray(cells, "connectivity");
-    for (auto [node, name] : {std::pair{daOff, "offsets"}, {daTypes, "types"}, {daConn, "connectivity"}})
-      if (!node)
-        return fail(Status::Corrupt,
-                    where + ": NumberOfCells=" + std::to_string(nc) + " but <Cells> has no DataArray '" + name + "'");
+    pugi::xml_node daOff, daTypes, daConn;
+    if (Result r = findCellArrays(piece, where, nc, daOff, daTypes, daConn); !r) return r;
     // The cell before the first ends where the first starts; the last cell's end is the
     // connectivity's length.
     const uint64_t before = rows.cellFirst > 0 ? 1 : 0;
@@ -738,19 +748,8 @@ Result readPieceShare(Vtu& vtu, pugi::xml_node piece, const std::string& label, 
 
   TetMesh& mesh = out.mesh;
   const uint64_t vertexBase = mesh.positions.size() / 3;
-  if (rows.points > 0) {
-    pugi::xml_node da = piece.child("Points").child("DataArray");
-    ArrayRef ref{where, da ? da.attribute("Name").as_string("Points") : "Points"};
-    if (!da) return fail(Status::Corrupt, where + ": " + std::to_string(np) + " points but no <Points> DataArray");
-    uint64_t comps;
-    if (Result r = readComponents(da, ref, comps); !r) return r;
-    if (comps != 3)
-      return fail(Status::Corrupt, ref.str() + ": points have " + std::to_string(comps) + " components, expected 3");
-    std::vector<double> p;
-    if (Result r = readDataArray(vtu, da, ref, np * 3, p, {3 * rows.pointFirst, 3 * rows.points}); !r) return r;
-    mesh.positions.reserve(mesh.positions.size() + p.size());
-    for (double x : p) mesh.positions.push_back(float(x));
-  }
+  if (rows.points > 0)
+    if (Result r = readPointRows(vtu, piece, where, np, {rows.pointFirst, rows.points}, mesh); !r) return r;
   if (Result r = appendVtkCells(where, conn, ends, types, vertexBase, rows.points, out.soup); !r) return r;
   return readPieceData(vtu, piece, where, np, nc, report, notePieceConversions, out, rows);
 }

@@ -358,16 +358,27 @@ int cmdVtu(char** argv) {
   return 0;
 }
 
+// The chunk files of the pack in `dir`, as pd's manifest names them.
+ChunkSource packFiles(const std::string& dir, const PartialDataset& pd) {
+  return [&dir, &pd](uint32_t index, std::vector<uint8_t>& file) {
+    return readFileBytes(dir + "/" + pd.manifest.chunks[index].file, pd.manifest.chunks[index].bytes, file);
+  };
+}
+
+// Opens the pack in `dir`: its manifest and base.
+Result openPack(const std::string& dir, PartialDataset& pd) {
+  std::string json;
+  Result r = readManifestFile(dir, json);
+  if (r) r = openPartial(pd, json, packFiles(dir, pd));
+  return r;
+}
+
 int cmdRegions(int argc, char** argv) {
   const std::string dir = argv[2];
   const double budget = std::atof(arg(argc, argv, "--bytes", "0"));
-  std::string json;
   PartialDataset pd;
-  auto source = [&](uint32_t index, std::vector<uint8_t>& file) {
-    return readFileBytes(dir + "/" + pd.manifest.chunks[index].file, pd.manifest.chunks[index].bytes, file);
-  };
-  Result r = readManifestFile(dir, json);
-  if (r) r = openPartial(pd, json, source);
+  const ChunkSource source = packFiles(dir, pd);
+  Result r = openPack(dir, pd);
   const Manifest& m = pd.manifest;
   // Ready regions (parent applied) by the viewer's priority: measured field error.
   std::priority_queue<std::pair<double, uint32_t>> ready;
@@ -414,13 +425,9 @@ int cmdClosure(int argc, char** argv) {
     values.push_back(v);
     p = *end == ',' ? end + 1 : end;
   }
-  std::string json;
   PartialDataset pd;
-  auto source = [&](uint32_t index, std::vector<uint8_t>& file) {
-    return readFileBytes(dir + "/" + pd.manifest.chunks[index].file, pd.manifest.chunks[index].bytes, file);
-  };
-  Result r = readManifestFile(dir, json);
-  if (r) r = openPartial(pd, json, source);
+  const ChunkSource source = packFiles(dir, pd);
+  Result r = openPack(dir, pd);
   if (!r) {
     std::fprintf(stderr, "%s\n", r.message.c_str());
     return 1;
