@@ -287,9 +287,9 @@ Result readMesh(const std::string& path, TetMesh& out, ReadReport& report, const
   if (fmt == Format::Exodus) return guarded(path, out, [&] { return readExodus(path, options, out, report); });
   if (fmt == Format::Cgns) return guarded(path, out, [&] { return readCgns(path, options, out, report); });
 
-  // A process's share of a VTK XML file decodes only its pieces: mapped, the file's other pieces
-  // (with appended data) are never read from disk (MappedFile).
-  if (fmt == Format::VtkXml && options.shareCount > 1) {
+  // A VTK XML file is mapped, not read into memory (MappedFile): its arrays are decoded from
+  // where they lie, and a process's share of it touches only its own parts.
+  if (fmt == Format::VtkXml) {
     MappedFile file;
     if (Result r = file.open(path); !r) return r;
     const std::string_view mapped = file.bytes();

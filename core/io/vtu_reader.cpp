@@ -194,6 +194,7 @@ class ByteSource {
 // ------------------------------------------------------------------ file-level settings
 struct Vtu {
   std::string label;
+  std::string_view file;  // the file's bytes: the inline arrays' text stays there (skeletonXml)
   bool bigEndian = false;
   bool header64 = false;
   bool zlib = false;
@@ -323,9 +324,63 @@ Result readPayload(const Vtu& vtu, ByteSource& src, const ArrayRef& ref, uint64_
   return Result::success();
 }
 
+// The attribute that stands, in the XML handed to pugixml, for a DataArray's text left in the
+// file: "offset length" (skeletonXml). No VTK writer uses the name.
+constexpr const char* kTextAttribute = "tetstream-text";
+
+// The XML part of a VTK XML file for pugixml, without the text of large inline DataArrays: each
+// such array's numbers or base64 (a run with no '<' and no '&' up to </DataArray>) stays in the
+// file, and its start tag gains kTextAttribute saying where. A file of inline data was copied
+// whole into the document and parsed whole; now the copy is the markup alone.
+std::string skeletonXml(std::string_view xml) {
+  constexpr size_t kLeaveInFile = 256;  // (shorter texts are copied: nothing to gain)
+  std::string out;
+  size_t copied = 0;
+  for (size_t at = xml.find("<DataArray"); at != std::string_view::npos; at = xml.find("<DataArray", at + 1)) {
+    // The start tag's end: the first '>' outside quotes.
+    size_t gt = at;
+    char quote = 0;
+    for (; gt < xml.size(); ++gt) {
+      const char c = xml[gt];
+      if (quote) {
+        if (c == quote) quote = 0;
+      } else if (c == '"' || c == '\'') {
+        quote = c;
+      } else if (c == '>') {
+        break;
+      }
+    }
+    if (gt >= xml.size() || xml[gt - 1] == '/') continue;  // (cut short, or an empty element)
+    const size_t lt = xml.find('<', gt + 1);
+    if (lt == std::string_view::npos || xml.substr(lt, 12) != "</DataArray>" || lt - gt - 1 < kLeaveInFile ||
+        xml.substr(gt + 1, lt - gt - 1).find('&') != std::string_view::npos)
+      continue;
+    if (out.empty()) out.reserve(xml.size() / 64 + 4096);
+    out.append(xml.substr(copied, gt - copied));
+    out += " ";
+    out += kTextAttribute;
+    out += "=\"" + std::to_string(gt + 1) + " " + std::to_string(lt - gt - 1) + "\">";
+    copied = lt;
+    at = lt;
+  }
+  if (copied == 0) return std::string(xml);
+  out.append(xml.substr(copied));
+  return out;
+}
+
 // The text of a DataArray: its character data, skipping child elements (VTK 9 puts
-// <InformationKey> elements inside arrays, before or after the numbers).
-std::string_view arrayText(pugi::xml_node da, std::string& storage) {
+// <InformationKey> elements inside arrays, before or after the numbers), or the run of the file
+// that skeletonXml left there.
+std::string_view arrayText(const Vtu& vtu, pugi::xml_node da, std::string& storage) {
+  if (pugi::xml_attribute left = da.attribute(kTextAttribute)) {
+    uint64_t offset = 0, length = 0;
+    std::string_view spec = left.value();
+    size_t pos = 0;
+    if (parseU64(nextToken(spec, pos), offset) && parseU64(nextToken(spec, pos), length) && offset <= vtu.file.size() &&
+        length <= vtu.file.size() - offset)
+      return vtu.file.substr(offset, length);
+    return {};  // (not reached: skeletonXml wrote it from the file)
+  }
   std::string_view single;
   int parts = 0;
   for (pugi::xml_node c = da.first_child(); c; c = c.next_sibling()) {
@@ -369,7 +424,7 @@ Result readDataArray(Vtu& vtu, pugi::xml_node da, const ArrayRef& ref, uint64_t 
   std::string storage;
   if (format == "ascii") {
     vtu.encodings.insert("ascii");
-    std::string_view text = arrayText(da, storage);
+    std::string_view text = arrayText(vtu, da, storage);
     // Each value takes at least one character and a separator, so this bound is real data.
     out.clear();
     out.reserve(size_t(std::min<uint64_t>(range.count, text.size() / 2 + 1)));
@@ -401,7 +456,7 @@ Result readDataArray(Vtu& vtu, pugi::xml_node da, const ArrayRef& ref, uint64_t 
   ByteSource src = ByteSource::raw({});
   if (format == "binary") {
     vtu.encodings.insert("inline base64");
-    src = ByteSource::base64(arrayText(da, storage));
+    src = ByteSource::base64(arrayText(vtu, da, storage));
   } else if (format == "appended") {
     if (!vtu.hasAppended)
       return fail(Status::Corrupt, ref.str() + ": format=\"appended\" but the file has no <AppendedData> section");
@@ -896,11 +951,18 @@ Result vtkio::readVtuPieces(std::string_view bytes, const std::string& label, st
   vtu.label = label;
   size_t xmlEnd;
   if (Result r = locateAppended(bytes, label, xmlEnd, vtu.hasAppended, vtu.appendedBase64, vtu.appended); !r) return r;
-  std::string xml(bytes.substr(0, xmlEnd));
+  vtu.file = bytes;
+  std::string xml = skeletonXml(bytes.substr(0, xmlEnd));
   if (vtu.hasAppended) xml += "</VTKFile>";
 
   pugi::xml_document doc;
   pugi::xml_parse_result pr = doc.load_buffer_inplace(xml.data(), xml.size(), pugi::parse_default, pugi::encoding_utf8);
+  if (!pr && xml.size() != xmlEnd + (vtu.hasAppended ? 10 : 0)) {
+    // Said of the file as written: where in it the markup breaks.
+    xml.assign(bytes.substr(0, xmlEnd));
+    if (vtu.hasAppended) xml += "</VTKFile>";
+    pr = doc.load_buffer_inplace(xml.data(), xml.size(), pugi::parse_default, pugi::encoding_utf8);
+  }
   if (!pr) {
     // pugixml reports where the broken element starts, not where the text stops; a file that does
     // not end with </VTKFile> was cut short.
