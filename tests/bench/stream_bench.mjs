@@ -4,7 +4,9 @@
 // Chromium (SwiftShader: software WebGL, so frame times are those of a machine without a GPU).
 //
 //   node tests/bench/stream_bench.mjs [--rate 10mbit] [--latency 50] [--n 64] [--runs 1] [--timeline] [--sequence]
-//                                     [--h2] [--mesh FILE ...]
+//                                     [--h2] [--leaf-vertices N] [--mesh FILE ...]
+// --leaf-vertices N: Harmonic packed with regions of at most N vertices (the pack's default
+// otherwise).
 // --h2: HTTPS with HTTP/2 (a certificate made with openssl for the run), as static hosts and CDNs
 // serve today; without it, HTTP/1.1 (six connections).
 //
@@ -176,11 +178,12 @@ async function main() {
   await precompressDir(webDir); // the wasm goes compressed (br) as any real deployment would send it
   // --sequence: packed as one sequence of chunks (no patch hierarchy), every chunk fetched.
   const sequence = args.includes('--sequence');
-  const datasets = [[`Harmonic ${n}³`, packed(`harmonic-${n}${sequence ? '-sequence' : ''}`, () => {
+  const leaves = sequence ? '0' : opt('leaf-vertices', '');
+  const datasets = [[`Harmonic ${n}³`, packed(`harmonic-${n}${leaves ? `-leaves-${leaves}` : ''}`, () => {
     const vtu = path.join(outDir, `harmonic-${n}.vtu`);
     if (!fs.existsSync(vtu)) cli('gen', 'harmonic', '--n', String(n), '-o', vtu);
     return vtu;
-  }, ['--name', `Harmonic ${n}³`, ...(sequence ? ['--leaf-vertices', '0'] : [])])]];
+  }, ['--name', `Harmonic ${n}³`, ...(leaves ? ['--leaf-vertices', leaves] : [])])]];
   if (fs.existsSync(postVtk)) datasets.push(['post.vtk', packed('post', () => postVtk, ['--name', 'post.vtk'])]);
   else console.log(`(no ${postVtk}: the real dataset is skipped)`);
   // --mesh FILE (repeatable): any other mesh, packed as the CLI packs it by default.
