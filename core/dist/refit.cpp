@@ -29,10 +29,11 @@ void refitBase(Comm& comm, Unit* root, const PartMesh& input, int field) {
     SharedBase b;
     for (uint32_t v = 0; v < s.vertexAlive.size(); ++v) {
       if (!s.vertexAlive[v]) continue;
+      const uint32_t c = uint32_t(localOf.size());  // (s.carried covers the alive vertices, in order)
       localOf.push_back(v);
       b.fit.push_back(s.values.empty() ? root->part.mesh.fields[size_t(field)].values[v] : s.values[v]);
-      b.represented.push_back(s.carried.represented.empty() ? 1 : s.carried.represented[v]);
-      const Range r = v < s.carried.fitRange.size() ? s.carried.fitRange[v] : Range{b.fit.back(), b.fit.back()};
+      b.represented.push_back(c < s.carried.represented.size() ? s.carried.represented[c] : 1);
+      const Range r = c < s.carried.fitRange.size() ? s.carried.fitRange[c] : Range{b.fit.back(), b.fit.back()};
       b.lo.push_back(r.min);
       b.hi.push_back(r.max);
     }

@@ -46,12 +46,15 @@ PartMesh partAfter(const PartMesh& in, const SimplifyResult& s) {
   PartMesh out;
   out.mesh.name = in.mesh.name;
   copyFieldNames(in.mesh, out.mesh);
-  // The state at the end (SimplifyResult::carried covers every vertex of the part's mesh).
-  const bool carried = s.carried.fit.size() == V;
+  // The state at the end (SimplifyResult::carried covers the alive vertices, in order).
+  uint32_t alive = 0;
+  for (uint32_t v = 0; v < V; ++v) alive += s.vertexAlive[v];
+  const bool carried = alive > 0 && s.carried.fit.size() == alive;
   std::vector<uint32_t> local(V, ~0u);
   for (uint32_t v = 0; v < V; ++v) {
     if (!s.vertexAlive[v]) continue;
-    local[v] = uint32_t(out.vertexId.size());
+    const uint32_t c = uint32_t(out.vertexId.size());  // (its index among the alive ones)
+    local[v] = c;
     const float* x = &in.mesh.positions[3 * size_t(v)];
     out.mesh.positions.insert(out.mesh.positions.end(), x, x + 3);
     for (size_t f = 0; f < in.mesh.fields.size(); ++f) out.mesh.fields[f].values.push_back(in.mesh.fields[f].values[v]);
@@ -59,12 +62,12 @@ PartMesh partAfter(const PartMesh& in, const SimplifyResult& s) {
     out.owned.push_back(in.owned[v]);
     if (!carried) continue;
     CarriedVertexState& d = out.carried;
-    d.fit.push_back(s.carried.fit[v]);
-    d.represented.push_back(s.carried.represented[v]);
-    d.boundary.push_back(s.carried.boundary[v]);
-    d.boundaryQuadric.push_back(s.carried.boundaryQuadric[v]);
-    d.fieldQuadric.push_back(s.carried.fieldQuadric[v]);
-    d.fitRange.push_back(s.carried.fitRange[v]);
+    d.fit.push_back(s.carried.fit[c]);
+    d.represented.push_back(s.carried.represented[c]);
+    d.boundary.push_back(s.carried.boundary[c]);
+    d.boundaryQuadric.push_back(s.carried.boundaryQuadric[c]);
+    d.fieldQuadric.push_back(s.carried.fieldQuadric[c]);
+    d.fitRange.push_back(s.carried.fitRange[c]);
   }
   for (uint32_t t = 0; t < T; ++t) {
     if (!s.tetAlive[t]) continue;

@@ -121,9 +121,9 @@ struct SimplifyPart {
 //     (and its tets);
 //   - values are not refitted at the end (refitValues is ignored): SimplifyResult::values are the
 //     fitted values;
-//   - SimplifyResult::carried covers every vertex of the part's mesh, dead ones included (their
-//     state at their collapse); partAfter (part.h) keeps the alive ones. A halo vertex's state is
-//     what this part had of it (its boundary may be the part's cut): only its owner's counts.
+//   - SimplifyResult::carried covers the vertices left alive, in vertex order (partAfter, part.h,
+//     takes it with them). A halo vertex's state is what this part had of it (its boundary may be
+//     the part's cut): only its owner's counts.
 // Deterministic as the whole mesh's simplification: the same for any number of threads.
 
 // The whole mesh's normalisers for SimplifyPart (fieldMin, fieldMax, diagonal, meanVertexVolume
@@ -204,7 +204,7 @@ struct SimplifyResult {
   uint64_t queuePops = 0, requeued = 0;  // pops of current entries, and those pushed back costlier
   uint32_t regionCollapses = 0;          // collapses made below the root, on two threads at once
   RegionTree tree;
-  CarriedVertexState carried;  // with SimplifyOptions::part: the state at the end, per vertex
+  CarriedVertexState carried;  // with SimplifyOptions::part: the state at the end, per alive vertex
   // "target reached", "no legal collapse left", "error bound reached", or (a part's top node
   // as a region, SimplifyPart::topIsRegion) "level cost reached".
   std::string stopReason;
