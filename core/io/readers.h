@@ -100,10 +100,9 @@ Result readCgns(const std::string& path, const ReadOptions& options, TetMesh& ou
 enum class ListingKind { None, Pvtu, Vtm, Pvtk };
 // What a file's first bytes say it is: a listing, or None for anything else (a .vtu, junk).
 ListingKind listingKind(std::string_view head);
-// A piece file's bytes: read into `text` or mapped (`file`: a process that reads a share of the
-// file then touches only that share's pages); `bytes` views whichever holds them.
+// A piece file's bytes: mapped (`file`: a process that reads a share of the file then touches
+// only that share's pages), or held by the loader; `bytes` views them.
 struct PieceBytes {
-  std::string text;
   MappedFile file;
   std::string_view bytes;
 };

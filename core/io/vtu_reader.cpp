@@ -331,8 +331,9 @@ constexpr const char* kTextAttribute = "tetstream-text";
 // The XML part of a VTK XML file for pugixml, without the text of large inline DataArrays: each
 // such array's numbers or base64 (a run with no '<' and no '&' up to </DataArray>) stays in the
 // file, and its start tag gains kTextAttribute saying where. A file of inline data was copied
-// whole into the document and parsed whole; now the copy is the markup alone.
-std::string skeletonXml(std::string_view xml) {
+// whole into the document and parsed whole; now the copy is the markup alone. `left`: whether
+// any text was left in the file.
+std::string skeletonXml(std::string_view xml, bool& left) {
   constexpr size_t kLeaveInFile = 256;  // (shorter texts are copied: nothing to gain)
   std::string out;
   size_t copied = 0;
@@ -363,7 +364,8 @@ std::string skeletonXml(std::string_view xml) {
     copied = lt;
     at = lt;
   }
-  if (copied == 0) return std::string(xml);
+  left = copied > 0;
+  if (!left) return std::string(xml);
   out.append(xml.substr(copied));
   return out;
 }
@@ -952,12 +954,13 @@ Result vtkio::readVtuPieces(std::string_view bytes, const std::string& label, st
   size_t xmlEnd;
   if (Result r = locateAppended(bytes, label, xmlEnd, vtu.hasAppended, vtu.appendedBase64, vtu.appended); !r) return r;
   vtu.file = bytes;
-  std::string xml = skeletonXml(bytes.substr(0, xmlEnd));
+  bool left = false;
+  std::string xml = skeletonXml(bytes.substr(0, xmlEnd), left);
   if (vtu.hasAppended) xml += "</VTKFile>";
 
   pugi::xml_document doc;
   pugi::xml_parse_result pr = doc.load_buffer_inplace(xml.data(), xml.size(), pugi::parse_default, pugi::encoding_utf8);
-  if (!pr && xml.size() != xmlEnd + (vtu.hasAppended ? 10 : 0)) {
+  if (!pr && left) {
     // Said of the file as written: where in it the markup breaks.
     xml.assign(bytes.substr(0, xmlEnd));
     if (vtu.hasAppended) xml += "</VTKFile>";

@@ -129,6 +129,17 @@ bool isTemporal(pugi::xml_node g) {
   return isCollection(g) && iequals(g.attribute("CollectionType").value(), "Temporal");
 }
 
+// Whether a topology of `nodes` ids a cell, declared `dims`, can be read in rows of cells.
+bool cellRowsDeclared(const std::vector<uint64_t>& dims, uint64_t nodes) {
+  return nodes > 0 && ((dims.size() == 2 && dims[1] == nodes) || (dims.size() == 1 && dims[0] % nodes == 0));
+}
+
+// An attribute of a function space (Center="Other"): its dofs are not per point or cell.
+bool anyOfFunctionSpace(const std::vector<pugi::xml_node>& attributes) {
+  return std::any_of(attributes.begin(), attributes.end(),
+                     [](pugi::xml_node a) { return iequals(a.attribute("Center").value(), "Other"); });
+}
+
 // One process's share of a grid (ReadOptions::shareIndex of shareCount): rows of its cells and
 // of its points, out of how many.
 struct Rows {
@@ -482,15 +493,14 @@ Result XdmfReader::readShareOfGrid(pugi::xml_node topo, pugi::xml_node geo, cons
                                    const std::vector<pugi::xml_node>& attributes, const std::string& where,
                                    PieceArrays& arrays, bool& done) {
   done = false;
-  for (pugi::xml_node a : attributes)
-    if (iequals(a.attribute("Center").value(), "Other")) return Result::success();
+  if (anyOfFunctionSpace(attributes)) return Result::success();
   const std::string what = where + " Topology";
   pugi::xml_node item;
   if (Result r = doc_.dataItem(topo, what, item); !r) return r;
   const std::vector<uint64_t> dims = doc_.declaredDims(item);
   const uint64_t nodes = uint64_t(kind.nodes);
-  const bool cellRows = dims.size() == 2 && dims[1] == nodes;
-  if (!cellRows && !(nodes > 0 && dims.size() == 1 && dims[0] % nodes == 0)) return Result::success();
+  if (!cellRowsDeclared(dims, nodes)) return Result::success();
+  const bool cellRows = dims.size() == 2;
   const uint64_t cellsTotal = cellRows ? dims[0] : dims[0] / nodes;
   const uint64_t from = cellsTotal * options_.shareIndex / options_.shareCount,
                  to = cellsTotal * (options_.shareIndex + 1ull) / options_.shareCount;
@@ -560,13 +570,10 @@ Result XdmfReader::gridShape(pugi::xml_node grid, const std::vector<pugi::xml_no
     if (Result r = doc_.children(c, "Attribute", where, more); !r) return r;
     attributes.insert(attributes.end(), more.begin(), more.end());
   }
-  for (pugi::xml_node a : attributes)
-    if (iequals(a.attribute("Center").value(), "Other")) return Result::success();
+  if (anyOfFunctionSpace(attributes)) return Result::success();
   pugi::xml_node item;
   if (Result r = doc_.dataItem(topos[0], where + " Topology", item); !r) return r;
-  const std::vector<uint64_t> dims = doc_.declaredDims(item);
-  const uint64_t nodes = uint64_t(kind->nodes);
-  byRows = (dims.size() == 2 && dims[1] == nodes) || (nodes > 0 && dims.size() == 1 && dims[0] % nodes == 0);
+  byRows = cellRowsDeclared(doc_.declaredDims(item), uint64_t(kind->nodes));
   return Result::success();
 }
 

@@ -441,6 +441,26 @@ std::vector<std::array<Corner, 4>> tetsByCorners(const TetMesh& m) {
   return out;
 }
 
+ReadOptions shareOf(uint32_t index, uint32_t count) {
+  ReadOptions o;
+  o.shareIndex = index;
+  o.shareCount = count;
+  return o;
+}
+
+uint64_t tetsOfShares(const std::string& path, uint32_t count, bool nonEmpty) {
+  uint64_t tets = 0;
+  for (uint32_t k = 0; k < count; ++k) {
+    TetMesh part;
+    ReadReport r;
+    EXPECT_TRUE(readMesh(path, part, r, shareOf(k, count))) << path << " share " << k;
+    EXPECT_TRUE(r.shared) << path << " share " << k;
+    if (nonEmpty) EXPECT_GT(part.tetCount(), 0u) << path << " share " << k;
+    tets += part.tetCount();
+  }
+  return tets;
+}
+
 void expectSharesMakeTheWhole(const std::string& path, uint32_t count, const std::string& skipField) {
   auto skip = [&](const ScalarField& f) { return f.name == skipField || f.name.ends_with("_cell"); };
   SCOPED_TRACE(path + " in " + std::to_string(count) + " shares");
@@ -456,12 +476,9 @@ void expectSharesMakeTheWhole(const std::string& path, uint32_t count, const std
             f.values[v]);
   std::vector<std::array<Corner, 4>> all;
   for (uint32_t k = 0; k < count; ++k) {
-    ReadOptions o;
-    o.shareIndex = k;
-    o.shareCount = count;
     TetMesh part;
     ReadReport r;
-    ASSERT_TRUE(readMesh(path, part, r, o)) << "share " << k;
+    ASSERT_TRUE(readMesh(path, part, r, shareOf(k, count))) << "share " << k;
     EXPECT_TRUE(r.shared);
     EXPECT_LT(part.vertexCount(), whole.vertexCount()) << "share " << k;
     ASSERT_EQ(part.fields.size(), whole.fields.size());

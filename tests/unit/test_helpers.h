@@ -165,6 +165,13 @@ double fieldRms(const TetMesh& in, const TetMesh& coarse, int field);
 using Corner = std::array<float, 3>;
 std::vector<std::array<Corner, 4>> tetsByCorners(const TetMesh& m);
 
+// The options of process `index` of `count` (ReadOptions::shareIndex, shareCount).
+ReadOptions shareOf(uint32_t index, uint32_t count);
+
+// Reads the file at `path` in `count` shares: every share reads and says it is one
+// (ReadReport::shared), and with `nonEmpty` holds a tet at least. Returns their tets in all.
+uint64_t tetsOfShares(const std::string& path, uint32_t count, bool nonEmpty);
+
 // Reads the file at `path` in `count` shares (ReadOptions::shareIndex, as the processes of a
 // distributed pack do): each is a share (ReadReport::shared) with fewer points than the whole,
 // each point's values are the whole's at that position, and together the shares hold every tet

@@ -616,10 +616,7 @@ TEST(CgnsShares, FewerUnstructuredZonesThanProcessesAreReadInWindows) {
   for (uint32_t count : {3u, 4u, 7u}) test::expectSharesMakeTheWhole(path, count);
   TetMesh m;
   ReadReport r;
-  ReadOptions o;
-  o.shareIndex = 1;
-  o.shareCount = 4;
-  ASSERT_TRUE(readMesh(path, m, r, o));
+  ASSERT_TRUE(readMesh(path, m, r, test::shareOf(1, 4)));
   EXPECT_TRUE(hasNote(r, "(a share of each of the 3 unstructured zones) and the")) << allNotes(r);
 }
 

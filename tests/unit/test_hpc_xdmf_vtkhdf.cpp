@@ -177,15 +177,11 @@ TEST(XdmfShares, TheSharesOfAGridHoldEveryTetOnceWithItsValues) {
 // grid of triangles beside them is skipped either way.
 TEST(XdmfShares, TheGridsOfACollectionAreSharedByGridOrByRows) {
   for (uint32_t count : {2u, 3u}) test::expectSharesMakeTheWhole(hpcPath("xdmf_inline.xmf"), count, "c");
-  ReadOptions o;
-  o.shareIndex = 1;
-  o.shareCount = 2;
   TetMesh m;
   ReadReport r;
-  ASSERT_TRUE(readMesh(hpcPath("xdmf_inline.xmf"), m, r, o));
+  ASSERT_TRUE(readMesh(hpcPath("xdmf_inline.xmf"), m, r, test::shareOf(1, 2)));
   EXPECT_TRUE(hasNote(r, "read grid 2 of the 2 volume grids, this process's share of the file")) << allNotes(r);
-  o.shareCount = 3;
-  ASSERT_TRUE(readMesh(hpcPath("xdmf_inline.xmf"), m, r = ReadReport{}, o));
+  ASSERT_TRUE(readMesh(hpcPath("xdmf_inline.xmf"), m, r = ReadReport{}, test::shareOf(1, 3)));
   EXPECT_TRUE(hasNote(r, "this process's share of the grid")) << allNotes(r);
 }
 
@@ -696,11 +692,8 @@ TEST(XdmfReader, GridsOnTheSamePoints) {
   expectValid(m, "mesh with tags");
   // On two processes the tags grid is not another process's share: every process reads both grids
   // (and keeps its share of the tets), so the repeated cells are still recognised.
-  ReadOptions o;
-  o.shareIndex = 1;
-  o.shareCount = 2;
   r = ReadReport{};
-  ASSERT_TRUE(readXdmf(tags, "t.xdmf", std::nullopt, o, m, r));
+  ASSERT_TRUE(readXdmf(tags, "t.xdmf", std::nullopt, test::shareOf(1, 2), m, r));
   EXPECT_FALSE(r.shared);
   EXPECT_EQ(m.tetCount(), 2u) << allNotes(r);
 

@@ -233,19 +233,14 @@ TEST(PartitionedReaders, SharesOfTheCellsOfAVtuMakeTheWhole) {
 TEST(PartitionedReaders, SlabsOfAStructuredGridMakeTheWhole) {
   for (const char* name : {"formats/grid43.vti", "formats/grid43.vts", "formats/grid43_binary.vts"}) {
     test::expectSharesMakeTheWhole(fixturePath(name), 2, "cid");  // (2 layers of cells along k)
-    ReadOptions o;
-    o.shareIndex = 1;
-    o.shareCount = 3;
     TetMesh m;
     ReadReport r;
-    ASSERT_TRUE(readMesh(fixturePath(name), m, r, o));
+    ASSERT_TRUE(readMesh(fixturePath(name), m, r, test::shareOf(1, 3)));
     EXPECT_FALSE(r.shared) << name << ": 3 processes, 2 layers: read whole";
   }
-  ReadOptions o;
-  o.shareCount = 2;
   TetMesh m;
   ReadReport r;
-  ASSERT_TRUE(readMesh(fixturePath("formats/grid43.vti"), m, r, o));
+  ASSERT_TRUE(readMesh(fixturePath("formats/grid43.vti"), m, r, test::shareOf(0, 2)));
   EXPECT_TRUE(hasNote(r, "read slab 1 of 2 of the grid along k (6 of 12 cells)")) << allNotes(r);
 }
 
@@ -258,18 +253,7 @@ TEST(PartitionedReaders, MoreProcessesThanFilesShareTheFiles) {
     TetMesh whole;
     ReadReport wr;
     ASSERT_TRUE(readMesh(partitioned(name), whole, wr)) << name;
-    uint64_t tets = 0;
-    for (uint32_t k = 0; k < 7; ++k) {
-      ReadOptions o;
-      o.shareIndex = k;
-      o.shareCount = 7;
-      TetMesh part;
-      ReadReport r;
-      ASSERT_TRUE(readMesh(partitioned(name), part, r, o)) << name << " share " << k;
-      EXPECT_TRUE(r.shared);
-      tets += part.tetCount();
-    }
-    EXPECT_EQ(tets, whole.tetCount()) << name;
+    EXPECT_EQ(test::tetsOfShares(partitioned(name), 7, false), whole.tetCount()) << name;
   }
 }
 
@@ -283,23 +267,9 @@ TEST(PartitionedReaders, SharesOfPiecesAndPartitionsHoldEveryTetOnce) {
     ReadReport wr;
     ASSERT_TRUE(readMesh(path, whole, wr)) << path;
     EXPECT_FALSE(wr.shared);
-    uint64_t tets = 0;
-    for (uint32_t k = 0; k < 3; ++k) {
-      ReadOptions o;
-      o.shareIndex = k;
-      o.shareCount = 3;
-      TetMesh part;
-      ReadReport r;
-      ASSERT_TRUE(readMesh(path, part, r, o)) << path << " share " << k;
-      EXPECT_TRUE(r.shared) << path;
-      EXPECT_GT(part.tetCount(), 0u) << path << " share " << k;
-      tets += part.tetCount();
-    }
-    EXPECT_EQ(tets, whole.tetCount()) << path;
+    EXPECT_EQ(test::tetsOfShares(path, 3, true), whole.tetCount()) << path;
   }
-  ReadOptions o;
-  o.shareIndex = 1;
-  o.shareCount = 2;
+  const ReadOptions o = test::shareOf(1, 2);
   TetMesh m;
   ReadReport r;
   ASSERT_TRUE(readMesh(partitioned("box.vtu"), m, r, o));
