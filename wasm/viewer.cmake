@@ -4,9 +4,9 @@
 # One program for both threads: the page runs main() (platform.cpp, api.cpp: drawing, panel,
 # input) and the refinement worker instantiates the same module without it (worker_api.cpp:
 # dataset, splits, surfaces). Those and imgui_gl_queries.cpp are the only viewer files with
-# Emscripten; the model (viewer_state, viewer_memory, telemetry, geometry_sync, page_state,
-# view_settings, colourmap, camera, frame_policy.h) has no GL and no Emscripten and also
-# compiles natively, for the unit tests.
+# Emscripten; the model (the tetstream_viewer_model library of the root CMakeLists.txt, with
+# page_state and frame_policy.h) has no GL and no Emscripten and also compiles natively, for the
+# unit tests and the model benchmark.
 
 set(TETSTREAM_IMGUI_DIR "${TETSTREAM_DEPS_DIR}/imgui")
 if(NOT EXISTS "${TETSTREAM_IMGUI_DIR}/imgui.cpp")
@@ -35,19 +35,10 @@ add_executable(tetstream_viewer
   ${CMAKE_CURRENT_LIST_DIR}/api.cpp
   ${CMAKE_CURRENT_LIST_DIR}/worker_api.cpp
   ${CMAKE_CURRENT_LIST_DIR}/page_state.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/view_settings.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/viewer_state.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/geometry_sync.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/telemetry.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/fetch_plan.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/eviction.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/colourmap.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/viewer_memory.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/camera.cpp
   ${CMAKE_CURRENT_LIST_DIR}/renderer.cpp
   ${CMAKE_CURRENT_LIST_DIR}/panel.cpp
 )
-target_link_libraries(tetstream_viewer PRIVATE tetstream_core tetstream_imgui)
+target_link_libraries(tetstream_viewer PRIVATE tetstream_viewer_model tetstream_imgui)
 set_target_properties(tetstream_viewer PROPERTIES LINK_DEPENDS ${CMAKE_CURRENT_LIST_DIR}/platform_calls.js)
 tetstream_warnings(tetstream_viewer)
 # GLM 0.9.9.8 (type_half.inl) uses `volatile float f; f *= f;`, deprecated in C++20.

@@ -19,6 +19,7 @@
 #include "camera.h"
 #include "geometry_sync.h"
 #include "telemetry.h"
+#include "update_pacing.h"
 #include "viewer_state.h"
 
 using namespace tetstream;
@@ -30,6 +31,7 @@ ViewerState g_model;
 OrbitCamera g_camera;  // the page's camera, for what each region covers on screen
 float g_aspect = 1.f;
 std::vector<uint8_t> g_delta;
+UpdatePacing g_pacing;  // when the page is sent the next update
 // Strings handed to the worker's script stay valid until the next call that returns one of the same kind.
 std::string g_stats, g_plan;
 
@@ -125,6 +127,7 @@ EMSCRIPTEN_KEEPALIVE void tw_fail(const char* message) { failLoad(g_model, messa
 EMSCRIPTEN_KEEPALIVE int tw_command(const char* text) {
   const nlohmann::json c = nlohmann::json::parse(text ? text : "", nullptr, false);
   if (!c.is_object()) return 0;
+  g_pacing.commandApplied();
   if (c.contains("view")) applyView(g_model, c["view"]);
   if (const auto level = c.find("level"); level != c.end() && level->is_object()) {
     if (const auto f = level->find("fraction"); f != level->end() && f->is_number())
@@ -150,7 +153,8 @@ EMSCRIPTEN_KEEPALIVE void tw_camera(double tx, double ty, double tz, double dist
   if (!g_model.dataset.manifest.nodes.empty() && g_model.fetch.missing > 0) ++g_model.fetch.version;
 }
 
-// Refines (or grows the interval tree) for about `ms`; 1 while more is to do.
+// Refines (or grows the interval tree) for about `ms`. Bit 0: more is to do; bit 1: an update
+// is due (update_pacing.h: the page is then sent tw_delta, tw_stats and the plan).
 EMSCRIPTEN_KEEPALIVE int tw_work(double ms) {
   ViewerState& s = g_model;
   const double deadline = now() + ms;
@@ -159,13 +163,15 @@ EMSCRIPTEN_KEEPALIVE int tw_work(double ms) {
   else
     growTree(s, deadline, now);
   if (s.state == LoadState::Complete && s.telemetry.completeMs < 0) s.telemetry.completeMs = now();
-  return refining(s) || treePending(s) ? 1 : 0;
+  const bool more = refining(s) || treePending(s);
+  return (more ? 1 : 0) | (g_pacing.due(now(), more, s.fetch.version) ? 2 : 0);
 }
 
 // What changed in the surface, slice and hull since the last call, as a delta; its address
-// (tw_delta_size bytes, valid until the next call).
+// (tw_delta_size bytes, valid until the next call). The start of an update to the page.
 EMSCRIPTEN_KEEPALIVE const uint8_t* tw_delta() {
   ViewerState& s = g_model;
+  g_pacing.sent(now(), s.fetch.version);
   g_delta.clear();
   const bool any = s.dirty.surface || s.dirty.slice || s.dirty.hull;
   if (any) {

@@ -8,7 +8,8 @@
 importScripts('tetstream.js');
 
 // Refinement per slice. Messages from the page (a new isovalue, a chunk) wait at most this long
-// plus one full extraction; each slice ends in one update to the page.
+// plus one full extraction. The program says after which slices the page gets an update
+// (wasm/update_pacing.h): while refining, at most every 33 ms.
 const SLICE_MS = 12;
 
 let viewer = null;
@@ -73,9 +74,9 @@ function work() {
   queued = false;
   if (!viewer) return;
   try {
-    const more = viewer._tw_work(SLICE_MS);
-    publish();
-    if (more) schedule();
+    const done = viewer._tw_work(SLICE_MS);
+    if (done & 2) publish();
+    if (done & 1) schedule();
   } catch (e) {
     aborted(e);
   }

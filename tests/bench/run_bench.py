@@ -37,6 +37,8 @@ CLI = os.path.join(ROOT, "build/native/tetstream")
 BENCH = os.path.join(ROOT, "build/native/tetstream_bench")
 CHECK = os.path.join(ROOT, "build/native/tetstream_core_check")
 CHECK_WASM = os.path.join(ROOT, "build/wasm/tetstream_core_check.js")
+MODEL = os.path.join(ROOT, "build/native/tetstream_model_bench")
+MODEL_WASM = os.path.join(ROOT, "build/wasm/tetstream_model_bench.js")
 VTK_SCRIPT = os.path.join(ROOT, "tests/bench/vtk_decimate.py")
 VTK_CONTOUR = os.path.join(ROOT, "tests/bench/vtk_contour.py")
 # The real meshes (post.vtk, carotid.vtk, ...): a folder named by TETSTREAM_DATASETS; skipped when absent.
@@ -183,6 +185,11 @@ def bench_mesh(name, mesh, field, iso, tmp, with_vtk, quick, repeat, light=False
     res["stream"] = {"native": run_json([CHECK, "--stream", full, str(iso)])}
     if os.path.exists(CHECK_WASM):
         res["stream"]["wasm"] = run_json(["node", "--no-experimental-fetch", CHECK_WASM, "--stream", full, str(iso)])
+    # The refinement worker's whole model (surface, hull, deltas for the page), every chunk.
+    res["stream"]["model"] = {"native": run_json([MODEL, full, "--everything", "--isovalue", str(iso)])}
+    if os.path.exists(MODEL_WASM):
+        res["stream"]["model"]["wasm"] = run_json(["node", "--no-experimental-fetch", MODEL_WASM, full, "--everything",
+                                                   "--isovalue", str(iso)])
     return res
 
 
@@ -244,14 +251,19 @@ def markdown(results, machine):
             lines.append(f"| {r['name']} | {x['chunks']} | {x['tets']:,} | {x['bytes'] / 1024:.0f} | {x['ours']['rmsRelative']:.5f} | "
                          f"{x['oursIso']['meanRelative']:.5f} / {x['oursIso']['maxRelative']:.4f} | {v} |")
     lines += ["", "Decode + apply + local isosurface update, splits/s: with the interval tree kept up to date, "
-              "and as the viewer streams (tree deferred until the level settles); undo with the tree.", "",
-              "| dataset | native, tree kept | wasm, tree kept | native, viewer | wasm, viewer | undo native | undo wasm |",
-              "|---|---|---|---|---|---|---|"]
+              "and as the viewer streams (tree deferred until the level settles); undo with the tree; the refinement "
+              "worker's whole model (surface, hull and the deltas for the page; tests/bench/model_bench.cpp).", "",
+              "| dataset | native, tree kept | wasm, tree kept | native, viewer | wasm, viewer | undo native | undo wasm "
+              "| worker model native | worker model wasm |",
+              "|---|---|---|---|---|---|---|---|---|"]
     for r in results:
         n, w = r["stream"]["native"], r["stream"].get("wasm") or {}
+        model = r["stream"].get("model", {})
+        mn, mw = model.get("native") or {}, model.get("wasm") or {}
         cell = lambda d, k: f"{d[k]:,.0f}" if k in d else "n/a"
         lines.append(f"| {r['name']} | {cell(n, 'splitsPerSecond')} | {cell(w, 'splitsPerSecond')} | {cell(n, 'viewerSplitsPerSecond')} | "
-                     f"{cell(w, 'viewerSplitsPerSecond')} | {cell(n, 'undoSplitsPerSecond')} | {cell(w, 'undoSplitsPerSecond')} |")
+                     f"{cell(w, 'viewerSplitsPerSecond')} | {cell(n, 'undoSplitsPerSecond')} | {cell(w, 'undoSplitsPerSecond')} "
+                     f"| {cell(mn, 'withDeltaSplitsPerSecond')} | {cell(mw, 'withDeltaSplitsPerSecond')} |")
     lines += ["", "Isovalue re-extraction, ms, native and wasm: the viewer's surface found through the interval tree / "
               "through a test of every tet (the same surface bookkeeping) / the plain extractor (a bare triangle soup "
               "from every tet, for reference):", "",

@@ -25,6 +25,7 @@
 #include "pack/packer.h"
 #include "page_state.h"
 #include "test_helpers.h"
+#include "update_pacing.h"
 #include "viewer_memory.h"
 #include "viewer_state.h"
 
@@ -964,4 +965,46 @@ TEST(PageState, TheWorkersModelFollowsThePageAndReportsBack) {
   EXPECT_FALSE(takeReport(page, "not json", seen, {}, error));
   EXPECT_FALSE(error.empty());
   EXPECT_EQ(page.surface.triangleCount(), model.surface.triangleCount());
+}
+
+// While the worker refines, the page gets an update at most every 33 ms (update_pacing.h): with
+// slices of 12 ms, after every third slice and after the last; the slices between go in one
+// delta, so the page's mirrors equal the model after every update. A command applied or a new
+// plan goes out after the next slice, whenever the last update went.
+TEST(PageState, UpdatesWhileRefiningCarryTheSlicesBetweenThem) {
+  const Packed& p = packedStream();
+  ViewerState model;
+  ASSERT_TRUE(openManifest(model, p.manifest).ok());
+  for (size_t c = 0; c < p.chunks.size(); ++c) ASSERT_TRUE(addChunk(model, uint32_t(c), p.chunks[c]).ok());
+  SurfaceMirror surface, slice;
+  HullMirror hull;
+  UpdatePacing pacing;
+  sync(model, surface, slice, hull);  // the base
+  pacing.sent(0, model.fetch.version);
+  double ms = 0;
+  int slices = 0, updates = 0;
+  for (bool more = true; more;) {
+    advance(model, g_ticks + 2, fakeNow);  // one batch of splits
+    ms += 12;
+    ++slices;
+    more = refining(model);
+    if (!pacing.due(ms, more, model.fetch.version)) continue;
+    pacing.sent(ms, model.fetch.version);
+    sync(model, surface, slice, hull);
+    ++updates;
+    expectMirrors(model.surface, surface, "after an update");
+  }
+  EXPECT_GT(slices, 6);
+  EXPECT_EQ(updates, (slices + 2) / 3) << slices << " slices";
+  EXPECT_EQ(model.state, LoadState::Complete);
+  expectMirrors(model.hull, hull);
+
+  const uint32_t plan = model.fetch.version;
+  EXPECT_FALSE(pacing.due(ms + 12, true, plan));
+  pacing.commandApplied();
+  EXPECT_TRUE(pacing.due(ms + 12, true, plan)) << "a command applied";
+  pacing.sent(ms + 12, plan);
+  EXPECT_FALSE(pacing.due(ms + 24, true, plan));
+  EXPECT_TRUE(pacing.due(ms + 24, true, plan + 1)) << "a new plan";
+  EXPECT_TRUE(pacing.due(ms + 24, false, plan)) << "the refinement stopped";
 }
