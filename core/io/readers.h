@@ -420,7 +420,9 @@ Result mergePieces(const std::string& label, std::vector<MeshPiece>& pieces, con
 // what was read. readVtu() is this followed by mergePieces(). Of a file of at least shareCount
 // pieces only share shareIndex is read: pieces shareIndex·n/shareCount up to
 // (shareIndex + 1)·n/shareCount; of fewer unstructured pieces, the same share of every piece's
-// cells and the points they span (ReadReport::shared says; structured pieces are read whole).
+// cells and the points they span, or only those they use when they leave some of that run unused
+// and the points are appended raw data (ReadReport::shared says; structured pieces are read
+// whole).
 Result readVtuPieces(std::string_view bytes, const std::string& label, std::vector<MeshPiece>& pieces,
                      ReadReport& report, uint32_t shareIndex = 0, uint32_t shareCount = 1);
 // A legacy VTK file as one MeshPiece (vtk_reader.cpp); readLegacyVtk() merges it alone.

@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <pugixml.hpp>
@@ -557,11 +558,50 @@ Result readExtent(pugi::xml_node node, const char* attr, const std::string& wher
   return Result::success();
 }
 
-// The rows of a piece one process reads: a run of its cells and the run of points they span.
+// The rows of a piece one process reads: a run of its cells and the run of points they span,
+// or of that run only the points they use (`pointPick`, ascending ids; empty: the whole run).
 struct PieceRows {
   uint64_t pointFirst = 0, points = UINT64_MAX;
   uint64_t cellFirst = 0, cells = UINT64_MAX;
+  std::vector<uint64_t> pointPick;
 };
+
+// Picked rows are read in windows of this many rows, each from the first picked row not read
+// yet: what is held at once is a window and the rows kept, not the whole run.
+constexpr uint64_t kPickWindow = uint64_t(1) << 20;
+
+// Whether a DataArray's rows can be read a window at a time for the cost of the window: appended
+// raw data (compressed or not) is reached by offset; text (ASCII, base64) would be decoded again
+// from the array's start for every window.
+bool readsByWindow(const Vtu& vtu, pugi::xml_node da) {
+  return std::string_view(da.attribute("format").value()) == "appended" && !vtu.appendedBase64;
+}
+
+// The values of rows `rows` of an array of `rowCount` rows of `comps` components each
+// (readDataArray), or of those only the rows in `pick` (ascending ids inside `rows`) when it is
+// not empty.
+template <class T>
+Result readRows(Vtu& vtu, pugi::xml_node da, const ArrayRef& ref, uint64_t rowCount, uint64_t comps, uint64_t first,
+                uint64_t count, std::span<const uint64_t> pick, std::vector<T>& out) {
+  auto values = [&](uint64_t from, uint64_t n) {
+    return ValueRange{from * comps, n == UINT64_MAX ? UINT64_MAX : n * comps};
+  };
+  if (pick.empty()) return readDataArray(vtu, da, ref, rowCount * comps, out, values(first, count));
+  const bool byWindow = readsByWindow(vtu, da);
+  std::vector<T> window;
+  std::vector<T> kept;
+  kept.reserve(pick.size() * comps);
+  for (size_t k = 0; k < pick.size();) {
+    const uint64_t from = pick[k], n = byWindow ? std::min(kPickWindow, rowCount - from) : pick.back() + 1 - from;
+    if (Result r = readDataArray(vtu, da, ref, rowCount * comps, window, values(from, n)); !r) return r;
+    for (; k < pick.size() && pick[k] < from + n; ++k) {
+      const auto row = window.begin() + std::ptrdiff_t((pick[k] - from) * comps);
+      kept.insert(kept.end(), row, row + std::ptrdiff_t(comps));
+    }
+  }
+  out = std::move(kept);
+  return Result::success();
+}
 
 // Reads the PointData and CellData arrays of one piece (np points, nc cells) into it: fields,
 // cell arrays, and the arrays that describe the partition (vtkGhostType, global ids). Of `rows`
@@ -588,9 +628,10 @@ Result readPieceData(Vtu& vtu, pugi::xml_node piece, const std::string& where, u
       uint64_t comps;
       if (Result r = readComponents(da, ref, comps); !r) return r;
       std::vector<double> values;
-      const uint64_t first = cells ? rows.cellFirst : rows.pointFirst, count = cells ? rows.cells : rows.points;
-      const ValueRange range{first * comps, count == UINT64_MAX ? UINT64_MAX : count * comps};
-      if (Result r = readDataArray(vtu, da, ref, (cells ? nc : np) * comps, values, range); !r) return r;
+      if (Result r = cells ? readRows(vtu, da, ref, nc, comps, rows.cellFirst, rows.cells, {}, values)
+                           : readRows(vtu, da, ref, np, comps, rows.pointFirst, rows.points, rows.pointPick, values);
+          !r)
+        return r;
       if (const PartitionArray p = partitionArrayKind(name, cells, idsAttribute); p != PartitionArray::None) {
         if (Result r = takePartitionArray(p, name, ref.str(), values, comps, cells, out); !r) return r;
         continue;
@@ -622,9 +663,10 @@ Result findCellArrays(pugi::xml_node piece, const std::string& where, uint64_t n
   return Result::success();
 }
 
-// Reads the points [first, first + count) of a piece of np points into mesh.positions.
+// Reads the points [first, first + count) of a piece of np points into mesh.positions, or of
+// those the ones in `pick` (readRows).
 Result readPointRows(Vtu& vtu, pugi::xml_node piece, const std::string& where, uint64_t np, ValueRange rows,
-                     TetMesh& mesh) {
+                     TetMesh& mesh, std::span<const uint64_t> pick = {}) {
   pugi::xml_node da = piece.child("Points").child("DataArray");
   ArrayRef ref{where, da ? da.attribute("Name").as_string("Points") : "Points"};
   if (!da) return fail(Status::Corrupt, where + ": " + std::to_string(np) + " points but no <Points> DataArray");
@@ -633,8 +675,7 @@ Result readPointRows(Vtu& vtu, pugi::xml_node piece, const std::string& where, u
   if (comps != 3)
     return fail(Status::Corrupt, ref.str() + ": points have " + std::to_string(comps) + " components, expected 3");
   std::vector<double> p;
-  const ValueRange values{3 * rows.first, rows.count == UINT64_MAX ? UINT64_MAX : 3 * rows.count};
-  if (Result r = readDataArray(vtu, da, ref, np * 3, p, values); !r) return r;
+  if (Result r = readRows(vtu, da, ref, np, 3, rows.first, rows.count, pick, p); !r) return r;
   mesh.positions.reserve(mesh.positions.size() + p.size());
   for (double x : p) mesh.positions.push_back(float(x));
   return Result::success();
@@ -738,11 +779,47 @@ Result readPiece(Vtu& vtu, GridKind kind, const Grid& whole, pugi::xml_node piec
   return readPieceData(vtu, piece, where, np, nc, report, notePieceConversions, out, rows);
 }
 
+// Points numbered far from the cells' order (a run of cells using points from all over the
+// piece) would make a share read nearly every point. When the points can be read a window at a
+// time (readsByWindow) and the cells leave some of the run of points their ids span unused, only
+// the points they use are read (rows.pointPick: readRows) and `conn` is renumbered to them;
+// else `conn` is made relative to the run's first point.
+void pickUsedPoints(const Vtu& vtu, pugi::xml_node piece, std::vector<int64_t>& conn, PieceRows& rows) {
+  rows.pointPick.clear();
+  const int64_t first = int64_t(rows.pointFirst);
+  if (rows.points == 0 || !readsByWindow(vtu, piece.child("Points").child("DataArray"))) {
+    for (int64_t& id : conn) id -= first;
+    return;
+  }
+  // A bit per point of the run, and per 64 of them the count of used points before: a point's
+  // place among those used costs a popcount (1.5 bits a point of the run, not 4 bytes).
+  std::vector<uint64_t> bits(size_t((rows.points + 63) / 64), 0);
+  for (int64_t id : conn) bits[size_t(id - first) / 64] |= uint64_t(1) << ((id - first) % 64);
+  std::vector<uint32_t> before(bits.size());
+  uint64_t used = 0;
+  for (size_t w = 0; w < bits.size(); ++w) {
+    before[w] = uint32_t(used);
+    used += uint64_t(std::popcount(bits[w]));
+  }
+  if (used == rows.points) {
+    for (int64_t& id : conn) id -= first;
+    return;
+  }
+  rows.pointPick.reserve(size_t(used));
+  for (size_t w = 0; w < bits.size(); ++w)
+    for (uint64_t b = bits[w]; b; b &= b - 1)
+      rows.pointPick.push_back(rows.pointFirst + 64 * w + uint64_t(std::countr_zero(b)));
+  for (int64_t& id : conn) {
+    const uint64_t k = uint64_t(id - first);
+    id = int64_t(before[k / 64]) + std::popcount(bits[k / 64] & ((uint64_t(1) << (k % 64)) - 1));
+  }
+}
+
 // Reads share `index` of `count` of an unstructured piece: its cells from index·nc/count up to
-// (index + 1)·nc/count and the points from the smallest to the largest id they use, with those
-// rows of every array. The other rows are passed over (raw appended data is not even read from
-// the mapped file, compressed blocks not inflated); the points on the cuts are read by both
-// sides and joined by the distributed pack like the points pieces share.
+// (index + 1)·nc/count and the points from the smallest to the largest id they use (or only
+// those they use: pickUsedPoints), with those rows of every array. The other rows are passed over (raw appended data is
+// not even read from the mapped file, compressed blocks not inflated); the points on the cuts are read by both sides
+// and joined by the distributed pack like the points pieces share.
 Result readPieceShare(Vtu& vtu, pugi::xml_node piece, const std::string& label, uint32_t index, uint32_t count,
                       MeshPiece& out, ReadReport& report, bool notePieceConversions, uint64_t& cellsTotal) {
   uint64_t np = 0, nc = 0;
@@ -801,13 +878,15 @@ Result readPieceShare(Vtu& vtu, pugi::xml_node piece, const std::string& label, 
   }
   rows.pointFirst = hi < 0 ? 0 : uint64_t(lo);
   rows.points = hi < 0 ? 0 : uint64_t(hi + 1 - lo);
-  for (int64_t& id : conn) id -= int64_t(rows.pointFirst);
+  pickUsedPoints(vtu, piece, conn, rows);
+  const uint64_t pointsRead = rows.pointPick.empty() ? rows.points : rows.pointPick.size();
 
   TetMesh& mesh = out.mesh;
   const uint64_t vertexBase = mesh.positions.size() / 3;
   if (rows.points > 0)
-    if (Result r = readPointRows(vtu, piece, where, np, {rows.pointFirst, rows.points}, mesh); !r) return r;
-  if (Result r = appendVtkCells(where, conn, ends, types, vertexBase, rows.points, out.soup); !r) return r;
+    if (Result r = readPointRows(vtu, piece, where, np, {rows.pointFirst, rows.points}, mesh, rows.pointPick); !r)
+      return r;
+  if (Result r = appendVtkCells(where, conn, ends, types, vertexBase, pointsRead, out.soup); !r) return r;
   return readPieceData(vtu, piece, where, np, nc, report, notePieceConversions, out, rows);
 }
 
@@ -930,7 +1009,8 @@ Result readCellShares(Vtu& vtu, const std::vector<pugi::xml_node>& nodes, const 
                                 ? "share " + std::to_string(shareIndex + 1) + " of " + std::to_string(shareCount)
                                 : "a share of each of the " + std::to_string(nodes.size()) + " pieces";
   report.notes.push_back("read " + std::to_string(cellsRead) + " of the " + std::to_string(cells) + " cells (" + which +
-                         ") and the " + std::to_string(points) + " points they span, this process's share of the file");
+                         ") and the " + std::to_string(points) +
+                         " points read for them, this process's share of the file");
   return Result::success();
 }
 

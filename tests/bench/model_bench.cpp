@@ -25,15 +25,8 @@ namespace {
 
 double nowMs() { return std::chrono::duration<double, std::milli>(BenchClock::now().time_since_epoch()).count(); }
 
-bool readAll(const std::string& path, std::vector<uint8_t>& out) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) return false;
-  out.clear();
-  uint8_t buf[1 << 16];
-  for (size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) out.insert(out.end(), buf, buf + n);
-  std::fclose(f);
-  return true;
-}
+// A chunk or manifest file: at most 1 GiB, the format's limit for a chunk.
+constexpr uint64_t kFileLimit = uint64_t(1) << 30;
 
 // Offers every chunk the plan asks for that is not in hand yet; false when none was left.
 bool offerPlanned(ViewerState& s, const std::string& dir) {
@@ -41,7 +34,7 @@ bool offerPlanned(ViewerState& s, const std::string& dir) {
   std::vector<uint8_t> bytes;
   for (uint32_t c : chunksToFetch(s)) {
     if (s.dataset.hasChunk(c) || s.pendingChunks.count(c)) continue;
-    if (!readAll(dir + "/" + s.dataset.manifest.chunks[c].file, bytes)) {
+    if (!readFileBytes(dir + "/" + s.dataset.manifest.chunks[c].file, kFileLimit, bytes).ok()) {
       std::fprintf(stderr, "error: cannot read chunk %u\n", c);
       std::exit(1);
     }
@@ -107,7 +100,7 @@ int main(int argc, char** argv) {
       isovalue = argv[++i];
   }
   std::vector<uint8_t> manifest;
-  if (!readAll(dir + "/manifest.json", manifest)) {
+  if (!readFileBytes(dir + "/manifest.json", kFileLimit, manifest).ok()) {
     std::fprintf(stderr, "error: cannot read %s/manifest.json\n", dir.c_str());
     return 1;
   }

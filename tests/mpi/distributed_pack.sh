@@ -111,6 +111,16 @@ import meshio, sys
 meshio.read(sys.argv[1]).write(sys.argv[2], compression='zlib')" "$WORK/harmonic.vtu" "$WORK/harmonic-zlib.vtu"
 sharesLikeOneProcess vtu-zlib "$WORK/harmonic-zlib.vtu" "this process's share of the file" "2" "0 0.25" \
   --leaf-vertices 256 --chunk-kb 8
+# Its points shuffled (a run of the cells uses points from all over the file): each rank reads
+# only the points its cells use.
+/usr/bin/python3 "$HERE/shuffle_points.py" "$WORK/harmonic.vtu" "$WORK/shuffled.vtu"
+sharesLikeOneProcess shuffled "$WORK/shuffled.vtu" "points read for them" "2 3" "0 0.25" --leaf-vertices 256 --chunk-kb 8
+points=$("$TETSTREAM" info "$WORK/harmonic.vtu" --json | tr -d ' \n' | grep -o '"vertices":[0-9]*' | head -1 | cut -d: -f2)
+for np in 2 3; do
+  grep -o 'the [0-9]* points read for them' "$WORK/shuffled-np$np.json" | while read -r _ read _; do
+    [ "$read" -lt $((points * 2 / np)) ] || { echo "FAIL: a rank of $np read $read of the $points points"; exit 1; }
+  done
+done
 
 # One XDMF grid with HDF5 heavy data and one Exodus II file, as meshio writes them (DOLFINx and
 # others write XDMF so: one file for the whole mesh): each rank reads its rows of the cells (HDF5

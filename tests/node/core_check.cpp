@@ -29,15 +29,8 @@ namespace {
 
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
-bool readAll(const std::string& path, std::vector<uint8_t>& out) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) return false;
-  out.clear();
-  uint8_t buf[1 << 16];
-  for (size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) out.insert(out.end(), buf, buf + n);
-  std::fclose(f);
-  return true;
-}
+// A chunk or manifest file: at most 1 GiB, the format's limit for a chunk.
+constexpr uint64_t kFileLimit = uint64_t(1) << 30;
 
 int surfaceCheck(int argc, char** argv) {
   Dataset ds;
@@ -95,7 +88,7 @@ int streamBench(const std::string& dir, float iso) {
   }
   std::vector<std::vector<uint8_t>> files(ds.manifest.chunks.size());
   for (uint32_t c = 1; c < files.size(); ++c)
-    if (!readAll(dir + "/" + ds.manifest.chunks[c].file, files[c])) return 1;
+    if (!readFileBytes(dir + "/" + ds.manifest.chunks[c].file, kFileLimit, files[c]).ok()) return 1;
   const int field = ds.manifest.findField(ds.manifest.isoField);
   // As the viewer does: receive each chunk, then splits in batches with a local update each.
   // `surface` is already built on the base; returns false on a bad chunk or record.
