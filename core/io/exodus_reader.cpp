@@ -17,9 +17,9 @@
 //
 // A share for one of several processes (ReadOptions::shareIndex of shareCount, core/dist): the
 // elements from index·N/count to (index + 1)·N/count in file order (all blocks), and the nodes
-// from the smallest to the largest their corners use, with those rows of every variable, all
-// through the library's partial reads; nodes on the cuts are read by both sides and joined later
-// by their coordinates.
+// their corners use (the run from the smallest to the largest, or of it only those, a window at
+// a time: io/row_pick.h), with those rows of every variable, all through the library's partial
+// reads; nodes on the cuts are read by both sides and joined later by their coordinates.
 #include <exodusII.h>
 #include <netcdf.h>
 
@@ -27,8 +27,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <memory>
 
 #include "io/readers.h"
+#include "io/row_pick.h"
 
 namespace tetstream {
 namespace {
@@ -210,47 +212,100 @@ class ExodusReader {
     return s;
   }
 
-  // The nodes read: all of them, or the window a share's cells span.
+  // The nodes read: all of them, or those a share's cells use (io/row_pick.h): the run from the
+  // smallest to the largest, or of that run only the used ones (nodePick_) when it has others.
   Result chooseNodes(const std::vector<std::vector<int64_t>>& conns) {
     nodeFirst_ = 0;
     nodeCount_ = numNodes_;
+    nodePick_.clear();
+    used_.reset();
     if (!share_) return Result::success();
     int64_t lo = INT64_MAX, hi = 0;
     uint64_t cells = 0;
-    for (size_t b = 0; b < blocks_.size(); ++b) {
-      if (!blocks_[b].kind.volume) continue;
-      cells += uint64_t(blocks_[b].readCount);
-      const int corners = kShapeCorners[int(blocks_[b].kind.shape)];
-      for (int64_t k = 0; k < blocks_[b].readCount; ++k)
-        for (int q = 0; q < corners; ++q) {
-          const int64_t v = conns[b][size_t(k * blocks_[b].nodesPer + q)];
-          if (v < 1 || v > numNodes_) continue;  // (refused with its element's name when added)
-          lo = std::min(lo, v - 1);
-          hi = std::max(hi, v);
-        }
-    }
+    auto eachCorner = [&](auto&& f) {
+      for (size_t b = 0; b < blocks_.size(); ++b) {
+        if (!blocks_[b].kind.volume) continue;
+        const int corners = kShapeCorners[int(blocks_[b].kind.shape)];
+        for (int64_t k = 0; k < blocks_[b].readCount; ++k)
+          for (int q = 0; q < corners; ++q) {
+            const int64_t v = conns[b][size_t(k * blocks_[b].nodesPer + q)];
+            if (v >= 1 && v <= numNodes_) f(v);  // (others are refused with their element's name when added)
+          }
+      }
+    };
+    for (const Block& b : blocks_)
+      if (b.kind.volume) cells += uint64_t(b.readCount);
+    eachCorner([&](int64_t v) {
+      lo = std::min(lo, v - 1);
+      hi = std::max(hi, v);
+    });
     if (hi == 0) lo = 0;
     nodeFirst_ = lo;
     nodeCount_ = hi - lo;
+    used_ = std::make_unique<io::UsedRows>(uint64_t(lo), uint64_t(nodeCount_));
+    eachCorner([&](int64_t v) { used_->mark(uint64_t(v - 1)); });
+    used_->finish();
+    if (used_->all())
+      used_.reset();
+    else
+      nodePick_ = used_->rows();
     report_.shared = true;
     report_.notes.push_back("read elements " + std::to_string(shareFrom_) + " to " + std::to_string(shareTo_) + " of " +
                             std::to_string(numElements_) + " (" + std::to_string(cells) + " of volume) and the " +
-                            std::to_string(nodeCount_) + " nodes they span, this process's share of the file");
+                            std::to_string(nodesRead()) + " nodes they use, this process's share of the file");
     return Result::success();
   }
 
+  // The nodes read, and where node v (1-based) is among them (nodeRead: -1 when not read).
+  size_t nodesRead() const { return used_ ? nodePick_.size() : size_t(nodeCount_); }
+  int64_t nodeRead(int64_t v) const {
+    if (v <= nodeFirst_ || v > nodeFirst_ + nodeCount_) return -1;
+    if (!used_) return v - 1 - nodeFirst_;
+    return used_->isUsed(uint64_t(v - 1)) ? int64_t(used_->place(uint64_t(v - 1))) : -1;
+  }
+
+  // Values of the nodes read, one a node, from read(first, count, values) of 0-based runs: the
+  // whole run, or of it the picked nodes a window at a time.
+  template <class Read>
+  Result readNodeRows(const std::string& what, Read&& read, std::vector<double>& out) {
+    if (!used_) {
+      out.resize(size_t(nodeCount_));
+      return nodeCount_ ? read(nodeFirst_, nodeCount_, out) : Result::success();
+    }
+    return io::readPickedRows(
+        nodePick_, uint64_t(numNodes_), true, what,
+        [&](uint64_t from, uint64_t n, std::vector<double>& window) {
+          window.resize(size_t(n));
+          return read(int64_t(from), int64_t(n), window);
+        },
+        out);
+  }
+
   Result readCoordinates(TetMesh& mesh) {
-    const size_t n = size_t(nodeCount_);
-    std::vector<double> x(n), y(n), z(n);
-    if (n && ex_get_partial_coord(file_.id, nodeFirst_ + 1, nodeCount_, x.data(), y.data(), z.data()) != kExodusOk)
-      return fail(Status::Corrupt, path_ + ": cannot read the node coordinates: " + lastExodusError());
+    const size_t n = nodesRead();
+    std::vector<double> axis[3];
+    for (int a = 0; a < 3; ++a) {
+      double* at[3] = {nullptr, nullptr, nullptr};
+      if (Result r = readNodeRows(
+              "the node coordinates",
+              [&](int64_t first, int64_t count, std::vector<double>& values) {
+                at[a] = values.data();
+                if (ex_get_partial_coord(file_.id, first + 1, count, at[0], at[1], at[2]) != kExodusOk)
+                  return fail(Status::Corrupt, path_ + ": cannot read the node coordinates: " + lastExodusError());
+                return Result::success();
+              },
+              axis[a]);
+          !r)
+        return r;
+    }
+    const std::vector<double>&x = axis[0], &y = axis[1], &z = axis[2];
     mesh.positions.resize(3 * n);
     for (size_t v = 0; v < n; ++v) {
       if (!std::isfinite(x[v]) || !std::isfinite(y[v]) || !std::isfinite(z[v])) {
         char buf[128];
         std::snprintf(buf, sizeof buf, "(%g, %g, %g)", x[v], y[v], z[v]);
-        return fail(Status::NonFinite,
-                    path_ + ": " + nodeName(nodeFirst_ + int64_t(v) + 1) + " has a non-finite coordinate " + buf);
+        const int64_t node = used_ ? int64_t(nodePick_[v]) : nodeFirst_ + int64_t(v);
+        return fail(Status::NonFinite, path_ + ": " + nodeName(node + 1) + " has a non-finite coordinate " + buf);
       }
       mesh.positions[3 * v] = float(x[v]);
       mesh.positions[3 * v + 1] = float(y[v]);
@@ -336,9 +391,9 @@ class ExodusReader {
       soup.skipped[{b.kind.special ? 0 : b.kind.vtkType, label}] += uint64_t(b.readCount);
       return Result::success();
     }
-    if (soup.referenced.size() < size_t(nodeCount_)) soup.referenced.resize(size_t(nodeCount_), 0);
-    auto mark = [&](int64_t v) {  // (a share's nodes outside its window are not read)
-      if (v > nodeFirst_ && v <= nodeFirst_ + nodeCount_) soup.referenced[size_t(v - 1 - nodeFirst_)] = 1;
+    if (soup.referenced.size() < nodesRead()) soup.referenced.resize(nodesRead(), 0);
+    auto mark = [&](int64_t v) {  // (a share's nodes outside those it reads are not read)
+      if (const int64_t at = nodeRead(v); at >= 0) soup.referenced[size_t(at)] = 1;
     };
     if (!b.kind.volume) {
       soup.skipped[{b.kind.vtkType, label}] += uint64_t(b.readCount);
@@ -359,7 +414,7 @@ class ExodusReader {
                                               std::to_string(v) + ", but the nodes are numbered 1.." +
                                               std::to_string(numNodes_));
         mark(v);
-        if (q < corners) ids[q] = uint32_t(v - 1 - nodeFirst_);
+        if (q < corners) ids[q] = uint32_t(nodeRead(v));
       }
       soup.add(b.kind.shape, ids, sourceBase + uint64_t(k));
     }
@@ -417,16 +472,22 @@ class ExodusReader {
     std::vector<std::string> names;
     if (Result r = variableNames(EX_NODAL, "nodal", names); !r) return r;
     if (names.empty() || noValues(names.size(), "nodal")) return Result::success();
-    const size_t n = size_t(nodeCount_);
-    std::vector<double> values(n);
+    std::vector<double> values;
     const size_t firstField = mesh.fields.size();
     for (size_t k = 0; k < names.size(); ++k) {
-      if (n &&
-          ex_get_partial_var(file_.id, int(step + 1), EX_NODAL, int(k + 1), 1, nodeFirst_ + 1, nodeCount_,
-                             values.data()) != kExodusOk &&
-          !readNodalVariableDirectly(step, k, values))
-        return fail(Status::Corrupt, path_ + ": nodal variable '" + names[k] + "' at step " + std::to_string(step) +
-                                         ": " + lastExodusError());
+      if (Result r = readNodeRows(
+              "nodal variable '" + names[k] + "'",
+              [&](int64_t first, int64_t count, std::vector<double>& out) {
+                if (ex_get_partial_var(file_.id, int(step + 1), EX_NODAL, int(k + 1), 1, first + 1, count,
+                                       out.data()) == kExodusOk ||
+                    readNodalVariableDirectly(step, k, first, count, out))
+                  return Result::success();
+                return fail(Status::Corrupt, path_ + ": nodal variable '" + names[k] + "' at step " +
+                                                 std::to_string(step) + ": " + lastExodusError());
+              },
+              values);
+          !r)
+        return r;
       ScalarField f;
       f.name = names[k];
       f.values.assign(values.begin(), values.end());
@@ -441,7 +502,7 @@ class ExodusReader {
   // each without saying the model is large, so the library finds none; they are read from
   // vals_nod_varK through netCDF (the Exodus file id is the netCDF id) when it has the layout
   // (time_step, num_nodes).
-  bool readNodalVariableDirectly(size_t step, size_t k, std::vector<double>& values) {
+  bool readNodalVariableDirectly(size_t step, size_t k, int64_t first, int64_t count, std::vector<double>& values) {
     const std::string name = "vals_nod_var" + std::to_string(k + 1);
     int var = -1, ndims = 0;
     int dims[NC_MAX_VAR_DIMS];
@@ -452,8 +513,8 @@ class ExodusReader {
         nc_inq_dimlen(file_.id, dims[1], &length[1]) != NC_NOERR || length[0] <= step ||
         length[1] != uint64_t(numNodes_))
       return false;
-    const size_t start[2] = {step, size_t(nodeFirst_)}, count[2] = {1, size_t(nodeCount_)};
-    if (nc_get_vara_double(file_.id, var, start, count, values.data()) != NC_NOERR) return false;
+    const size_t start[2] = {step, size_t(first)}, counts[2] = {1, size_t(count)};
+    if (nc_get_vara_double(file_.id, var, start, counts, values.data()) != NC_NOERR) return false;
     if (!directNoted_) {
       directNoted_ = true;
       report_.notes.push_back(
@@ -542,7 +603,9 @@ class ExodusReader {
   int64_t numNodes_ = 0, numElements_ = 0;
   bool share_ = false;                     // reading one process's share (the header comment)
   uint64_t shareFrom_ = 0, shareTo_ = 0;   // the elements read, in file order over all blocks
-  int64_t nodeFirst_ = 0, nodeCount_ = 0;  // the nodes read (0-based first)
+  int64_t nodeFirst_ = 0, nodeCount_ = 0;  // the run of nodes a share's cells use (0-based first)
+  std::unique_ptr<io::UsedRows> used_;     // of that run the nodes used, when not all are
+  std::vector<uint64_t> nodePick_;         // those nodes (0-based), ascending: the nodes read
   std::vector<Block> blocks_;
   std::vector<double> times_;
   bool nodeMapRead_ = false, elemMapRead_ = false, directNoted_ = false;

@@ -14,13 +14,13 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cmath>
 #include <cstring>
 #include <pugixml.hpp>
 #include <set>
 
 #include "io/readers.h"
+#include "io/row_pick.h"
 
 namespace tetstream {
 namespace {
@@ -566,10 +566,6 @@ struct PieceRows {
   std::vector<uint64_t> pointPick;
 };
 
-// Picked rows are read in windows of this many rows, each from the first picked row not read
-// yet: what is held at once is a window and the rows kept, not the whole run.
-constexpr uint64_t kPickWindow = uint64_t(1) << 20;
-
 // Whether a DataArray's rows can be read a window at a time for the cost of the window: appended
 // raw data (compressed or not) is reached by offset; text (ASCII, base64) would be decoded again
 // from the array's start for every window.
@@ -587,20 +583,12 @@ Result readRows(Vtu& vtu, pugi::xml_node da, const ArrayRef& ref, uint64_t rowCo
     return ValueRange{from * comps, n == UINT64_MAX ? UINT64_MAX : n * comps};
   };
   if (pick.empty()) return readDataArray(vtu, da, ref, rowCount * comps, out, values(first, count));
-  const bool byWindow = readsByWindow(vtu, da);
-  std::vector<T> window;
-  std::vector<T> kept;
-  kept.reserve(pick.size() * comps);
-  for (size_t k = 0; k < pick.size();) {
-    const uint64_t from = pick[k], n = byWindow ? std::min(kPickWindow, rowCount - from) : pick.back() + 1 - from;
-    if (Result r = readDataArray(vtu, da, ref, rowCount * comps, window, values(from, n)); !r) return r;
-    for (; k < pick.size() && pick[k] < from + n; ++k) {
-      const auto row = window.begin() + std::ptrdiff_t((pick[k] - from) * comps);
-      kept.insert(kept.end(), row, row + std::ptrdiff_t(comps));
-    }
-  }
-  out = std::move(kept);
-  return Result::success();
+  return io::readPickedRows(
+      pick, rowCount, readsByWindow(vtu, da), ref.str(),
+      [&](uint64_t from, uint64_t n, std::vector<T>& window) {
+        return readDataArray(vtu, da, ref, rowCount * comps, window, values(from, n));
+      },
+      out);
 }
 
 // Reads the PointData and CellData arrays of one piece (np points, nc cells) into it: fields,
@@ -779,39 +767,15 @@ Result readPiece(Vtu& vtu, GridKind kind, const Grid& whole, pugi::xml_node piec
   return readPieceData(vtu, piece, where, np, nc, report, notePieceConversions, out, rows);
 }
 
-// Points numbered far from the cells' order (a run of cells using points from all over the
-// piece) would make a share read nearly every point. When the points can be read a window at a
-// time (readsByWindow) and the cells leave some of the run of points their ids span unused, only
-// the points they use are read (rows.pointPick: readRows) and `conn` is renumbered to them;
-// else `conn` is made relative to the run's first point.
+// The points a share reads (io/row_pick.h): of appended raw data only those its cells use
+// (rows.pointPick, read by readRows), else the run their ids span. `conn` is renumbered to the
+// points read.
 void pickUsedPoints(const Vtu& vtu, pugi::xml_node piece, std::vector<int64_t>& conn, PieceRows& rows) {
   rows.pointPick.clear();
-  const int64_t first = int64_t(rows.pointFirst);
-  if (rows.points == 0 || !readsByWindow(vtu, piece.child("Points").child("DataArray"))) {
-    for (int64_t& id : conn) id -= first;
-    return;
-  }
-  // A bit per point of the run, and per 64 of them the count of used points before: a point's
-  // place among those used costs a popcount (1.5 bits a point of the run, not 4 bytes).
-  std::vector<uint64_t> bits(size_t((rows.points + 63) / 64), 0);
-  for (int64_t id : conn) bits[size_t(id - first) / 64] |= uint64_t(1) << ((id - first) % 64);
-  std::vector<uint32_t> before(bits.size());
-  uint64_t used = 0;
-  for (size_t w = 0; w < bits.size(); ++w) {
-    before[w] = uint32_t(used);
-    used += uint64_t(std::popcount(bits[w]));
-  }
-  if (used == rows.points) {
-    for (int64_t& id : conn) id -= first;
-    return;
-  }
-  rows.pointPick.reserve(size_t(used));
-  for (size_t w = 0; w < bits.size(); ++w)
-    for (uint64_t b = bits[w]; b; b &= b - 1)
-      rows.pointPick.push_back(rows.pointFirst + 64 * w + uint64_t(std::countr_zero(b)));
-  for (int64_t& id : conn) {
-    const uint64_t k = uint64_t(id - first);
-    id = int64_t(before[k / 64]) + std::popcount(bits[k / 64] & ((uint64_t(1) << (k % 64)) - 1));
+  if (rows.points > 0 && readsByWindow(vtu, piece.child("Points").child("DataArray"))) {
+    rows.pointPick = io::pickUsedRows(conn, rows.pointFirst, rows.points);
+  } else {
+    for (int64_t& id : conn) id -= int64_t(rows.pointFirst);
   }
 }
 

@@ -359,6 +359,13 @@ std::vector<uint64_t> Document::declaredDims(pugi::xml_node item) {
   return dims;
 }
 
+bool Document::readsRowsAlone(pugi::xml_node item, uint64_t total) {
+  const std::vector<uint64_t> d = declaredDims(item);
+  pugi::xml_node node;
+  return !d.empty() && d[0] == total && total > 0 && follow(item, "", node).ok() &&
+         iequals(node.attribute("Format").value(), "HDF");
+}
+
 template <class T>
 Result Document::readRows(pugi::xml_node item, const std::string& what, uint64_t total, uint64_t first, uint64_t count,
                           Values<T>& out) {

@@ -72,6 +72,9 @@ class Document {
                     Values<double>& out);
   Result integerRows(pugi::xml_node item, const std::string& what, uint64_t total, uint64_t first, uint64_t count,
                      Values<int64_t>& out);
+  // Whether rows of `item` (of `total` rows) are read for the cost of those rows: an HDF5
+  // hyperslab of a Uniform item. Other data is read whole and sliced.
+  bool readsRowsAlone(pugi::xml_node item, uint64_t total);
   // A Uniform DataItem's declared Dimensions (empty for any other item, or none declared).
   std::vector<uint64_t> declaredDims(pugi::xml_node item);
 

@@ -28,8 +28,10 @@
 #include <filesystem>
 #include <map>
 #include <set>
+#include <span>
 
 #include "io/readers.h"
+#include "io/row_pick.h"
 #include "io/xdmf_document.h"
 #include "io/xdmf_function.h"
 
@@ -141,10 +143,12 @@ bool anyOfFunctionSpace(const std::vector<pugi::xml_node>& attributes) {
 }
 
 // One process's share of a grid (ReadOptions::shareIndex of shareCount): rows of its cells and
-// of its points, out of how many.
+// of its points, out of how many; of the points' run only those in pointPick when it is not
+// empty (io/row_pick.h).
 struct Rows {
   uint64_t cellsTotal = 0, cellFirst = 0;
-  uint64_t pointsTotal = 0, pointFirst = 0;
+  uint64_t pointsTotal = 0, pointFirst = 0, pointsSpan = 0;
+  std::vector<uint64_t> pointPick;
 };
 
 // A piece's arrays, merged across pieces like the VTK XML reader does.
@@ -173,7 +177,11 @@ class XdmfReader {
   Result readShareOfGrid(pugi::xml_node topo, pugi::xml_node geo, const TopologyKind& kind,
                          const std::vector<pugi::xml_node>& attributes, const std::string& where, PieceArrays& arrays,
                          bool& done);
-  Result pointRows(pugi::xml_node geo, const std::string& where, uint64_t first, uint64_t count, uint64_t& total);
+  Result pointRows(pugi::xml_node geo, const std::string& where, uint64_t first, uint64_t count,
+                   std::span<const uint64_t> pick, uint64_t& total);
+  // Rows [first, first + count) of a DataItem of `total` rows, or of them those in `pick`.
+  Result pickedRows(pugi::xml_node item, const std::string& what, uint64_t total, uint64_t first, uint64_t count,
+                    std::span<const uint64_t> pick, xdmf::Values<double>& out);
   void dropRepeatedCells(size_t firstNew, uint64_t vertexBase, uint64_t points, const std::string& where);
   Result readCells(pugi::xml_node topo, const TopologyKind* kind, const std::string& where, uint64_t points,
                    uint64_t vertexBase, std::vector<int64_t>& conn, int& nodes, uint64_t& cells);
@@ -438,10 +446,25 @@ Result XdmfReader::baseOffset(pugi::xml_node topo, const std::string& what, int6
   return Result::success();
 }
 
+Result XdmfReader::pickedRows(pugi::xml_node item, const std::string& what, uint64_t total, uint64_t first,
+                              uint64_t count, std::span<const uint64_t> pick, xdmf::Values<double>& out) {
+  if (pick.empty()) return doc_.numberRows(item, what, total, first, count, out);
+  out = {};
+  return io::readPickedRows(
+      pick, total, doc_.readsRowsAlone(item, total), what,
+      [&](uint64_t from, uint64_t n, std::vector<double>& window) {
+        xdmf::Values<double> v;
+        Result r = doc_.numberRows(item, what, total, from, n, v);
+        window = std::move(v.values);
+        return r;
+      },
+      out.values);
+}
+
 // Points [first, first + count) of a Geometry of `total` points (total: set from its declared
-// size), appended to the mesh's.
+// size), or of them those in `pick`, appended to the mesh's.
 Result XdmfReader::pointRows(pugi::xml_node geo, const std::string& where, uint64_t first, uint64_t count,
-                             uint64_t& total) {
+                             std::span<const uint64_t> pick, uint64_t& total) {
   std::string_view type = geo.attribute("GeometryType").value();
   if (type.empty()) type = geo.attribute("Type").value();
   if (type.empty()) type = "XYZ";
@@ -470,12 +493,15 @@ Result XdmfReader::pointRows(pugi::xml_node geo, const std::string& where, uint6
   for (size_t a = 0; a < items.size(); ++a) {
     // (XYZ as N x 3 rows or as 3N values; X_Y_Z as N values each)
     const bool rowsOfThree = xyz && dims.size() == 2 && dims[1] == 3;
-    const uint64_t scale = xyz && !rowsOfThree ? 3 : 1;
-    if (Result r = doc_.numberRows(items[a], what, rowsOfThree || !xyz ? total : 3 * total, scale * first,
-                                   scale * count, axis[a]);
-        !r)
+    if (xyz && !rowsOfThree) {  // (a point is 3 rows: read by point when picked)
+      std::vector<uint64_t> rows;
+      for (uint64_t p : pick) rows.insert(rows.end(), {3 * p, 3 * p + 1, 3 * p + 2});
+      if (Result r = pickedRows(items[a], what, 3 * total, 3 * first, 3 * count, rows, axis[a]); !r) return r;
+    } else if (Result r = pickedRows(items[a], what, total, first, count, pick, axis[a]); !r) {
       return r;
+    }
   }
+  if (!pick.empty()) count = pick.size();
   mesh_.positions.reserve(mesh_.positions.size() + 3 * count);
   for (uint64_t i = 0; i < count; ++i)
     for (int k = 0; k < 3; ++k)
@@ -523,10 +549,13 @@ Result XdmfReader::readShareOfGrid(pugi::xml_node topo, pugi::xml_node geo, cons
   rows.cellsTotal = cellsTotal;
   rows.cellFirst = from;
   rows.pointFirst = uint64_t(lo);
-  const uint64_t points = uint64_t(hi + 1 - lo);
+  const uint64_t span = uint64_t(hi + 1 - lo);
+  rows.pointsSpan = span;
+  // The points the cells use (io/row_pick.h); `ids` become their places among those read.
+  rows.pointPick = io::pickUsedRows(ids.values, rows.pointFirst, span);
+  const uint64_t points = rows.pointPick.empty() ? span : rows.pointPick.size();
   const uint64_t vertexBase = mesh_.positions.size() / 3;
-  if (Result r = pointRows(geo, where, rows.pointFirst, points, rows.pointsTotal); !r) return r;
-  for (int64_t& id : ids.values) id -= lo;
+  if (Result r = pointRows(geo, where, rows.pointFirst, span, rows.pointPick, rows.pointsTotal); !r) return r;
   std::vector<int64_t> offsets(to - from + 1), types(to - from, kind.vtk);
   for (uint64_t c = 0; c < offsets.size(); ++c) offsets[c] = int64_t(c * nodes);
   if (Result r = appendVtkCells(where, ids.values, offsets, types, vertexBase, points, soup_); !r) return r;
@@ -540,7 +569,7 @@ Result XdmfReader::readShareOfGrid(pugi::xml_node topo, pugi::xml_node geo, cons
   report_.shared = true;
   report_.notes.push_back("read cells " + std::to_string(from) + " to " + std::to_string(to) + " of " +
                           std::to_string(cellsTotal) + " and the " + std::to_string(points) +
-                          " points they span, this process's share of the grid");
+                          " points they use, this process's share of the grid");
   done = true;
   return Result::success();
 }
@@ -698,8 +727,9 @@ Result XdmfReader::readAttributes(const std::vector<pugi::xml_node>& attributes,
     Values<double> v;
     const uint64_t n = node ? grid.points : grid.cells;
     if (rows) {  // a share of the grid: the rows of its points, or of its cells
-      if (Result r = doc_.numberRows(item, what, node ? rows->pointsTotal : rows->cellsTotal,
-                                     node ? rows->pointFirst : rows->cellFirst, n, v);
+      if (Result r =
+              node ? pickedRows(item, what, rows->pointsTotal, rows->pointFirst, rows->pointsSpan, rows->pointPick, v)
+                   : doc_.numberRows(item, what, rows->cellsTotal, rows->cellFirst, n, v);
           !r)
         return r;
     } else if (Result r = doc_.numbers(item, what, v); !r) {

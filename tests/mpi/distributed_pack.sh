@@ -111,14 +111,24 @@ import meshio, sys
 meshio.read(sys.argv[1]).write(sys.argv[2], compression='zlib')" "$WORK/harmonic.vtu" "$WORK/harmonic-zlib.vtu"
 sharesLikeOneProcess vtu-zlib "$WORK/harmonic-zlib.vtu" "this process's share of the file" "2" "0 0.25" \
   --leaf-vertices 256 --chunk-kb 8
-# Its points shuffled (a run of the cells uses points from all over the file): each rank reads
-# only the points its cells use.
+# Its points shuffled (a run of the cells uses points from all over the file), as a .vtu of
+# appended raw data, one XDMF grid with HDF5 heavy data and one Exodus II file: each rank reads
+# only the points its cells use, far fewer than every point.
 /usr/bin/python3 "$HERE/shuffle_points.py" "$WORK/harmonic.vtu" "$WORK/shuffled.vtu"
-sharesLikeOneProcess shuffled "$WORK/shuffled.vtu" "points read for them" "2 3" "0 0.25" --leaf-vertices 256 --chunk-kb 8
+for ext in xdmf exo; do
+  /usr/bin/python3 -c "
+import meshio, sys
+m = meshio.read(sys.argv[1])
+meshio.write(sys.argv[2], meshio.Mesh(m.points, m.cells, point_data=m.point_data))" "$WORK/shuffled.vtu" "$WORK/shuffled.$ext"
+done
 points=$("$TETSTREAM" info "$WORK/harmonic.vtu" --json | tr -d ' \n' | grep -o '"vertices":[0-9]*' | head -1 | cut -d: -f2)
-for np in 2 3; do
-  grep -o 'the [0-9]* points read for them' "$WORK/shuffled-np$np.json" | while read -r _ read _; do
-    [ "$read" -lt $((points * 2 / np)) ] || { echo "FAIL: a rank of $np read $read of the $points points"; exit 1; }
+for case in "vtu:points read for them" "xdmf:points they use" "exo:nodes they use"; do
+  ext=${case%%:*} note=${case#*:}
+  sharesLikeOneProcess "shuffled-$ext" "$WORK/shuffled.$ext" "$note" "2 3" "0 0.25" --leaf-vertices 256 --chunk-kb 8
+  for np in 2 3; do
+    grep -o "the [0-9]* $note" "$WORK/shuffled-$ext-np$np.json" | while read -r _ read _; do
+      [ "$read" -lt $((points * 2 / np)) ] || { echo "FAIL: a rank of $np read $read of the $points points"; exit 1; }
+    done
   done
 done
 

@@ -455,10 +455,44 @@ uint64_t tetsOfShares(const std::string& path, uint32_t count, bool nonEmpty) {
     ReadReport r;
     EXPECT_TRUE(readMesh(path, part, r, shareOf(k, count))) << path << " share " << k;
     EXPECT_TRUE(r.shared) << path << " share " << k;
-    if (nonEmpty) EXPECT_GT(part.tetCount(), 0u) << path << " share " << k;
+    if (nonEmpty) {
+      EXPECT_GT(part.tetCount(), 0u) << path << " share " << k;
+    }
     tets += part.tetCount();
   }
   return tets;
+}
+
+void expectSharesReadOnlyUsedPoints(const std::string& path, uint32_t count, const std::string& noteTail) {
+  for (uint32_t k = 0; k < count; ++k) {
+    SCOPED_TRACE(path + ": share " + std::to_string(k) + " of " + std::to_string(count));
+    TetMesh part;
+    ReadReport r;
+    ASSERT_TRUE(readMesh(path, part, r, shareOf(k, count)));
+    std::vector<uint8_t> used(part.vertexCount(), 0);
+    for (uint32_t v : part.tets) used[v] = 1;
+    EXPECT_EQ(std::count(used.begin(), used.end(), 1), std::ptrdiff_t(part.vertexCount()));
+    const std::string note = "the " + std::to_string(part.vertexCount()) + " " + noteTail;
+    EXPECT_TRUE(std::any_of(r.notes.begin(), r.notes.end(),
+                            [&](const std::string& n) { return n.find(note) != std::string::npos; }))
+        << note << "; the last note: " << (r.notes.empty() ? "" : r.notes.back());
+  }
+}
+
+TetMesh shuffledPoints(const TetMesh& m) {
+  // Point p of the result is m's vertex order[p].
+  std::vector<uint32_t> order(m.vertexCount()), placeOf(m.vertexCount());
+  for (uint32_t v = 0; v < order.size(); ++v) order[v] = v;
+  for (uint32_t v = uint32_t(order.size()); v-- > 1;) std::swap(order[v], order[(v * 2654435761u) % (v + 1)]);
+  TetMesh out = m;
+  for (uint32_t p = 0; p < order.size(); ++p) {
+    placeOf[order[p]] = p;
+    for (int k = 0; k < 3; ++k)
+      out.positions[3 * size_t(p) + size_t(k)] = m.positions[3 * size_t(order[p]) + size_t(k)];
+    for (size_t f = 0; f < m.fields.size(); ++f) out.fields[f].values[p] = m.fields[f].values[order[p]];
+  }
+  for (uint32_t& v : out.tets) v = placeOf[v];
+  return out;
 }
 
 void expectSharesMakeTheWhole(const std::string& path, uint32_t count, const std::string& skipField) {

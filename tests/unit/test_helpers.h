@@ -172,6 +172,14 @@ ReadOptions shareOf(uint32_t index, uint32_t count);
 // (ReadReport::shared), and with `nonEmpty` holds a tet at least. Returns their tets in all.
 uint64_t tetsOfShares(const std::string& path, uint32_t count, bool nonEmpty);
 
+// Reads the file at `path` in `count` shares: each holds only points its tets use (read no
+// others: io/row_pick.h), and its reader says how many it read ("the N " + noteTail).
+void expectSharesReadOnlyUsedPoints(const std::string& path, uint32_t count, const std::string& noteTail);
+
+// `m` with its points in a shuffled order (the same every time), as a solver that numbers points
+// and cells each its own way writes them: a run of the tets uses points from all over.
+TetMesh shuffledPoints(const TetMesh& m);
+
 // Reads the file at `path` in `count` shares (ReadOptions::shareIndex, as the processes of a
 // distributed pack do): each is a share (ReadReport::shared) with fewer points than the whole,
 // each point's values are the whole's at that position, and together the shares hold every tet

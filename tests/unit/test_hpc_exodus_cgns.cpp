@@ -559,6 +559,49 @@ TEST(ExodusShares, TheSharesOfAFileHoldEveryTetOnceWithItsValues) {
   for (uint32_t count : {2u, 3u, 5u}) {
     test::expectSharesMakeTheWhole(hpcPath("exo_blocks.exo"), count, "pressure");
     test::expectSharesMakeTheWhole(hpcPath("exo_meshio.exo"), count);
+    test::expectSharesReadOnlyUsedPoints(hpcPath("exo_blocks.exo"), count, "nodes they use");
+  }
+}
+
+// Writes `mesh` through the Exodus library: one block of TETRA elements, the fields as nodal
+// variables at one time step, the points in the mesh's order.
+void writeExodusTets(const TetMesh& mesh, const std::string& path) {
+  int cpu = 8, io = 8;
+  const int id = ex_create(path.c_str(), EX_CLOBBER, &cpu, &io);
+  ASSERT_GE(id, 0);
+  const int V = int(mesh.vertexCount()), T = int(mesh.tetCount()), F = int(mesh.fields.size());
+  ASSERT_EQ(ex_put_init(id, "tets", 3, V, T, 1, 0, 0), 0);
+  std::vector<double> axis[3];
+  for (int k = 0; k < 3; ++k)
+    for (int v = 0; v < V; ++v) axis[k].push_back(mesh.positions[3 * size_t(v) + size_t(k)]);
+  ASSERT_EQ(ex_put_coord(id, axis[0].data(), axis[1].data(), axis[2].data()), 0);
+  ASSERT_EQ(ex_put_block(id, EX_ELEM_BLOCK, 1, "TETRA", T, 4, 0, 0, 0), 0);
+  std::vector<int> conn(mesh.tets.begin(), mesh.tets.end());
+  for (int& v : conn) ++v;
+  ASSERT_EQ(ex_put_conn(id, EX_ELEM_BLOCK, 1, conn.data(), nullptr, nullptr), 0);
+  std::vector<std::string> names;
+  std::vector<char*> pointers;
+  for (const ScalarField& f : mesh.fields) names.push_back(f.name);
+  for (std::string& n : names) pointers.push_back(n.data());
+  ASSERT_EQ(ex_put_variable_param(id, EX_NODAL, F), 0);
+  ASSERT_EQ(ex_put_variable_names(id, EX_NODAL, F, pointers.data()), 0);
+  const double time = 0;
+  ASSERT_EQ(ex_put_time(id, 1, &time), 0);
+  for (int f = 0; f < F; ++f) {
+    const std::vector<double> values(mesh.fields[size_t(f)].values.begin(), mesh.fields[size_t(f)].values.end());
+    ASSERT_EQ(ex_put_var(id, 1, EX_NODAL, f + 1, 1, V, values.data()), 0);
+  }
+  ASSERT_EQ(ex_close(id), 0);
+}
+
+// Nodes numbered far from the elements' order: a share of the elements reads only the nodes they
+// use (io/row_pick.h), a window of rows at a time, coordinates and nodal variables alike.
+TEST(ExodusShares, SharesOfShuffledNodesReadOnlyTheNodesTheirElementsUse) {
+  const std::string path = test::suiteDir("ExodusShares", "shuffled") + "/shuffled.exo";
+  writeExodusTets(test::shuffledPoints(test::harmonicMesh(10)), path);
+  for (uint32_t count : {2u, 3u}) {
+    test::expectSharesMakeTheWhole(path, count);
+    test::expectSharesReadOnlyUsedPoints(path, count, "nodes they use");
   }
 }
 

@@ -163,13 +163,15 @@ TEST(XdmfReader, FormatAndNotesSayWhatWasRead) {
 }
 
 // ------------------------------------------------------------------ time steps
-// One grid read by several processes (core/dist): each reads its rows of the cells and the
-// points they span. Together the shares hold every tet of the whole once, on the same points
-// with the same point values, from HDF5 (hyperslabs), from raw binary files and through a time
-// series whose steps include their mesh.
+// One grid read by several processes (core/dist): each reads its rows of the cells and of the
+// points they use (io/row_pick.h). Together the shares hold every tet of the whole once, on the
+// same points with the same point values, from HDF5 (hyperslabs), from raw binary files and
+// through a time series whose steps include their mesh.
 TEST(XdmfShares, TheSharesOfAGridHoldEveryTetOnceWithItsValues) {
-  for (const char* name : {"xdmf_grid.xdmf", "xdmf_binary.xdmf", "xdmf_series.xdmf"})
+  for (const char* name : {"xdmf_grid.xdmf", "xdmf_binary.xdmf", "xdmf_series.xdmf"}) {
     test::expectSharesMakeTheWhole(hpcPath(name), 3, "c");
+    test::expectSharesReadOnlyUsedPoints(hpcPath(name), 3, "points they use");
+  }
 }
 
 // A spatial collection of grids (one per rank of the run that wrote it): on as many processes as

@@ -233,38 +233,13 @@ TEST(PartitionedReaders, SharesOfTheCellsOfAVtuMakeTheWhole) {
 // reads only the points its cells use, a window of rows at a time, instead of every point their
 // ids span; the shares still make the whole.
 TEST(PartitionedReaders, SharesReadOnlyThePointsTheirCellsUse) {
-  TetMesh m = test::harmonicMesh(12);
-  // Points in a shuffled order: point p of the file is m's vertex order[p].
-  std::vector<uint32_t> order(m.vertexCount()), placeOf(m.vertexCount());
-  for (uint32_t v = 0; v < order.size(); ++v) order[v] = v;
-  for (uint32_t v = uint32_t(order.size()); v-- > 1;) std::swap(order[v], order[(v * 2654435761u) % (v + 1)]);
-  TetMesh shuffled = m;
-  for (uint32_t p = 0; p < order.size(); ++p) {
-    placeOf[order[p]] = p;
-    for (int k = 0; k < 3; ++k) shuffled.positions[3 * p + k] = m.positions[3 * size_t(order[p]) + k];
-    for (size_t f = 0; f < m.fields.size(); ++f) shuffled.fields[f].values[p] = m.fields[f].values[order[p]];
-  }
-  for (uint32_t& v : shuffled.tets) v = placeOf[v];
+  const TetMesh shuffled = test::shuffledPoints(test::harmonicMesh(12));
   const std::string path = test::suiteDir("PartitionedReaders", "shuffled") + "/shuffled.vtu";
   ASSERT_TRUE(writeVtu(path, shuffled));
 
   for (uint32_t count : {2u, 3u}) {
     test::expectSharesMakeTheWhole(path, count, "");
-    for (uint32_t k = 0; k < count; ++k) {
-      TetMesh part;
-      ReadReport r;
-      ASSERT_TRUE(readMesh(path, part, r, test::shareOf(k, count)));
-      // Every point read is one its cells use, and the report says how many were read.
-      std::vector<uint8_t> used(part.vertexCount(), 0);
-      for (uint32_t v : part.tets) used[v] = 1;
-      EXPECT_EQ(std::count(used.begin(), used.end(), 1), std::ptrdiff_t(part.vertexCount())) << k << " of " << count;
-      EXPECT_LT(part.vertexCount(), m.vertexCount() / 2 + m.vertexCount() / count);
-      const std::string note = "the " + std::to_string(part.vertexCount()) + " points read for them";
-      EXPECT_TRUE(std::any_of(r.notes.begin(), r.notes.end(),
-                              [&](const std::string& n) { return n.find(note) != std::string::npos; }))
-          << note << "\n"
-          << r.notes.back();
-    }
+    test::expectSharesReadOnlyUsedPoints(path, count, "points read for them");
   }
 }
 
