@@ -38,8 +38,10 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <optional>
 
 #include "io/readers.h"
+#include "io/row_pick.h"
 
 namespace tetstream {
 namespace {
@@ -123,6 +125,17 @@ struct Zone {
   // vertices from vertexFirst (0-based), elements numbered from cellFirst + 1.
   uint64_t vertexFirst = 0, vertexCount = 0, cellFirst = 0, cellCount = 0;
   bool window = false;  // a share's window: only its elements are read (else every section whole)
+  // Of the window's run of vertices, the ones its elements' corners use, when not all
+  // (io/row_pick.h): only those are read (`pick`, ascending, 0-based).
+  std::optional<io::UsedRows> used;
+  std::vector<uint64_t> pick;
+  uint64_t verticesRead() const { return used ? pick.size() : vertexCount; }
+  // Where vertex v (1-based) is among those read; -1 when it is not read.
+  int64_t vertexRead(int64_t v) const {
+    if (uint64_t(v) <= vertexFirst || uint64_t(v) > vertexFirst + vertexCount) return -1;
+    if (!used) return v - 1 - int64_t(vertexFirst);
+    return used->isUsed(uint64_t(v - 1)) ? int64_t(used->place(uint64_t(v - 1))) : -1;
+  }
   std::map<int, std::vector<cgsize_t>> windowConnectivity;  // per section: its window's elements, read once
   bool stepSolution = false;                                // the time step names one solution (below), or none
   std::string solution;
@@ -328,7 +341,7 @@ class CgnsReader {
     for (Zone& zone : zones_) {
       zone.vertexBase = totalVertices_;
       zone.slotBase = totalSlots_;
-      totalVertices_ += zone.vertexCount;  // (what is read of it: all, a slab or a window)
+      totalVertices_ += zone.verticesRead();  // (what is read of it: all, a slab or a window)
       totalSlots_ += zone.cellCount;
       structured_ += zone.structured;
     }
@@ -371,6 +384,8 @@ class CgnsReader {
       for (Zone& y : zones_) {
         y.window = false;
         y.windowConnectivity.clear();
+        y.used.reset();
+        y.pick.clear();
         y.vertexFirst = y.cellFirst = 0;
         y.vertexCount = y.vertices;
         y.cellCount = y.cells;
@@ -385,16 +400,17 @@ class CgnsReader {
     report_.notes.push_back(
         zones_.size() == 1
             ? "read elements " + std::to_string(z.cellFirst + 1) + " to " + std::to_string(z.cellFirst + z.cellCount) +
-                  " of " + std::to_string(z.cells) + " and the " + std::to_string(z.vertexCount) +
-                  " vertices they span, this process's share of the file"
+                  " of " + std::to_string(z.cells) + " and the " + std::to_string(z.verticesRead()) +
+                  " vertices they use, this process's share of the file"
             : "read " + std::to_string(totalSlots_) + " of the " + std::to_string(cells) +
                   " elements (a share of each of the " + zonesText(zones_.size(), "unstructured") + ") and the " +
-                  std::to_string(totalVertices_) + " vertices they span, this process's share of the file");
+                  std::to_string(totalVertices_) + " vertices they use, this process's share of the file");
     return Result::success();
   }
 
-  // The window of one unstructured zone: the share's elements and the vertices they span. The
-  // share's connectivity is read here to find them and kept for readSections. A MIXED section,
+  // The window of one unstructured zone: the share's elements and the vertices their corners use
+  // (the run they span, or only those: Zone::pick). The share's connectivity is read here to find
+  // them and kept for readSections. A MIXED section,
   // whose elements have no fixed size, leaves the zone whole (z.window stays false).
   Result windowOfZone(Zone& z) {
     const uint64_t from = z.cells * options_.shareIndex / options_.shareCount,
@@ -403,6 +419,7 @@ class CgnsReader {
     if (cg_nsections(file_.fn, base_, z.index, &nsections) != CG_OK)
       return fail(Status::Corrupt, zoneLabel(z) + ": cannot read its element sections: " + lastCgnsError());
     uint64_t lo = UINT64_MAX, hi = 0;
+    std::map<int, int> corners, nodesPer;  // per section read
     for (int s = 1; s <= nsections; ++s) {
       Section sec;
       if (Result r = readSection(z, s, sec); !r) return r;
@@ -418,12 +435,26 @@ class CgnsReader {
       conn.resize(size_t(last - first + 1) * size_t(npe));
       if (cg_elements_partial_read(file_.fn, base_, z.index, s, first, last, conn.data(), nullptr) != CG_OK)
         return fail(Status::Corrupt, sec.where + ": " + lastCgnsError());
+      corners[s] = std::min(npe, kShapeCorners[int(cgnsType(sec.type).shape)]);
+      nodesPer[s] = npe;
       for (cgsize_t v : conn)
         if (v >= 1 && uint64_t(v) <= z.vertices) lo = std::min(lo, uint64_t(v - 1)), hi = std::max(hi, uint64_t(v));
     }
     if (hi == 0) lo = 0;
     z.vertexFirst = lo;
     z.vertexCount = hi - lo;
+    // The vertices the elements' corners use (higher-order nodes are dropped: not read).
+    z.used.emplace(lo, hi - lo);
+    for (const auto& [s, conn] : z.windowConnectivity)
+      for (size_t e = 0; e + size_t(nodesPer[s]) <= conn.size(); e += size_t(nodesPer[s]))
+        for (int q = 0; q < corners[s]; ++q)
+          if (conn[e + size_t(q)] >= 1 && uint64_t(conn[e + size_t(q)]) <= z.vertices)
+            z.used->mark(uint64_t(conn[e + size_t(q)] - 1));
+    z.used->finish();
+    if (z.used->all())
+      z.used.reset();
+    else
+      z.pick = z.used->rows();
     z.cellFirst = from;
     z.cellCount = to - from;
     z.window = true;
@@ -555,14 +586,25 @@ class CgnsReader {
       lo[0] = cgsize_t(z.vertexFirst + 1);
       hi[0] = cgsize_t(z.vertexFirst + z.vertexCount);
     }
-    values.resize(size_t(z.vertexCount));
-    if (cg_coord_read(file_.fn, base_, z.index, name, CGNS_ENUMV(RealDouble), lo, hi, values.data()) != CG_OK)
-      return fail(Status::Corrupt, zoneLabel(z) + ": " + name + ": " + lastCgnsError());
-    return Result::success();
+    auto read = [&](std::vector<double>& out) {
+      out.resize(size_t(hi[0] - lo[0] + 1) * size_t(hi[1] - lo[1] + 1) * size_t(hi[2] - lo[2] + 1));
+      if (cg_coord_read(file_.fn, base_, z.index, name, CGNS_ENUMV(RealDouble), lo, hi, out.data()) != CG_OK)
+        return fail(Status::Corrupt, zoneLabel(z) + ": " + name + ": " + lastCgnsError());
+      return Result::success();
+    };
+    if (z.pick.empty()) return read(values);
+    return io::readPickedRows(
+        z.pick, z.vertices, true, zoneLabel(z) + ": " + name,
+        [&](uint64_t from, uint64_t n, std::vector<double>& window) {
+          lo[0] = cgsize_t(from + 1);
+          hi[0] = cgsize_t(from + n);
+          return read(window);
+        },
+        values);
   }
 
   Result readCoordinates(const Zone& z, TetMesh& mesh) {
-    if (z.vertexCount == 0) return Result::success();
+    if (z.verticesRead() == 0) return Result::success();
     int ncoords = 0;
     if (cg_ncoords(file_.fn, base_, z.index, &ncoords) != CG_OK)
       return fail(Status::Corrupt, zoneLabel(z) + ": GridCoordinates: " + lastCgnsError());
@@ -592,11 +634,12 @@ class CgnsReader {
       cylindricalNoted_ = true;
       report_.notes.push_back("converted cylindrical coordinates (R, Theta, Z) to Cartesian");
     }
-    for (uint64_t v = 0; v < z.vertexCount; ++v) {
+    for (uint64_t v = 0; v < z.verticesRead(); ++v) {
       double x = a[v], y = b[v];
       if (cyl) x = a[v] * std::cos(b[v]), y = a[v] * std::sin(b[v]);
       if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(c[v]))
-        return fail(Status::NonFinite, zoneLabel(z) + ": vertex " + std::to_string(z.vertexFirst + v + 1) +
+        return fail(Status::NonFinite, zoneLabel(z) + ": vertex " +
+                                           std::to_string((z.pick.empty() ? z.vertexFirst + v : z.pick[v]) + 1) +
                                            " has a non-finite coordinate");
       float* p = &mesh.positions[3 * (z.vertexBase + v)];
       p[0] = float(x), p[1] = float(y), p[2] = float(c[v]);
@@ -613,13 +656,10 @@ class CgnsReader {
   // One element of an unstructured zone: e is its element number (1-based within the zone).
   Result addElement(const Zone& z, const std::string& where, const std::string& type, const CgnsType& kind,
                     const cgsize_t* nodes, int count, int64_t e, CellSoup& soup) {
-    auto inWindow = [&](cgsize_t v) {
-      return uint64_t(v) > z.vertexFirst && uint64_t(v) <= z.vertexFirst + z.vertexCount;
-    };
     if (!kind.volume) {
       ++soup.skipped[{kind.vtkType, "CGNS " + type}];
       for (int q = 0; q < count; ++q)
-        if (inWindow(nodes[q])) soup.referenced[z.vertexBase + uint64_t(nodes[q] - 1) - z.vertexFirst] = 1;
+        if (const int64_t at = z.vertexRead(nodes[q]); at >= 0) soup.referenced[z.vertexBase + uint64_t(at)] = 1;
       return Result::success();
     }
     const int corners = kShapeCorners[int(kind.shape)];
@@ -633,11 +673,13 @@ class CgnsReader {
         return fail(Status::OutOfRange, where + ": element " + std::to_string(e) + " (" + type + ") uses vertex " +
                                             std::to_string(v) + ", but the zone's vertices are numbered 1.." +
                                             std::to_string(z.vertices));
-      if (!inWindow(v))  // (a share's window covers its elements' vertices: not reached)
+      const int64_t at = z.vertexRead(v);
+      if (at < 0 && (q < corners || !z.used))  // (a share reads its elements' corners: not reached)
         return fail(Status::OutOfRange, where + ": element " + std::to_string(e) + " uses vertex " + std::to_string(v) +
                                             " outside the vertices read");
-      soup.referenced[z.vertexBase + uint64_t(v - 1) - z.vertexFirst] = 1;
-      if (q < corners) ids[q] = uint32_t(z.vertexBase + uint64_t(v - 1) - z.vertexFirst);
+      if (at < 0) continue;  // (a higher-order node a share does not read)
+      soup.referenced[z.vertexBase + uint64_t(at)] = 1;
+      if (q < corners) ids[q] = uint32_t(z.vertexBase + uint64_t(at));
     }
     const uint64_t source = uint64_t(e) > z.cellFirst && uint64_t(e) <= z.cellFirst + z.cellCount
                                 ? z.slotBase + uint64_t(e - 1) - z.cellFirst
@@ -833,7 +875,7 @@ class CgnsReader {
     int nfields = 0;
     if (cg_nfields(file_.fn, base_, z.index, s, &nfields) != CG_OK)
       return fail(Status::Corrupt, where + ": " + lastCgnsError());
-    const uint64_t n = vertex ? z.vertexCount : z.cellCount;
+    const uint64_t n = vertex ? z.verticesRead() : z.cellCount;
     cgsize_t lo[3] = {1, 1, 1}, hi[3] = {1, 1, 1};
     if (z.structured) {
       for (int d = 0; d < 3; ++d) hi[d] = cgsize_t(vertex ? z.dims[d] : z.dims[d] - 1);
@@ -841,8 +883,12 @@ class CgnsReader {
       hi[z.slabAxis] += cgsize_t(z.slabFirst);
     } else {
       lo[0] = cgsize_t((vertex ? z.vertexFirst : z.cellFirst) + 1);
-      hi[0] = cgsize_t((vertex ? z.vertexFirst : z.cellFirst) + n);
+      hi[0] = cgsize_t((vertex ? z.vertexFirst : z.cellFirst) + (vertex ? z.vertexCount : n));
     }
+    auto read = [&](const char* fname, std::vector<double>& out) {
+      out.resize(size_t(hi[0] - lo[0] + 1) * size_t(hi[1] - lo[1] + 1) * size_t(hi[2] - lo[2] + 1));
+      return cg_field_read(file_.fn, base_, z.index, s, fname, CGNS_ENUMV(RealDouble), lo, hi, out.data()) == CG_OK;
+    };
     std::vector<double> values(static_cast<size_t>(n));
     for (int f = 1; f <= nfields; ++f) {
       char fname[64] = {};
@@ -855,9 +901,22 @@ class CgnsReader {
         report_.notes.push_back("skipped " + where + " field '" + field + "': an earlier solution of the zone has it");
         continue;
       }
-      if (n &&
-          cg_field_read(file_.fn, base_, z.index, s, fname, CGNS_ENUMV(RealDouble), lo, hi, values.data()) != CG_OK)
-        return fail(Status::Corrupt, where + " field '" + field + "': " + lastCgnsError());
+      const std::string what = where + " field '" + field + "'";
+      if (n && vertex && !z.pick.empty()) {
+        const cgsize_t runLo = lo[0], runHi = hi[0];
+        Result r = io::readPickedRows(
+            z.pick, z.vertices, true, what,
+            [&](uint64_t from, uint64_t count, std::vector<double>& window) {
+              lo[0] = cgsize_t(from + 1);
+              hi[0] = cgsize_t(from + count);
+              return read(fname, window) ? Result::success() : fail(Status::Corrupt, what + ": " + lastCgnsError());
+            },
+            values);
+        lo[0] = runLo, hi[0] = runHi;
+        if (!r) return r;
+      } else if (n && !read(fname, values)) {
+        return fail(Status::Corrupt, what + ": " + lastCgnsError());
+      }
       std::vector<double>& dst = into.get(field, size_t(vertex ? totalVertices_ : totalSlots_));
       std::copy(values.begin(), values.end(), dst.begin() + std::ptrdiff_t(vertex ? z.vertexBase : z.slotBase));
     }

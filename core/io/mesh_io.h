@@ -99,16 +99,17 @@ struct ReadOptions {
   // cells, as below (of a legacy piece the first of them reads it, the others nothing). A VTKHDF
   // file of at least shareCount partitions, or a VTK XML file of at least shareCount <Piece>s:
   // the partitions or pieces likewise. A .vtu of fewer pieces: the cells in those rows of each
-  // piece and the points from the smallest to the largest id they use; a .vti or .vts of fewer
-  // pieces, each at least shareCount cells deep along k: those layers of cells of each piece. An XDMF file of at least
-  // shareCount volume grids (a spatial collection): those grids, each whole. Of fewer grids, each
-  // of one cell type: the cells
-  // in those rows of its topology and the points from the smallest to the largest id they use.
-  // An Exodus II file: the elements in those rows of its blocks (in file order) and the nodes
-  // from the smallest to the largest they use. A CGNS base of at least shareCount zones: those
-  // zones, each whole; of fewer unstructured zones of fixed-type sections: their elements in
-  // those rows and the vertices they span; of fewer structured zones, each deep enough: a slab of
-  // layers of cells of each zone and their points. Other files ignore it (ReadReport::shared says).
+  // piece and their points; a .vti or .vts of fewer pieces, each at least shareCount cells deep
+  // along k: those layers of cells of each piece. An XDMF file of at least shareCount volume grids
+  // (a spatial collection): those grids, each whole. Of fewer grids, each of one cell type: the
+  // cells in those rows of its topology and their points. An Exodus II file: the elements in those
+  // rows of its blocks (in file order) and their nodes. A CGNS base of at least shareCount zones:
+  // those zones, each whole; of fewer unstructured zones of fixed-type sections: their elements
+  // in those rows and their vertices; of fewer structured zones, each deep enough: a slab of
+  // layers of cells of each zone and their points. Points read by rows are the run from the
+  // smallest id the cells use to the largest, or only those they use when the run has others and
+  // the format reads a window of rows alone (io/row_pick.h). Other files ignore it
+  // (ReadReport::shared says).
   uint32_t shareIndex = 0, shareCount = 1;
 };
 

@@ -90,7 +90,7 @@ sharesLikeOneProcess cgns "$HPC/cgns_structured.cgns" "this process's share of t
 # The same two zones on 3 ranks: each rank reads a slab of both.
 sharesLikeOneProcess cgns-slabs "$HPC/cgns_structured.cgns" "this process's share of the file" "3" "1.05 1.35" \
   --base-vertices 8 --leaf-vertices 4
-# A CGNS base of one unstructured zone: each rank reads its elements and the vertices they span.
+# A CGNS base of one unstructured zone: each rank reads its elements and the vertices they use.
 sharesLikeOneProcess cgns-zone "$HPC/cgns_steps.cgns" "this process's share of the file" "2" "12 14" \
   --base-vertices 8 --leaf-vertices 4
 

@@ -606,9 +606,10 @@ TEST(ExodusShares, SharesOfShuffledNodesReadOnlyTheNodesTheirElementsUse) {
 }
 
 // Writes `mesh` through the CGNS library as a base of `zones` unstructured zones of TETRA_4
-// elements, each a run of the tets with its own copy of the vertices they use, and the fields as
-// Vertex solutions: the layout of a solver that writes one zone per rank.
-void writeCgnsZones(const TetMesh& mesh, int zones, const std::string& path) {
+// elements, each a run of the tets with its own copy of the vertices they use (in the order the
+// tets first use them, or with `meshOrder` in the mesh's), and the fields as Vertex solutions: the
+// layout of a solver that writes one zone per rank.
+void writeCgnsZones(const TetMesh& mesh, int zones, const std::string& path, bool meshOrder = false) {
   int fn = -1, base = 0;
   ASSERT_EQ(cg_open(path.c_str(), CG_MODE_WRITE, &fn), CG_OK) << cg_get_error();
   ASSERT_EQ(cg_base_write(fn, "Base", 3, 3, &base), CG_OK);
@@ -617,6 +618,11 @@ void writeCgnsZones(const TetMesh& mesh, int zones, const std::string& path) {
     const uint32_t from = uint32_t(uint64_t(T) * uint32_t(z) / uint32_t(zones)),
                    to = uint32_t(uint64_t(T) * uint32_t(z + 1) / uint32_t(zones));
     std::map<uint32_t, cgsize_t> local;  // mesh vertex -> 1-based zone vertex
+    if (meshOrder)
+      for (uint32_t t = from; t < to; ++t)
+        for (int k = 0; k < 4; ++k) local.emplace(mesh.tets[4 * size_t(t) + size_t(k)], 0);
+    cgsize_t next = 0;
+    for (auto& [v, id] : local) id = ++next;
     std::vector<cgsize_t> conn;
     for (uint32_t t = from; t < to; ++t)
       for (int k = 0; k < 4; ++k) {
@@ -651,7 +657,7 @@ void writeCgnsZones(const TetMesh& mesh, int zones, const std::string& path) {
 }
 
 // A CGNS base of fewer unstructured zones than processes (one zone per rank of a smaller run):
-// each process reads its window of every zone, the elements and the vertices they span.
+// each process reads its window of every zone, the elements and the vertices they use.
 TEST(CgnsShares, FewerUnstructuredZonesThanProcessesAreReadInWindows) {
   ScratchDir dir("cgns-zones");
   const std::string path = dir.path + "/zones.cgns";
@@ -663,8 +669,20 @@ TEST(CgnsShares, FewerUnstructuredZonesThanProcessesAreReadInWindows) {
   EXPECT_TRUE(hasNote(r, "(a share of each of the 3 unstructured zones) and the")) << allNotes(r);
 }
 
+// Vertices numbered far from the elements' order: a share of a zone's elements reads only the
+// vertices they use (io/row_pick.h), coordinates and solutions alike.
+TEST(CgnsShares, SharesOfShuffledVerticesReadOnlyTheVerticesTheirElementsUse) {
+  ScratchDir dir("cgns-shuffled");
+  const std::string path = dir.path + "/shuffled.cgns";
+  writeCgnsZones(test::shuffledPoints(test::harmonicMesh(8)), 1, path, /*meshOrder=*/true);
+  for (uint32_t count : {2u, 3u}) {
+    test::expectSharesMakeTheWhole(path, count);
+    test::expectSharesReadOnlyUsedPoints(path, count, "vertices they use");
+  }
+}
+
 // A CGNS base of as many zones as processes or more: each reads its zones whole. A base of one
-// unstructured zone: each reads its elements and the vertices they span, with its rows of the
+// unstructured zone: each reads its elements and the vertices they use, with its rows of the
 // solutions (a time series here: the step's solution). Fewer structured zones than processes:
 // each reads its slab of k-layers of every zone, with those layers of the solutions.
 TEST(CgnsShares, EachProcessReadsItsZonesOrItsElements) {
