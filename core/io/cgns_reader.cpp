@@ -23,8 +23,9 @@
 // base with at least as many zones as processes, the zones from index·Z/count to
 // (index + 1)·Z/count, each whole (zones meet where their points coincide, which core/dist joins
 // as one process does). A base of one unstructured zone of fixed-type sections: the elements
-// numbered from index·N/count + 1 to (index + 1)·N/count and the vertices from the smallest to
-// the largest they use, with those rows of the solutions (the library's partial reads); of
+// numbered from index·N/count + 1 to (index + 1)·N/count and the vertices their corners use (the
+// run from the smallest to the largest, or only those: io/row_pick.h), with those rows of the
+// solutions (the library's partial reads); of
 // several (fewer than processes), the same of each, unless one has a MIXED section. A base
 // of fewer structured zones than processes, each at least `count` cells deep along its longest
 // index direction: of every zone the cells of layers index·L/count to (index + 1)·L/count along it
