@@ -826,7 +826,13 @@ Result readPieceShare(Vtu& vtu, pugi::xml_node piece, const std::string& label, 
       return r;
     // Offsets relative to the run read, with the first cell's start in front.
     if (before) ends.erase(ends.begin());
-    for (int64_t& e : ends) e -= start;
+    for (int64_t& e : ends) {
+      if (e < start || e > stop)
+        return fail(Status::Corrupt, where + ": DataArray 'offsets': a cell ends at " + std::to_string(e) +
+                                         ", outside the connectivity " + std::to_string(start) + ".." +
+                                         std::to_string(stop) + " of the cells read");
+      e -= start;
+    }
     ends.insert(ends.begin(), 0);
   } else {
     ends = {0};

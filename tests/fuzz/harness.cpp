@@ -306,13 +306,22 @@ void meshFile(const char* extension, const uint8_t* data, size_t size) {
   ReadReport report;
   const std::string_view bytes(reinterpret_cast<const char*>(data), size);
   if (readMeshBytes(bytes, std::string("fuzz") + extension, m, report)) checkReaderPromise(m);
-  if (std::string_view(extension) == ".xdmf") {  // one process's share of two as well: read by rows
+  // One process's share of two and of three as well: read by rows, only the points the cells
+  // use (io/row_pick.h).
+  if (std::string_view(extension) == ".xdmf") {
     ReadOptions share;
     share.shareIndex = 1;
     share.shareCount = 2;
     TetMesh half;
     ReadReport halfReport;
     if (readXdmf(bytes, "fuzz.xdmf", std::nullopt, share, half, halfReport)) checkReaderPromise(half);
+  }
+  if (std::string_view(extension) == ".vtu") {
+    for (uint32_t count : {2u, 3u}) {
+      TetMesh part;
+      ReadReport partReport;
+      if (readVtu(bytes, "fuzz.vtu", part, partReport, 1, count)) checkReaderPromise(part);
+    }
   }
 }
 
