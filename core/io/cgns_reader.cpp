@@ -126,16 +126,15 @@ struct Zone {
   // vertices from vertexFirst (0-based), elements numbered from cellFirst + 1.
   uint64_t vertexFirst = 0, vertexCount = 0, cellFirst = 0, cellCount = 0;
   bool window = false;  // a share's window: only its elements are read (else every section whole)
-  // Of the window's run of vertices, the ones its elements' corners use, when not all
-  // (io/row_pick.h): only those are read (`pick`, ascending, 0-based).
+  // Of the window's run of vertices, the ones its elements' corners use (io/row_pick.h); when
+  // not all are, only those are read (`pick`, ascending, 0-based).
   std::optional<io::UsedRows> used;
   std::vector<uint64_t> pick;
-  uint64_t verticesRead() const { return used ? pick.size() : vertexCount; }
+  uint64_t verticesRead() const { return used ? used->used() : vertexCount; }
   // Where vertex v (1-based) is among those read; -1 when it is not read.
   int64_t vertexRead(int64_t v) const {
-    if (uint64_t(v) <= vertexFirst || uint64_t(v) > vertexFirst + vertexCount) return -1;
-    if (!used) return v - 1 - int64_t(vertexFirst);
-    return used->isUsed(uint64_t(v - 1)) ? int64_t(used->place(uint64_t(v - 1))) : -1;
+    if (used) return used->placeOf(uint64_t(v - 1));
+    return uint64_t(v) > vertexFirst && uint64_t(v) <= vertexFirst + vertexCount ? v - 1 - int64_t(vertexFirst) : -1;
   }
   std::map<int, std::vector<cgsize_t>> windowConnectivity;  // per section: its window's elements, read once
   bool stepSolution = false;                                // the time step names one solution (below), or none
@@ -452,10 +451,7 @@ class CgnsReader {
           if (conn[e + size_t(q)] >= 1 && uint64_t(conn[e + size_t(q)]) <= z.vertices)
             z.used->mark(uint64_t(conn[e + size_t(q)] - 1));
     z.used->finish();
-    if (z.used->all())
-      z.used.reset();
-    else
-      z.pick = z.used->rows();
+    if (!z.used->all()) z.pick = z.used->rows();
     z.cellFirst = from;
     z.cellCount = to - from;
     z.window = true;

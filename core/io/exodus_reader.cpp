@@ -245,10 +245,7 @@ class ExodusReader {
     used_ = std::make_unique<io::UsedRows>(uint64_t(lo), uint64_t(nodeCount_));
     eachCorner([&](int64_t v) { used_->mark(uint64_t(v - 1)); });
     used_->finish();
-    if (used_->all())
-      used_.reset();
-    else
-      nodePick_ = used_->rows();
+    if (!used_->all()) nodePick_ = used_->rows();
     report_.shared = true;
     report_.notes.push_back("read elements " + std::to_string(shareFrom_) + " to " + std::to_string(shareTo_) + " of " +
                             std::to_string(numElements_) + " (" + std::to_string(cells) + " of volume) and the " +
@@ -257,18 +254,17 @@ class ExodusReader {
   }
 
   // The nodes read, and where node v (1-based) is among them (nodeRead: -1 when not read).
-  size_t nodesRead() const { return used_ ? nodePick_.size() : size_t(nodeCount_); }
+  size_t nodesRead() const { return used_ ? size_t(used_->used()) : size_t(nodeCount_); }
   int64_t nodeRead(int64_t v) const {
-    if (v <= nodeFirst_ || v > nodeFirst_ + nodeCount_) return -1;
-    if (!used_) return v - 1 - nodeFirst_;
-    return used_->isUsed(uint64_t(v - 1)) ? int64_t(used_->place(uint64_t(v - 1))) : -1;
+    if (used_) return used_->placeOf(uint64_t(v - 1));
+    return v >= 1 && v <= nodeCount_ ? v - 1 : -1;
   }
 
   // Values of the nodes read, one a node, from read(first, count, values) of 0-based runs: the
   // whole run, or of it the picked nodes a window at a time.
   template <class Read>
   Result readNodeRows(const std::string& what, Read&& read, std::vector<double>& out) {
-    if (!used_) {
+    if (nodePick_.empty()) {
       out.resize(size_t(nodeCount_));
       return nodeCount_ ? read(nodeFirst_, nodeCount_, out) : Result::success();
     }
@@ -304,7 +300,7 @@ class ExodusReader {
       if (!std::isfinite(x[v]) || !std::isfinite(y[v]) || !std::isfinite(z[v])) {
         char buf[128];
         std::snprintf(buf, sizeof buf, "(%g, %g, %g)", x[v], y[v], z[v]);
-        const int64_t node = used_ ? int64_t(nodePick_[v]) : nodeFirst_ + int64_t(v);
+        const int64_t node = nodePick_.empty() ? nodeFirst_ + int64_t(v) : int64_t(nodePick_[v]);
         return fail(Status::NonFinite, path_ + ": " + nodeName(node + 1) + " has a non-finite coordinate " + buf);
       }
       mesh.positions[3 * v] = float(x[v]);
@@ -604,8 +600,8 @@ class ExodusReader {
   bool share_ = false;                     // reading one process's share (the header comment)
   uint64_t shareFrom_ = 0, shareTo_ = 0;   // the elements read, in file order over all blocks
   int64_t nodeFirst_ = 0, nodeCount_ = 0;  // the run of nodes a share's cells use (0-based first)
-  std::unique_ptr<io::UsedRows> used_;     // of that run the nodes used, when not all are
-  std::vector<uint64_t> nodePick_;         // those nodes (0-based), ascending: the nodes read
+  std::unique_ptr<io::UsedRows> used_;     // (a share) of that run the nodes used
+  std::vector<uint64_t> nodePick_;         // those nodes (0-based), ascending, when not all are: the nodes read
   std::vector<Block> blocks_;
   std::vector<double> times_;
   bool nodeMapRead_ = false, elemMapRead_ = false, directNoted_ = false;

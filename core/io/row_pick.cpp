@@ -18,6 +18,7 @@ void UsedRows::finish() {
 
 uint64_t UsedRows::place(uint64_t id) const {
   const uint64_t k = id - first_;
+  if (all()) return k;
   return before_[k / 64] + uint64_t(std::popcount(bits_[k / 64] & ((uint64_t(1) << (k % 64)) - 1)));
 }
 

@@ -34,6 +34,10 @@ class UsedRows {
   bool isUsed(uint64_t id) const { return bits_[(id - first_) / 64] >> ((id - first_) % 64) & 1; }
   // The place of used row `id` among the used rows (after finish()).
   uint64_t place(uint64_t id) const;
+  // Where row `id` is among the used rows; -1 when it lies outside the run or is not used.
+  int64_t placeOf(uint64_t id) const {
+    return id >= first_ && id - first_ < count_ && isUsed(id) ? int64_t(place(id)) : -1;
+  }
   // The used rows, ascending.
   std::vector<uint64_t> rows() const;
 

@@ -780,10 +780,10 @@ void pickUsedPoints(const Vtu& vtu, pugi::xml_node piece, std::vector<int64_t>& 
 }
 
 // Reads share `index` of `count` of an unstructured piece: its cells from index·nc/count up to
-// (index + 1)·nc/count and the points from the smallest to the largest id they use (or only
-// those they use: pickUsedPoints), with those rows of every array. The other rows are passed over (raw appended data is
-// not even read from the mapped file, compressed blocks not inflated); the points on the cuts are read by both sides
-// and joined by the distributed pack like the points pieces share.
+// (index + 1)·nc/count and their points (pickUsedPoints), with those rows of every array. The
+// other rows are passed over (raw appended data is not even read from the mapped file,
+// compressed blocks not inflated); the points on the cuts are read by both sides and joined by
+// the distributed pack like the points pieces share.
 Result readPieceShare(Vtu& vtu, pugi::xml_node piece, const std::string& label, uint32_t index, uint32_t count,
                       MeshPiece& out, ReadReport& report, bool notePieceConversions, uint64_t& cellsTotal) {
   uint64_t np = 0, nc = 0;
