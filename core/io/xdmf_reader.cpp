@@ -34,87 +34,20 @@
 #include "io/row_pick.h"
 #include "io/xdmf_document.h"
 #include "io/xdmf_function.h"
+#include "io/xdmf_mixed.h"
+#include "io/xdmf_topology.h"
 
 namespace tetstream {
 namespace {
 
 using namespace vtkio;
 using xdmf::Document;
+using xdmf::kindByName;
+using xdmf::TopologyKind;
 using xdmf::Values;
 
 constexpr int kMaxGridDepth = 16;
 constexpr size_t kMaxPieces = size_t(1) << 20;
-
-struct TopologyKind {
-  const char* name;  // as XDMF spells it
-  int code;          // in Mixed topologies
-  int64_t vtk;       // the VTK cell type, 0 for none
-  int nodes;         // per cell; 0: given per grid (NodesPerElement) or per cell (Mixed)
-  bool read;         // a volume cell tetstream reads
-};
-
-constexpr TopologyKind kKinds[] = {
-    {"Polyvertex", 0x1, 2, 0, false},
-    {"Polyline", 0x2, 4, 0, false},
-    {"Polygon", 0x3, 7, 0, false},
-    {"Triangle", 0x4, 5, 3, false},
-    {"Quadrilateral", 0x5, 9, 4, false},
-    {"Tetrahedron", 0x6, 10, 4, true},
-    {"Pyramid", 0x7, 14, 5, true},
-    {"Wedge", 0x8, 13, 6, true},
-    {"Hexahedron", 0x9, 12, 8, true},
-    {"Polyhedron", 0x10, 42, 0, false},
-    {"Edge_3", 0x22, 21, 3, false},
-    {"Quadrilateral_9", 0x23, 28, 9, false},
-    {"Triangle_6", 0x24, 22, 6, false},
-    {"Quadrilateral_8", 0x25, 23, 8, false},
-    {"Tetrahedron_10", 0x26, 24, 10, true},
-    {"Pyramid_13", 0x27, 27, 13, true},
-    {"Wedge_15", 0x28, 26, 15, true},
-    {"Wedge_18", 0x29, 32, 18, true},
-    {"Hexahedron_20", 0x30, 25, 20, true},
-    {"Hexahedron_24", 0x31, 33, 24, true},
-    {"Hexahedron_27", 0x32, 29, 27, true},
-    // Higher orders: node orders tetstream does not know, counted and skipped.
-    {"Hexahedron_64", 0x33, 0, 64, false},
-    {"Hexahedron_125", 0x34, 0, 125, false},
-    {"Hexahedron_216", 0x35, 0, 216, false},
-    {"Hexahedron_343", 0x36, 0, 343, false},
-    {"Hexahedron_512", 0x37, 0, 512, false},
-    {"Hexahedron_729", 0x38, 0, 729, false},
-    {"Hexahedron_1000", 0x39, 0, 1000, false},
-    {"Hexahedron_1331", 0x40, 0, 1331, false},
-    {"Hexahedron_Spectral_64", 0x41, 0, 64, false},
-    {"Hexahedron_Spectral_125", 0x42, 0, 125, false},
-    {"Hexahedron_Spectral_216", 0x43, 0, 216, false},
-    {"Hexahedron_Spectral_343", 0x44, 0, 343, false},
-    {"Hexahedron_Spectral_512", 0x45, 0, 512, false},
-    {"Hexahedron_Spectral_729", 0x46, 0, 729, false},
-    {"Hexahedron_Spectral_1000", 0x47, 0, 1000, false},
-    {"Hexahedron_Spectral_1331", 0x48, 0, 1331, false},
-};
-
-// Short spellings some writers use (meshio reads them too).
-constexpr std::pair<const char*, const char*> kAliases[] = {
-    {"Tet_10", "Tetrahedron_10"}, {"Hex_20", "Hexahedron_20"},   {"Hex_24", "Hexahedron_24"},
-    {"Hex_27", "Hexahedron_27"},  {"Quad_8", "Quadrilateral_8"}, {"Quad_9", "Quadrilateral_9"},
-    {"Tri_6", "Triangle_6"},      {"Quad", "Quadrilateral"},     {"Tri", "Triangle"},
-    {"Tet", "Tetrahedron"},       {"Hex", "Hexahedron"},
-};
-
-const TopologyKind* kindByName(std::string_view name) {
-  for (const auto& [alias, full] : kAliases)
-    if (iequals(name, alias)) name = full;
-  for (const TopologyKind& k : kKinds)
-    if (iequals(name, k.name)) return &k;
-  return nullptr;
-}
-
-const TopologyKind* kindByCode(int64_t code) {
-  for (const TopologyKind& k : kKinds)
-    if (k.code == code) return &k;
-  return nullptr;
-}
 
 // Skipped cells are named by their XDMF type, whatever the VTK type behind them.
 void countSkipped(CellSoup& soup, const TopologyKind& k, uint64_t n) {
@@ -174,7 +107,7 @@ class XdmfReader {
                     std::vector<bool>& readHere);
   Result gridShape(pugi::xml_node grid, const std::vector<pugi::xml_node>& companions, const std::string& where,
                    bool& volume, bool& byRows, const void*& geometry);
-  Result readShareOfGrid(pugi::xml_node topo, pugi::xml_node geo, const TopologyKind& kind,
+  Result readShareOfGrid(pugi::xml_node topo, pugi::xml_node geo, const TopologyKind* kind,
                          const std::vector<pugi::xml_node>& attributes, const std::string& where, PieceArrays& arrays,
                          bool& done);
   Result pointRows(pugi::xml_node geo, const std::string& where, uint64_t first, uint64_t count,
@@ -185,14 +118,18 @@ class XdmfReader {
   void dropRepeatedCells(size_t firstNew, uint64_t vertexBase, uint64_t points, const std::string& where);
   Result readCells(pugi::xml_node topo, const TopologyKind* kind, const std::string& where, uint64_t points,
                    uint64_t vertexBase, std::vector<int64_t>& conn, int& nodes, uint64_t& cells);
-  Result readMixed(const std::vector<int64_t>& values, const std::string& where, uint64_t points, uint64_t vertexBase,
-                   uint64_t& cells);
+  // A share's rows [from, to) of a Mixed topology of `total` values, walked a window at a time
+  // where its data reads windows for their cost (HDF5), else read whole and walked.
+  Result mixedRows(pugi::xml_node item, const std::string& where, int64_t base, uint64_t total, uint64_t from,
+                   uint64_t to, uint64_t declared, xdmf::MixedCells& out);
+  Result appendMixed(const std::string& where, const xdmf::MixedCells& cells, uint64_t vertexBase, uint64_t points);
   Result readPoints(pugi::xml_node geo, const std::string& where, uint64_t& points);
   // rows: given, only those rows of each attribute are read (a share of the grid).
   Result readAttributes(const std::vector<pugi::xml_node>& attributes, const std::string& where,
                         const xdmf::GridCells& grid, bool first, bool sharedPoints, PieceArrays& arrays,
                         const Rows* rows = nullptr);
   Result baseOffset(pugi::xml_node topo, const std::string& what, int64_t& base);
+  Result declaredCells(pugi::xml_node topo, const std::string& what, bool& hasCount, uint64_t& declared);
 
   Document& doc_;
   const ReadOptions& options_;
@@ -359,73 +296,13 @@ Result XdmfReader::readPoints(pugi::xml_node geo, const std::string& where, uint
   return Result::success();
 }
 
-Result XdmfReader::readMixed(const std::vector<int64_t>& values, const std::string& where, uint64_t points,
-                             uint64_t vertexBase, uint64_t& cells) {
-  // type code, [node count,] nodes; per cell. Cells tetstream does not read keep their place
-  // (as VTK_EMPTY_CELL) so that cell data stays aligned; they are named by XDMF type afterwards.
-  std::vector<int64_t> conn, offsets, types;
-  std::map<const TopologyKind*, uint64_t> notRead;
-  conn.reserve(values.size());
-  const size_t n = values.size();
-  size_t i = 0;
-  auto need = [&](uint64_t k, const char* what) -> Result {
-    if (k > n - i)
-      return fail(Status::Truncated, where + " Topology (Mixed): cell " + std::to_string(types.size()) + " needs " +
-                                         std::to_string(k) + " more values for its " + what + ", " +
-                                         std::to_string(n - i) + " remain");
-    return Result::success();
-  };
-  while (i < n) {
-    const int64_t code = values[i++];
-    const TopologyKind* k = kindByCode(code);
-    if (!k)
-      return fail(Status::Corrupt, where + " Topology (Mixed): cell " + std::to_string(types.size()) +
-                                       " has the unknown cell type code " + std::to_string(code));
-    offsets.push_back(int64_t(conn.size()));
-    uint64_t count = uint64_t(k->nodes);
-    if (k->code == 0x10) {
-      // Polyhedron: the number of faces, then per face its node count and nodes.
-      if (Result r = need(1, "face count"); !r) return r;
-      const int64_t faces = values[i++];
-      if (faces < 0 || uint64_t(faces) > n - i)
-        return fail(Status::Corrupt, where + " Topology (Mixed): polyhedron " + std::to_string(types.size()) +
-                                         " declares " + std::to_string(faces) + " faces");
-      for (int64_t f = 0; f < faces; ++f) {
-        if (Result r = need(1, "face node count"); !r) return r;
-        const int64_t m = values[i++];
-        if (m < 0)
-          return fail(Status::Corrupt,
-                      where + " Topology (Mixed): a polyhedron face of " + std::to_string(m) + " nodes");
-        if (Result r = need(uint64_t(m), "face nodes"); !r) return r;
-        conn.insert(conn.end(), values.begin() + std::ptrdiff_t(i), values.begin() + std::ptrdiff_t(i + size_t(m)));
-        i += size_t(m);
-      }
-      types.push_back(0);
-      ++notRead[k];
-      continue;
-    }
-    if (count == 0) {
-      if (Result r = need(1, "node count"); !r) return r;
-      if (values[i] < 0)
-        return fail(Status::Corrupt, where + " Topology (Mixed): cell " + std::to_string(types.size()) +
-                                         " has a node count of " + std::to_string(values[i]));
-      count = uint64_t(values[i++]);
-    }
-    if (Result r = need(count, "nodes"); !r) return r;
-    conn.insert(conn.end(), values.begin() + std::ptrdiff_t(i), values.begin() + std::ptrdiff_t(i + count));
-    i += count;
-    if (k->read) {
-      types.push_back(k->vtk);
-    } else {
-      types.push_back(0);
-      ++notRead[k];
-    }
-  }
-  offsets.push_back(int64_t(conn.size()));
-  cells = types.size();
-  if (Result r = appendVtkCells(where, conn, offsets, types, vertexBase, points, soup_); !r) return r;
+Result XdmfReader::appendMixed(const std::string& where, const xdmf::MixedCells& cells, uint64_t vertexBase,
+                               uint64_t points) {
+  if (Result r = appendVtkCells(where, cells.connectivity, cells.offsets, cells.types, vertexBase, points, soup_); !r)
+    return r;
+  // appendVtkCells counted the cells not read as VTK_EMPTY_CELL: they are named by XDMF type.
   uint64_t renamed = 0;
-  for (const auto& [k, c] : notRead) {
+  for (const auto& [k, c] : cells.notRead) {
     countSkipped(soup_, *k, c);
     renamed += c;
   }
@@ -433,6 +310,33 @@ Result XdmfReader::readMixed(const std::vector<int64_t>& values, const std::stri
     auto it = soup_.skipped.find({0, vtkCellTypeName(0) + " (0)"});
     if (it != soup_.skipped.end() && (it->second -= renamed) == 0) soup_.skipped.erase(it);
   }
+  return Result::success();
+}
+
+Result XdmfReader::mixedRows(pugi::xml_node item, const std::string& where, int64_t base, uint64_t total, uint64_t from,
+                             uint64_t to, uint64_t declared, xdmf::MixedCells& out) {
+  const std::string what = where + " Topology";
+  xdmf::MixedWalker walker(where, base, from, to, /*skippedNodes=*/false);
+  const bool byWindow = doc_.readsRowsAlone(item, total);
+  uint64_t at = 0, window = io::kPickWindow;
+  Values<int64_t> v;
+  while (!walker.done() && at < total) {
+    const uint64_t n = byWindow ? std::min(window, total - at) : total;
+    if (Result r = byWindow ? doc_.integerRows(item, what, total, at, n, v) : doc_.integers(item, what, v); !r)
+      return r;
+    if (!byWindow && v.values.size() != total)
+      return fail(Status::Corrupt,
+                  what + ": " + std::to_string(v.values.size()) + " values, Dimensions says " + std::to_string(total));
+    size_t used = 0;
+    if (Result r = walker.walk(v.values, at + n == total, out, used); !r) return r;
+    at += used;
+    window = used ? io::kPickWindow : 2 * window;  // (a cell longer than the window: a larger one)
+  }
+  // Every cell up to the share's last was found; the last share also sees the values end there.
+  if (walker.cells() < to || (to == declared && at != total))
+    return fail(Status::Corrupt, what + ": NumberOfElements=" + std::to_string(declared) +
+                                     " but the Mixed data holds " + (walker.cells() < to ? "only " : "more than ") +
+                                     std::to_string(walker.cells()) + " cells");
   return Result::success();
 }
 
@@ -509,13 +413,15 @@ Result XdmfReader::pointRows(pugi::xml_node geo, const std::string& where, uint6
   return Result::success();
 }
 
-// A share of one grid for one of several processes (core/dist): the cells in rows [from, to)
-// of the topology, from index·N/count to (index + 1)·N/count, and the points from the smallest
-// to the largest id they use, with those rows of every attribute. Each process reads about a
-// count-th of the cells; the points on the cuts are read by both sides and joined later by their
-// coordinates. done stays false (nothing read) for a grid this cannot cut by rows: a topology of
-// no declared size, or an attribute of a function space (its dofs are not per point or cell).
-Result XdmfReader::readShareOfGrid(pugi::xml_node topo, pugi::xml_node geo, const TopologyKind& kind,
+// A share of one grid for one of several processes (core/dist): the cells from index·N/count to
+// (index + 1)·N/count, and the points they use (the run from the smallest id to the largest, or
+// only those: io/row_pick.h), with those rows of every attribute. Of one cell type the cells are
+// rows of the topology; of Mixed cells the topology is walked from its first cell (a window at a
+// time where its data allows) to find them. Each process reads about a count-th of the cells;
+// the points on the cuts are read by both sides and joined later by their coordinates. done
+// stays false (nothing read) for a grid this cannot cut: a topology of no declared size, or an
+// attribute of a function space (its dofs are not per point or cell).
+Result XdmfReader::readShareOfGrid(pugi::xml_node topo, pugi::xml_node geo, const TopologyKind* kind,
                                    const std::vector<pugi::xml_node>& attributes, const std::string& where,
                                    PieceArrays& arrays, bool& done) {
   done = false;
@@ -524,22 +430,40 @@ Result XdmfReader::readShareOfGrid(pugi::xml_node topo, pugi::xml_node geo, cons
   pugi::xml_node item;
   if (Result r = doc_.dataItem(topo, what, item); !r) return r;
   const std::vector<uint64_t> dims = doc_.declaredDims(item);
-  const uint64_t nodes = uint64_t(kind.nodes);
-  if (!cellRowsDeclared(dims, nodes)) return Result::success();
-  const bool cellRows = dims.size() == 2;
-  const uint64_t cellsTotal = cellRows ? dims[0] : dims[0] / nodes;
-  const uint64_t from = cellsTotal * options_.shareIndex / options_.shareCount,
-                 to = cellsTotal * (options_.shareIndex + 1ull) / options_.shareCount;
-  Values<int64_t> ids;
-  if (Result r = doc_.integerRows(item, what, dims[0], cellRows ? from : from * nodes,
-                                  cellRows ? to - from : (to - from) * nodes, ids);
-      !r)
-    return r;
   int64_t base = 0;
   if (Result r = baseOffset(topo, what, base); !r) return r;
+  xdmf::MixedCells cells;  // the share's cells (ids less the base)
+  uint64_t cellsTotal = 0, from = 0, to = 0;
+  auto share = [&](uint64_t n) {
+    cellsTotal = n;
+    from = n * options_.shareIndex / options_.shareCount;
+    to = n * (options_.shareIndex + 1ull) / options_.shareCount;
+  };
+  if (kind) {
+    const uint64_t nodes = uint64_t(kind->nodes);
+    if (!cellRowsDeclared(dims, nodes)) return Result::success();
+    const bool cellRows = dims.size() == 2;
+    share(cellRows ? dims[0] : dims[0] / nodes);
+    Values<int64_t> ids;
+    if (Result r = doc_.integerRows(item, what, dims[0], cellRows ? from : from * nodes,
+                                    cellRows ? to - from : (to - from) * nodes, ids);
+        !r)
+      return r;
+    cells.connectivity = std::move(ids.values);
+    for (int64_t& id : cells.connectivity) id -= base;
+    cells.types.assign(to - from, kind->vtk);
+    cells.offsets.resize(to - from + 1);
+    for (uint64_t c = 0; c < cells.offsets.size(); ++c) cells.offsets[c] = int64_t(c * nodes);
+  } else {
+    bool hasCount = false;
+    uint64_t declared = 0;
+    if (Result r = declaredCells(topo, what, hasCount, declared); !r) return r;
+    if (!hasCount || dims.size() != 1) return Result::success();
+    share(declared);
+    if (Result r = mixedRows(item, where, base, dims[0], from, to, declared, cells); !r) return r;
+  }
   int64_t lo = INT64_MAX, hi = -1;
-  for (int64_t& id : ids.values) {
-    id -= base;
+  for (int64_t id : cells.connectivity) {
     if (id < 0) return fail(Status::Corrupt, what + ": a cell names point " + std::to_string(id));
     lo = std::min(lo, id);
     hi = std::max(hi, id);
@@ -551,19 +475,17 @@ Result XdmfReader::readShareOfGrid(pugi::xml_node topo, pugi::xml_node geo, cons
   rows.pointFirst = uint64_t(lo);
   const uint64_t span = uint64_t(hi + 1 - lo);
   rows.pointsSpan = span;
-  // The points the cells use (io/row_pick.h); `ids` become their places among those read.
-  rows.pointPick = io::pickUsedRows(ids.values, rows.pointFirst, span);
+  // The points the cells use (io/row_pick.h); the ids become their places among those read.
+  rows.pointPick = io::pickUsedRows(cells.connectivity, rows.pointFirst, span);
   const uint64_t points = rows.pointPick.empty() ? span : rows.pointPick.size();
   const uint64_t vertexBase = mesh_.positions.size() / 3;
   if (Result r = pointRows(geo, where, rows.pointFirst, span, rows.pointPick, rows.pointsTotal); !r) return r;
-  std::vector<int64_t> offsets(to - from + 1), types(to - from, kind.vtk);
-  for (uint64_t c = 0; c < offsets.size(); ++c) offsets[c] = int64_t(c * nodes);
-  if (Result r = appendVtkCells(where, ids.values, offsets, types, vertexBase, points, soup_); !r) return r;
+  if (Result r = appendMixed(where, cells, vertexBase, points); !r) return r;
   xdmf::GridCells gc;
-  gc.connectivity = &ids.values;
+  gc.connectivity = kind ? &cells.connectivity : nullptr;
   gc.cells = to - from;
-  gc.nodes = int(nodes);
-  gc.corners = kShapeCorners[int(vtkCellInfo(kind.vtk).shape)];
+  gc.nodes = kind ? kind->nodes : 0;
+  gc.corners = kind ? kShapeCorners[int(vtkCellInfo(kind->vtk).shape)] : 0;
   gc.points = points;
   if (Result r = readAttributes(attributes, where, gc, true, false, arrays, &rows); !r) return r;
   report_.shared = true;
@@ -574,9 +496,9 @@ Result XdmfReader::readShareOfGrid(pugi::xml_node topo, pugi::xml_node geo, cons
   return Result::success();
 }
 
-// What a grid is, for sharing it: a grid of volume cells tetstream reads, one that can be read
-// in rows (readShareOfGrid: one cell type, a declared size, no attribute of a function space),
-// and its Geometry element (after references).
+// What a grid is, for sharing it: a grid of volume cells tetstream reads, one whose cells can be
+// shared out (readShareOfGrid: a declared size, and of Mixed cells a declared count; no
+// attribute of a function space), and its Geometry element (after references).
 Result XdmfReader::gridShape(pugi::xml_node grid, const std::vector<pugi::xml_node>& companions,
                              const std::string& where, bool& volume, bool& byRows, const void*& geometry) {
   volume = byRows = false;
@@ -592,7 +514,6 @@ Result XdmfReader::gridShape(pugi::xml_node grid, const std::vector<pugi::xml_no
   if (!volume) return Result::success();
   if (Result r = doc_.children(grid, "Geometry", where, geos); !r) return r;
   if (geos.size() == 1) geometry = geos[0].internal_object();
-  if (mixed) return Result::success();
   if (Result r = doc_.children(grid, "Attribute", where, attributes); !r) return r;
   for (pugi::xml_node c : companions) {
     std::vector<pugi::xml_node> more;
@@ -602,7 +523,10 @@ Result XdmfReader::gridShape(pugi::xml_node grid, const std::vector<pugi::xml_no
   if (anyOfFunctionSpace(attributes)) return Result::success();
   pugi::xml_node item;
   if (Result r = doc_.dataItem(topos[0], where + " Topology", item); !r) return r;
-  byRows = cellRowsDeclared(doc_.declaredDims(item), uint64_t(kind->nodes));
+  const std::vector<uint64_t> dims = doc_.declaredDims(item);
+  // Mixed cells are found by walking the topology: its size and cell count must be declared.
+  byRows = mixed ? dims.size() == 1 && (topos[0].attribute("NumberOfElements") || topos[0].attribute("Dimensions"))
+                 : cellRowsDeclared(dims, uint64_t(kind->nodes));
   return Result::success();
 }
 
@@ -644,6 +568,19 @@ Result XdmfReader::shareGrids(const std::vector<pugi::xml_node>& pieces, const s
   return Result::success();
 }
 
+// A topology's declared cell count (NumberOfElements, or XDMF 2's Dimensions), when it has one.
+Result XdmfReader::declaredCells(pugi::xml_node topo, const std::string& what, bool& hasCount, uint64_t& declared) {
+  declared = 0;
+  hasCount = topo.attribute("NumberOfElements") || topo.attribute("Dimensions");
+  if (!hasCount) return Result::success();
+  const char* text = topo.attribute("NumberOfElements") ? topo.attribute("NumberOfElements").value()
+                                                        : topo.attribute("Dimensions").value();
+  size_t pos = 0;
+  if (!parseU64(nextToken(text, pos), declared))
+    return fail(Status::Corrupt, what + ": NumberOfElements='" + printable(text) + "' is not a count");
+  return Result::success();
+}
+
 Result XdmfReader::readCells(pugi::xml_node topo, const TopologyKind* kind, const std::string& where, uint64_t points,
                              uint64_t vertexBase, std::vector<int64_t>& conn, int& nodes, uint64_t& cells) {
   const std::string what = where + " Topology";
@@ -653,24 +590,22 @@ Result XdmfReader::readCells(pugi::xml_node topo, const TopologyKind* kind, cons
   if (Result r = doc_.integers(item, what, v); !r) return r;
   int64_t base = 0;
   if (Result r = baseOffset(topo, what, base); !r) return r;
-  for (int64_t& id : v.values) id -= base;
+  bool hasCount = false;
   uint64_t declared = 0;
-  const bool hasCount = topo.attribute("NumberOfElements") || topo.attribute("Dimensions");
-  if (hasCount) {
-    const char* text = topo.attribute("NumberOfElements") ? topo.attribute("NumberOfElements").value()
-                                                          : topo.attribute("Dimensions").value();
-    size_t pos = 0;
-    std::string_view first = nextToken(text, pos);
-    if (!parseU64(first, declared))
-      return fail(Status::Corrupt, what + ": NumberOfElements='" + printable(text) + "' is not a count");
-  }
-  if (!kind) {  // Mixed
-    if (Result r = readMixed(v.values, where, points, vertexBase, cells); !r) return r;
+  if (Result r = declaredCells(topo, what, hasCount, declared); !r) return r;
+  if (!kind) {  // Mixed: the node ids lose the base, the type codes do not
+    xdmf::MixedCells mixed;
+    xdmf::MixedWalker walker(where, base, 0, UINT64_MAX);
+    size_t used = 0;
+    if (Result r = walker.walk(v.values, true, mixed, used); !r) return r;
+    if (Result r = appendMixed(where, mixed, vertexBase, points); !r) return r;
+    cells = walker.cells();
     if (hasCount && declared != cells)
       return fail(Status::Corrupt, what + ": NumberOfElements=" + std::to_string(declared) +
                                        " but the Mixed data holds " + std::to_string(cells) + " cells");
     return Result::success();
   }
+  for (int64_t& id : v.values) id -= base;
   nodes = kind->nodes;
   if (nodes == 0) nodes = 1;  // (only cells that are not read have no fixed count; never reached)
   if (v.values.size() % uint64_t(nodes) != 0)
@@ -849,11 +784,12 @@ Result XdmfReader::readPiece(pugi::xml_node grid, const std::vector<pugi::xml_no
     if (Result r = doc_.children(c, "Attribute", where, more); !r) return r;
     attributes.insert(attributes.end(), more.begin(), more.end());
   }
-  if (shareGrid_ && kind) {
+  if (shareGrid_) {
     bool done = false;
-    if (Result r = readShareOfGrid(topo, geos[0], *kind, attributes, where, arrays, done); !r) return r;
+    if (Result r = readShareOfGrid(topo, geos[0], kind, attributes, where, arrays, done); !r) return r;
     if (done) {
-      topologies_.push_back(kind->name);
+      const std::string name = mixed ? "Mixed" : kind->name;
+      if (std::find(topologies_.begin(), topologies_.end(), name) == topologies_.end()) topologies_.push_back(name);
       return Result::success();
     }
   }

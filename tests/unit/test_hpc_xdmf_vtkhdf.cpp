@@ -16,6 +16,7 @@
 
 #include "io/mesh_io.h"
 #include "io/readers.h"
+#include "io/xdmf_mixed.h"
 #include "io/xml_path.h"
 #include "test_helpers.h"
 
@@ -185,6 +186,121 @@ TEST(XdmfShares, TheGridsOfACollectionAreSharedByGridOrByRows) {
   EXPECT_TRUE(hasNote(r, "read grid 2 of the 2 volume grids, this process's share of the file")) << allNotes(r);
   ASSERT_TRUE(readMesh(hpcPath("xdmf_inline.xmf"), m, r = ReadReport{}, test::shareOf(1, 3)));
   EXPECT_TRUE(hasNote(r, "this process's share of the grid")) << allNotes(r);
+}
+
+// Writes `mesh` as one XDMF grid of Mixed cells in HDF5, ids from BaseOffset 1: its tets
+// (code 6), and between them cells tetstream does not read, a triangle (code 4) after every 7th
+// tet and a polyline of two nodes (code 2 and its node count) after every 11th, as a mesh with
+// its facets and edges in one topology is written. Point field "f" and cell data "c".
+void writeMixedXdmf(const TetMesh& mesh, const std::string& dir) {
+  std::vector<int64_t> topo;
+  std::vector<double> cellValues;
+  for (uint32_t t = 0; t < mesh.tetCount(); ++t) {
+    const uint32_t* v = &mesh.tets[4 * size_t(t)];
+    topo.insert(topo.end(), {6, v[0] + 1, v[1] + 1, v[2] + 1, v[3] + 1});
+    cellValues.push_back(t);
+    if (t % 7 == 0) topo.insert(topo.end(), {4, v[0] + 1, v[1] + 1, v[2] + 1}), cellValues.push_back(-1);
+    if (t % 11 == 0) topo.insert(topo.end(), {2, 2, v[0] + 1, v[3] + 1}), cellValues.push_back(-2);
+  }
+  std::vector<double> xyz(mesh.positions.begin(), mesh.positions.end()),
+      f(mesh.fields[0].values.begin(), mesh.fields[0].values.end());
+  hid_t file = H5Fcreate((dir + "/mixed.h5").c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  auto write = [&](const char* name, hid_t type, const void* data, std::vector<hsize_t> dims) {
+    hid_t space = H5Screate_simple(int(dims.size()), dims.data(), nullptr);
+    hid_t d = H5Dcreate2(file, name, type == H5T_NATIVE_INT64 ? H5T_STD_I64LE : H5T_IEEE_F64LE, space, H5P_DEFAULT,
+                         H5P_DEFAULT, H5P_DEFAULT);
+    H5Dwrite(d, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data);
+    H5Dclose(d);
+    H5Sclose(space);
+  };
+  write("topo", H5T_NATIVE_INT64, topo.data(), {topo.size()});
+  write("xyz", H5T_NATIVE_DOUBLE, xyz.data(), {mesh.vertexCount(), 3});
+  write("f", H5T_NATIVE_DOUBLE, f.data(), {mesh.vertexCount()});
+  write("c", H5T_NATIVE_DOUBLE, cellValues.data(), {cellValues.size()});
+  H5Fclose(file);
+  const std::string n = std::to_string(mesh.vertexCount());
+  saveFile(
+      dir + "/mixed.xdmf", R"(<Xdmf Version="3.0"><Domain><Grid Name="mesh">
+<Topology TopologyType="Mixed" NumberOfElements=")" +
+                               std::to_string(cellValues.size()) + R"(" BaseOffset="1">
+ <DataItem Dimensions=")" + std::to_string(topo.size()) +
+                               R"(" NumberType="Int" Precision="8" Format="HDF">mixed.h5:/topo</DataItem></Topology>
+<Geometry GeometryType="XYZ"><DataItem Dimensions=")" +
+                               n + R"( 3" Precision="8" Format="HDF">mixed.h5:/xyz</DataItem></Geometry>
+<Attribute Name="f" Center="Node"><DataItem Dimensions=")" +
+                               n + R"(" Precision="8" Format="HDF">mixed.h5:/f</DataItem></Attribute>
+<Attribute Name="c" Center="Cell"><DataItem Dimensions=")" +
+                               std::to_string(cellValues.size()) +
+                               R"(" Precision="8" Format="HDF">mixed.h5:/c</DataItem></Attribute>
+</Grid></Domain></Xdmf>)");
+}
+
+// One grid of Mixed cells read by several processes: each walks the topology's codes to its
+// share of the cells and reads only the points they use; together the shares hold every tet of
+// the whole once. Node ids lose the BaseOffset, type codes do not.
+TEST(XdmfShares, MixedCellsAreSharedByWalkingTheirCodes) {
+  ScratchDir dir("xdmf-mixed-shares");
+  const TetMesh mesh = test::shuffledPoints(test::harmonicMesh(6));
+  writeMixedXdmf(mesh, dir.path);
+  const std::string path = dir.path + "/mixed.xdmf";
+  TetMesh whole;
+  ReadReport r;
+  ASSERT_TRUE(readMesh(path, whole, r)) << allNotes(r);
+  EXPECT_EQ(whole.tetCount(), mesh.tetCount());
+  EXPECT_TRUE(
+      hasNote(r, "skipped " + std::to_string((mesh.tetCount() + 6) / 7) + " cells of unsupported type XDMF Triangle"))
+      << allNotes(r);
+  for (uint32_t count : {2u, 3u, 5u}) {
+    test::expectSharesMakeTheWhole(path, count, "c");
+    test::expectSharesReadOnlyUsedPoints(path, count, "points they use");
+  }
+  for (const char* name : {"xdmf_mixed.xdmf", "xdmf_mixed_quadratic.xdmf"})  // ("col": cell data)
+    for (uint32_t count : {2u, 3u}) test::expectSharesMakeTheWhole(hpcPath(name), count, "col");
+}
+
+// The walk a window of values at a time finds the cells the walk of all of them does, wherever
+// the windows cut the cells; a topology cut short inside a cell, or one with a cell code nobody
+// defines, is refused by the walk that reaches it.
+TEST(XdmfMixed, WalkingInWindowsFindsTheSameCells) {
+  // A tet, a polyhedron of two faces (a triangle and a quad), a polyline of 3, a pyramid, a tet.
+  const std::vector<int64_t> topo = {6, 0, 1, 2, 3, 0x10, 2, 3, 0, 1, 2, 4, 0, 1, 2, 3,
+                                     2, 3, 4, 5, 6, 7,    1, 2, 3, 4, 5, 6, 1, 2, 3, 4};
+  xdmf::MixedCells all;
+  size_t used = 0;
+  xdmf::MixedWalker whole("t", 0, 0, UINT64_MAX);
+  ASSERT_TRUE(whole.walk(topo, true, all, used));
+  EXPECT_EQ(used, topo.size());
+  EXPECT_EQ(whole.cells(), 5u);
+  EXPECT_EQ(all.types, (std::vector<int64_t>{10, 0, 0, 14, 10}));
+  for (uint64_t from = 0; from <= 5; ++from)
+    for (uint64_t to = from; to <= 5; ++to)
+      for (size_t window = 1; window <= 8; ++window) {
+        SCOPED_TRACE("cells " + std::to_string(from) + " to " + std::to_string(to) + ", windows of " +
+                     std::to_string(window));
+        xdmf::MixedWalker w("t", 0, from, to);
+        xdmf::MixedCells part;
+        size_t at = 0, n = window;
+        while (!w.done() && at < topo.size()) {
+          const size_t take = std::min(n, topo.size() - at);
+          ASSERT_TRUE(w.walk(std::span(topo).subspan(at, take), at + take == topo.size(), part, used));
+          at += used;
+          n = used ? window : 2 * n;
+        }
+        EXPECT_EQ(w.cells(), to);
+        EXPECT_EQ(part.types, std::vector<int64_t>(all.types.begin() + std::ptrdiff_t(from),
+                                                   all.types.begin() + std::ptrdiff_t(to)));
+        const auto first = all.connectivity.begin();
+        EXPECT_EQ(part.connectivity, std::vector<int64_t>(first + all.offsets[from], first + all.offsets[to]));
+      }
+  xdmf::MixedCells out;
+  xdmf::MixedWalker cut("t", 0, 0, UINT64_MAX);
+  Result r = cut.walk(std::span(topo).first(topo.size() - 1), true, out, used);
+  EXPECT_EQ(r.status, Status::Truncated);
+  EXPECT_NE(r.message.find("cell 4 needs 4 more values for its nodes, 3 remain"), std::string::npos) << r.message;
+  xdmf::MixedWalker unknown("t", 0, 3, 4);
+  r = unknown.walk(std::vector<int64_t>{6, 0, 1, 2, 3, 99, 0}, false, out, used);
+  EXPECT_EQ(r.status, Status::Corrupt);
+  EXPECT_NE(r.message.find("cell 1 has the unknown cell type code 99"), std::string::npos) << r.message;
 }
 
 TEST(XdmfTimeSeries, StepsAreListedAndPicked) {
