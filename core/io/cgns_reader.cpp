@@ -22,15 +22,16 @@
 // A share for one of several processes (ReadOptions::shareIndex of shareCount, core/dist): of a
 // base with at least as many zones as processes, the zones from index·Z/count to
 // (index + 1)·Z/count, each whole (zones meet where their points coincide, which core/dist joins
-// as one process does). A base of one unstructured zone of fixed-type sections: the elements
+// as one process does). A base of one unstructured zone: the elements
 // numbered from index·N/count + 1 to (index + 1)·N/count and the vertices their corners use (the
 // run from the smallest to the largest, or only those: io/row_pick.h), with those rows of the
-// solutions (the library's partial reads); of
-// several (fewer than processes), the same of each, unless one has a MIXED section. A base
+// solutions (the library's partial reads; a MIXED section's elements through io/cgns_mixed.h); of
+// several (fewer than processes), the same of each. A base
 // of fewer structured zones than processes, each at least `count` cells deep along its longest
 // index direction: of every zone the cells of layers index·L/count to (index + 1)·L/count along it
 // and their points (the layer where two processes' slabs meet is read by both, and joined by
-// core/dist). Other bases of fewer zones than processes are read whole by every process.
+// core/dist). Other bases of fewer zones than processes (structured and unstructured zones
+// together) are read whole by every process.
 #include <cgnslib.h>
 
 #include <algorithm>
@@ -41,6 +42,7 @@
 #include <map>
 #include <optional>
 
+#include "io/cgns_mixed.h"
 #include "io/readers.h"
 #include "io/row_pick.h"
 
@@ -139,6 +141,14 @@ struct Zone {
   std::map<int, std::vector<cgsize_t>> windowConnectivity;  // per section: its window's elements, read once
   bool stepSolution = false;                                // the time step names one solution (below), or none
   std::string solution;
+};
+
+// An element section of a zone, as the file declares it.
+struct Section {
+  std::string where, type;
+  std::string path;  // "/base/zone/section", for the library's node I/O
+  CGNS_ENUMT(ElementType_t) etype;
+  cgsize_t start = 0, end = 0;
 };
 
 class CgnsReader {
@@ -376,22 +386,10 @@ class CgnsReader {
   }
 
   // Of fewer unstructured zones than processes, each process's window of every zone (the header
-  // comment), when every zone can be read so; else all whole.
+  // comment).
   Result keepWindowsOfZones() {
-    for (Zone& z : zones_) {
+    for (Zone& z : zones_)
       if (Result r = windowOfZone(z); !r) return r;
-      if (z.window) continue;
-      for (Zone& y : zones_) {
-        y.window = false;
-        y.windowConnectivity.clear();
-        y.used.reset();
-        y.pick.clear();
-        y.vertexFirst = y.cellFirst = 0;
-        y.vertexCount = y.vertices;
-        y.cellCount = y.cells;
-      }
-      return Result::success();
-    }
     numberZones();
     uint64_t cells = 0;
     for (const Zone& z : zones_) cells += z.cells;
@@ -410,46 +408,63 @@ class CgnsReader {
 
   // The window of one unstructured zone: the share's elements and the vertices their corners use
   // (the run they span, or only those: Zone::pick). The share's connectivity is read here to find
-  // them and kept for readSections. A MIXED section,
-  // whose elements have no fixed size, leaves the zone whole (z.window stays false).
+  // them and kept for readSections; of a MIXED section through io/cgns_mixed.h.
   Result windowOfZone(Zone& z) {
     const uint64_t from = z.cells * options_.shareIndex / options_.shareCount,
                    to = z.cells * (options_.shareIndex + 1ull) / options_.shareCount;
     int nsections = 0;
     if (cg_nsections(file_.fn, base_, z.index, &nsections) != CG_OK)
       return fail(Status::Corrupt, zoneLabel(z) + ": cannot read its element sections: " + lastCgnsError());
-    uint64_t lo = UINT64_MAX, hi = 0;
-    std::map<int, int> corners, nodesPer;  // per section read
+    std::vector<std::pair<int, Section>> read;  // the sections with elements in the window
     for (int s = 1; s <= nsections; ++s) {
       Section sec;
       if (Result r = readSection(z, s, sec); !r) return r;
-      if (sec.type == "MIXED") {
-        z.windowConnectivity.clear();
-        return Result::success();
-      }
-      int npe = 0;
       const cgsize_t first = std::max<cgsize_t>(sec.start, cgsize_t(from + 1)),
                      last = std::min<cgsize_t>(sec.end, cgsize_t(to));
-      if (!cgnsType(sec.type).volume || cg_npe(sec.etype, &npe) != CG_OK || npe < 1 || first > last) continue;
+      if (first > last) continue;
       std::vector<cgsize_t>& conn = z.windowConnectivity[s];
-      conn.resize(size_t(last - first + 1) * size_t(npe));
-      if (cg_elements_partial_read(file_.fn, base_, z.index, s, first, last, conn.data(), nullptr) != CG_OK)
-        return fail(Status::Corrupt, sec.where + ": " + lastCgnsError());
-      corners[s] = std::min(npe, kShapeCorners[int(cgnsType(sec.type).shape)]);
-      nodesPer[s] = npe;
-      for (cgsize_t v : conn)
-        if (v >= 1 && uint64_t(v) <= z.vertices) lo = std::min(lo, uint64_t(v - 1)), hi = std::max(hi, uint64_t(v));
+      if (sec.type == "MIXED") {
+        cgsize_t dataSize = 0;
+        bool walked = false;
+        if (cg_ElementDataSize(file_.fn, base_, z.index, s, &dataSize) != CG_OK)
+          return fail(Status::Corrupt, sec.where + ": " + lastCgnsError());
+        if (Result r = cgns::readMixedWindow(file_.fn, sec.path, sec.where, sec.start, sec.end, dataSize, first, last,
+                                             conn, walked);
+            !r)
+          return r;
+        if (walked)
+          report_.notes.push_back(sec.where + ": its ElementStartOffset does not say where this process's elements " +
+                                  "begin; found by their types, from the first element");
+      } else {
+        int npe = 0;
+        if (!cgnsType(sec.type).volume || cg_npe(sec.etype, &npe) != CG_OK || npe < 1) {
+          z.windowConnectivity.erase(s);
+          continue;
+        }
+        conn.resize(size_t(last - first + 1) * size_t(npe));
+        if (cg_elements_partial_read(file_.fn, base_, z.index, s, first, last, conn.data(), nullptr) != CG_OK)
+          return fail(Status::Corrupt, sec.where + ": " + lastCgnsError());
+      }
+      read.emplace_back(s, sec);
     }
+    // The vertices the volume elements' corners use (higher-order nodes and the nodes of elements
+    // that are not read are not read).
+    uint64_t lo = UINT64_MAX, hi = 0;
+    auto eachCorner = [&](auto&& visit) {
+      for (const auto& [s, sec] : read)
+        forEachElement(sec, z.windowConnectivity[s], [&](const std::string& type, const cgsize_t* nodes, int count) {
+          const CgnsType kind = cgnsType(type);
+          if (!kind.volume) return;
+          for (int q = 0; q < std::min(count, kShapeCorners[int(kind.shape)]); ++q)
+            if (nodes[q] >= 1 && uint64_t(nodes[q]) <= z.vertices) visit(uint64_t(nodes[q] - 1));
+        });
+    };
+    eachCorner([&](uint64_t v) { lo = std::min(lo, v), hi = std::max(hi, v + 1); });
     if (hi == 0) lo = 0;
     z.vertexFirst = lo;
     z.vertexCount = hi - lo;
-    // The vertices the elements' corners use (higher-order nodes are dropped: not read).
     z.used.emplace(lo, hi - lo);
-    for (const auto& [s, conn] : z.windowConnectivity)
-      for (size_t e = 0; e + size_t(nodesPer[s]) <= conn.size(); e += size_t(nodesPer[s]))
-        for (int q = 0; q < corners[s]; ++q)
-          if (conn[e + size_t(q)] >= 1 && uint64_t(conn[e + size_t(q)]) <= z.vertices)
-            z.used->mark(uint64_t(conn[e + size_t(q)] - 1));
+    eachCorner([&](uint64_t v) { z.used->mark(v); });
     z.used->finish();
     if (!z.used->all()) z.pick = z.used->rows();
     z.cellFirst = from;
@@ -458,12 +473,26 @@ class CgnsReader {
     return Result::success();
   }
 
-  // Section s of zone z as the file declares it.
-  struct Section {
-    std::string where, type;
-    CGNS_ENUMT(ElementType_t) etype;
-    cgsize_t start = 0, end = 0;
-  };
+  // Calls visit(type name, nodes, node count) for each element of a section's connectivity: of a
+  // MIXED section each element's code says its type (checked when it was read), else every
+  // element is the section's type.
+  template <class Visit>
+  static void forEachElement(const Section& sec, std::span<const cgsize_t> conn, Visit&& visit) {
+    if (sec.type == "MIXED") {
+      for (size_t at = 0; at < conn.size();) {
+        const int entries = cgns::mixedEntries(conn[at]);
+        if (entries == 0 || size_t(entries) > conn.size() - at) return;
+        visit(elementTypeName(int(conn[at])), &conn[at + 1], entries - 1);
+        at += size_t(entries);
+      }
+      return;
+    }
+    int npe = 0;
+    if (cg_npe(sec.etype, &npe) != CG_OK || npe < 1) return;
+    for (size_t at = 0; at + size_t(npe) <= conn.size(); at += size_t(npe)) visit(sec.type, &conn[at], npe);
+  }
+
+  // Section s of zone z.
   Result readSection(const Zone& z, int s, Section& out) {
     char name[64] = {};
     int nbndry = 0, parentFlag = 0;
@@ -471,6 +500,7 @@ class CgnsReader {
         CG_OK)
       return fail(Status::Corrupt, zoneLabel(z) + ": section " + std::to_string(s) + ": " + lastCgnsError());
     out.where = zoneLabel(z) + " section '" + printable(name) + "'";
+    out.path = "/" + baseName_ + "/" + z.name + "/" + name;
     out.type = elementTypeName(int(out.etype));
     return Result::success();
   }
@@ -725,6 +755,20 @@ class CgnsReader {
       if (dataSize < 0) return fail(Status::Corrupt, where + ": " + std::to_string(dataSize) + " connectivity entries");
       if (Result r = checkCount(where + ": its connectivity size", uint64_t(dataSize), 4); !r) return r;
       std::vector<cgsize_t> conn(static_cast<size_t>(dataSize));
+      if (type == "MIXED" && z.window) {  // the window's elements, read and checked when it was chosen
+        auto kept = z.windowConnectivity.find(s);
+        if (reading == 0 || kept == z.windowConnectivity.end()) continue;
+        int64_t element = int64_t(first);
+        for (size_t at = 0; at < kept->second.size(); ++element) {
+          const cgsize_t* e = &kept->second[at];
+          const int entries = cgns::mixedEntries(e[0]);
+          const std::string name = elementTypeName(int(e[0]));
+          if (Result r = addElement(z, where, name, cgnsType(name), e + 1, entries - 1, element, soup); !r) return r;
+          at += size_t(entries);
+        }
+        z.windowConnectivity.erase(kept);
+        continue;
+      }
       if (type == "MIXED") {
         if (Result r = readMixed(z, s, where, start, count, conn, soup); !r) return r;
         continue;

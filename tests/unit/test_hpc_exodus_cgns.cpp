@@ -266,11 +266,14 @@ void damagedCopies(const std::string& file, const std::string& ext, bool& anyFai
       changed[at] = char(state >> 24);
     }
     ASSERT_TRUE(saveFile(copy, changed));
-    TetMesh m;
-    ReadReport r;
-    const Result res = readMesh(copy, m, r);
-    if (!res) {
-      EXPECT_NE(res.message.find(copy), std::string::npos) << res.message;
+    // Read whole, and as one process's share of three (a window of each zone, or a slab).
+    for (const ReadOptions& o : {ReadOptions{}, test::shareOf(1, 3)}) {
+      TetMesh m;
+      ReadReport r;
+      const Result res = readMesh(copy, m, r, o);
+      if (!res) {
+        EXPECT_NE(res.message.find(copy), std::string::npos) << res.message;
+      }
     }
   }
 }
@@ -681,6 +684,110 @@ TEST(CgnsShares, SharesOfShuffledVerticesReadOnlyTheVerticesTheirElementsUse) {
   }
 }
 
+// Writes `mesh` through the CGNS library as one unstructured zone with one MIXED section: its
+// tets (TETRA_4), and between them elements that are not read, a triangle (TRI_3) after every 7th
+// tet and a bar (BAR_2) after every 11th, with each element's ElementStartOffset, or with
+// `wrongOffsets` offsets that disagree with the types inside (as CGNS 3.4.0's tools write them).
+void writeCgnsMixed(const TetMesh& mesh, const std::string& path, bool wrongOffsets) {
+  std::vector<cgsize_t> conn, offsets{0};
+  auto add = [&](CGNS_ENUMT(ElementType_t) type, std::initializer_list<uint32_t> nodes) {
+    conn.push_back(cgsize_t(type));
+    for (uint32_t v : nodes) conn.push_back(cgsize_t(v + 1));
+    offsets.push_back(cgsize_t(conn.size()));
+  };
+  for (uint32_t t = 0; t < mesh.tetCount(); ++t) {
+    const uint32_t* v = &mesh.tets[4 * size_t(t)];
+    add(CGNS_ENUMV(TETRA_4), {v[0], v[1], v[2], v[3]});
+    if (t % 7 == 0) add(CGNS_ENUMV(TRI_3), {v[0], v[1], v[2]});
+    if (t % 11 == 0) add(CGNS_ENUMV(BAR_2), {v[0], v[3]});
+  }
+  const cgsize_t elements = cgsize_t(offsets.size() - 1);
+  if (wrongOffsets)
+    for (size_t k = 1; k + 1 < offsets.size(); ++k) offsets[k] += 1;
+  int fn = -1, base = 0, zone = 0, coord = 0, section = 0, sol = 0, field = 0;
+  ASSERT_EQ(cg_open(path.c_str(), CG_MODE_WRITE, &fn), CG_OK) << cg_get_error();
+  ASSERT_EQ(cg_base_write(fn, "Base", 3, 3, &base), CG_OK);
+  cgsize_t size[3] = {cgsize_t(mesh.vertexCount()), elements, 0};
+  ASSERT_EQ(cg_zone_write(fn, base, "mixed", size, CGNS_ENUMV(Unstructured), &zone), CG_OK);
+  for (int a = 0; a < 3; ++a) {
+    std::vector<double> x;
+    for (uint32_t v = 0; v < mesh.vertexCount(); ++v) x.push_back(mesh.positions[3 * size_t(v) + size_t(a)]);
+    const char* name[3] = {"CoordinateX", "CoordinateY", "CoordinateZ"};
+    ASSERT_EQ(cg_coord_write(fn, base, zone, CGNS_ENUMV(RealDouble), name[a], x.data(), &coord), CG_OK);
+  }
+  ASSERT_EQ(cg_poly_section_write(fn, base, zone, "Cells", CGNS_ENUMV(MIXED), 1, elements, 0, conn.data(),
+                                  offsets.data(), &section),
+            CG_OK)
+      << cg_get_error();
+  ASSERT_EQ(cg_sol_write(fn, base, zone, "Solution", CGNS_ENUMV(Vertex), &sol), CG_OK);
+  std::vector<double> values(mesh.fields[0].values.begin(), mesh.fields[0].values.end());
+  ASSERT_EQ(
+      cg_field_write(fn, base, zone, sol, CGNS_ENUMV(RealDouble), mesh.fields[0].name.c_str(), values.data(), &field),
+      CG_OK);
+  ASSERT_EQ(cg_close(fn), CG_OK);
+}
+
+// Sets the code of element `element` (0-based) of the MIXED section writeCgnsMixed wrote to
+// `code`, through HDF5 (the CGNS library refuses to write a code no element type has). The
+// element is found by the codes before it (the offsets may be wrong).
+void setMixedCode(const std::string& path, size_t element, int code) {
+  hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  hid_t conn = H5Dopen2(file, "/Base/mixed/Cells/ElementConnectivity/ data", H5P_DEFAULT);
+  ASSERT_GE(conn, 0);
+  std::vector<int64_t> c(size_t(H5Sget_simple_extent_npoints(H5Dget_space(conn))));
+  H5Dread(conn, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, c.data());
+  size_t at = 0;
+  for (size_t e = 0; e < element; ++e) {
+    int npe = 0;
+    ASSERT_EQ(cg_npe(CGNS_ENUMT(ElementType_t)(c[at]), &npe), CG_OK);
+    at += 1 + size_t(npe);
+  }
+  c[at] = code;
+  H5Dwrite(conn, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, c.data());
+  H5Dclose(conn);
+  H5Fclose(file);
+}
+
+// A MIXED section read by several processes: each reads the offsets of its own elements and the
+// connectivity they name, and only the vertices their corners use. Offsets that disagree with the
+// element types (CGNS 3.4.0's tools) are not trusted: the types are walked from the first element.
+// Either way the shares hold every tet of the whole once; so for the fixture whose MIXED zone
+// has such offsets, in ADF and HDF5.
+TEST(CgnsShares, MixedSectionsAreReadInWindows) {
+  ScratchDir dir("cgns-mixed");
+  const TetMesh mesh = test::shuffledPoints(test::harmonicMesh(7));
+  for (bool wrong : {false, true}) {
+    SCOPED_TRACE(wrong ? "offsets that disagree" : "offsets");
+    const std::string path = dir.path + (wrong ? "/wrong.cgns" : "/mixed.cgns");
+    writeCgnsMixed(mesh, path, wrong);
+    TetMesh whole;
+    ReadReport r;
+    ASSERT_TRUE(readMesh(path, whole, r)) << allNotes(r);
+    EXPECT_EQ(whole.tetCount(), mesh.tetCount());
+    for (uint32_t count : {2u, 3u, 5u}) {
+      test::expectSharesMakeTheWhole(path, count);
+      test::expectSharesReadOnlyUsedPoints(path, count, "vertices they use");
+    }
+    ASSERT_TRUE(readMesh(path, whole, r = ReadReport{}, test::shareOf(1, 3)));
+    EXPECT_EQ(hasNote(r, "found by their types, from the first element"), wrong) << allNotes(r);
+  }
+  for (const char* name : {"cgns_unstructured.cgns", "cgns_unstructured.adf.cgns"})
+    for (uint32_t count : {3u, 4u}) test::expectSharesMakeTheWhole(hpcPath(name), count);
+  // A code no element type has, in the last share's elements: that share and the whole refuse
+  // the file, naming the element; the first share never reaches it.
+  const std::string bad = dir.path + "/bad.cgns";
+  for (bool wrong : {false, true}) {
+    writeCgnsMixed(mesh, bad, wrong);
+    setMixedCode(bad, 1000, 99);
+    TetMesh m;
+    ReadReport r;
+    EXPECT_FAILS(readMesh(bad, m, r), Status::Corrupt, "element 1001 has element type code 99");
+    EXPECT_FAILS(readMesh(bad, m, r, test::shareOf(1, 2)), Status::Corrupt, "element 1001 has element type code 99");
+    EXPECT_TRUE(readMesh(bad, m, r, test::shareOf(0, 2)));
+  }
+}
+
 // A CGNS base of as many zones as processes or more: each reads its zones whole. A base of one
 // unstructured zone: each reads its elements and the vertices they use, with its rows of the
 // solutions (a time series here: the step's solution). Fewer structured zones than processes:
@@ -695,8 +802,8 @@ TEST(CgnsShares, EachProcessReadsItsZonesOrItsElements) {
   ReadReport r;
   ReadOptions o;
   o.shareIndex = 1;
-  o.shareCount = 3;  // more processes than zones: read whole
-  ASSERT_TRUE(readMesh(hpcPath("cgns_unstructured.cgns"), m, r, o));
+  o.shareCount = 5;  // more processes than zones and than layers of cells: read whole
+  ASSERT_TRUE(readMesh(hpcPath("cgns_structured.cgns"), m, r, o));
   EXPECT_FALSE(r.shared);
 }
 
