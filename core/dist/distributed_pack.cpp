@@ -263,6 +263,9 @@ Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& 
     uo.stream.ringWalk = opt.ringWalk;
     uo.stream.threads = opt.threads;
     uo.topIsRegion = u.group != 0;
+    // A rank's own part holds its input vertices at full resolution: its nodes' field error is
+    // measured there (a combined part holds coarse parts: its node keeps the estimate).
+    uo.measureAt = g.low < 0 ? &u.part.owned : nullptr;
     uo.vertexBegin = layout.vertexBegin[size_t(u.group)];
     uo.tetBegin = layout.tetBegin[size_t(u.group)];
     StableIds hand;  // stable ids of the handoff (and the values it starts from), in its order

@@ -255,6 +255,8 @@ Result writeDistributed(Comm& comm, const RankTree& tree, const UnitLayout& layo
       info.tetBegin = uint32_t(un.tetBegin), info.tetEnd = uint32_t(un.tetEnd);
       info.bounds = rep.nodeBounds[k];
       info.ranges = rep.nodeRanges[k];
+      info.fieldRms = un.fieldRms;
+      info.fieldMax = un.fieldMax;
       float own = 0;
       for (uint32_t c = un.firstChunk; c < un.firstChunk + un.chunkCount && c < rep.chunkError.size(); ++c)
         own = std::max(own, rep.chunkError[c]);
@@ -278,6 +280,10 @@ Result writeDistributed(Comm& comm, const RankTree& tree, const UnitLayout& layo
   if (m.nodes.size() <= 1) m.nodes.clear();  // (one region: one sequence, as packMesh writes it)
   m.chunks[0].fieldRms = measured.baseRms;
   m.chunks[0].fieldMax = measured.baseMax;
+  if (!m.nodes.empty()) {  // the root's region is the whole mesh, before its splits the base
+    m.nodes[0].fieldRms = measured.baseRms;
+    m.nodes[0].fieldMax = measured.baseMax;
+  }
   if (m.chunks.size() > 1) m.chunks.back().fieldRms = m.chunks.back().fieldMax = 0;  // (the input on the grid)
   m.vertices = m.chunks.back().vertices;
   m.tets = m.chunks.back().tets;

@@ -63,13 +63,24 @@ class Encoder {
   }
 
   // encodeUnit: the splits of a part's log from its handoff (split_encode.h). Nothing is
-  // compressed and no field error measured; the chunks are kept raw in `unit`.
+  // compressed; the chunks are kept raw in `unit`. The field error is measured by node at
+  // uo.measureAt only.
   Result runUnit(const UnitEncodeOptions& uo, UnitEncoded& unit) {
     unit_ = &unit;
     unitRoot_ = !uo.topIsRegion;
     if (Result r = buildHandoff(uo); !r) return r;
+    if (uo.measureAt) {
+      if (uo.measureAt->size() != mesh_.vertexCount())
+        return fail(Status::BadArgument, "encodeUnit: " + std::to_string(uo.measureAt->size()) +
+                                             " vertices to measure at for a part of " +
+                                             std::to_string(mesh_.vertexCount()));
+      measureAt_ = uo.measureAt;
+      startMeter(m_.findField(m_.isoField));
+    }
     planNodes();
-    if (Result r = encodeSplits(s_.log.size()); !r) return r;
+    Result r = encodeSplits(s_.log.size());
+    if (metered_) baseError();  // (the meter reads out_.base on another thread until then)
+    if (!r) return r;
     // Every vertex and tet alive at the part's start is in pm_ now: its stable id, for the units
     // whose handoffs are made of them.
     unit.startVertex.assign(out_.streamVertexOf.size(), kNoStable);
@@ -239,6 +250,11 @@ class Encoder {
       unitNode_.firstChunk = uint32_t(unit_->chunks.size());
       unitNode_.vertexBegin = stableVertexCount();
       unitNode_.tetBegin = stableTetCount();
+      if (metered_) {
+        measureLevel(n);
+        unitNode_.fieldRms = levelErrors_[n].rms;
+        unitNode_.fieldMax = levelErrors_[n].max;
+      }
       target_ = isRoot(n) ? opt_.firstChunkBytes : opt_.chunkBytes;
       return;
     }
@@ -251,27 +267,43 @@ class Encoder {
     info.bounds = stats_.bounds[n];
     info.ranges = stats_.ranges[n];
     info.fieldError = std::min(range_, stats_.fieldError[n]);
-    const uint32_t level = tree.depth ? tree.levelOf(n) : 0;
-    if (metered_ && level != measuredLevel_) {
-      measuredLevel_ = level;
-      levelErrors_.assign(tree.nodes(), LevelError{});
-      if (n == 1) {
-        levelErrors_[1] = baseError();
-      } else {
-        if (!jobs_.empty()) measure(jobs_.back().info);
-        const bool tree = s_.tree.depth > 0;
-        meter_.totalByGroup(
-            [&](uint32_t v) { return tree && s_.tree.leafOf[v] != ~0u ? s_.tree.nodeOf(v, level) : ~0u; },
-            levelErrors_);
-      }
-    }
     if (metered_) {
+      measureLevel(n);
       info.fieldRms = levelErrors_[n].rms;
       info.fieldMax = levelErrors_[n].max;
     }
     // The root's first chunk is small, for the first refinements to come soon after the base;
     // other nodes are fetched whole, chosen by what they show.
     target_ = isRoot(n) ? opt_.firstChunkBytes : opt_.chunkBytes;
+  }
+
+  // When node n begins a level of the tree, the field error of the mesh now by node of that level
+  // (levelErrors_), over the input vertices measured (a unit's measureAt_, else all): the whole
+  // base's for the root, then a measurement at each level (the one before it, for a stream: the
+  // last chunk's figures). A unit's first level is the handoff, which the meter located first.
+  void measureLevel(uint32_t n) {
+    const RegionTree& tree = s_.tree;
+    const uint32_t level = tree.depth ? tree.levelOf(n) : 0;
+    if (level == measuredLevel_) return;
+    const bool first = measuredLevel_ == ~0u;
+    measuredLevel_ = level;
+    levelErrors_.assign(std::max<uint32_t>(tree.nodes(), 2), LevelError{});
+    if (!unit_ && n == 1) {
+      levelErrors_[1] = baseError();
+      return;
+    }
+    baseError();  // (the meter has located the input's vertices)
+    if (unit_ && !first)
+      meter_.current(pm_.mesh, pm_.stars, opt_.threads);
+    else if (!unit_ && !jobs_.empty())
+      measure(jobs_.back().info);
+    meter_.totalByGroup(
+        [&](uint32_t v) {
+          if (measureAt_ && !(*measureAt_)[v]) return ~0u;
+          if (!tree.depth) return 1u;
+          return tree.leafOf[v] != ~0u ? tree.nodeOf(v, level) : ~0u;
+        },
+        levelErrors_);
   }
 
   // Node n of the tree is the whole mesh's root (a unit's top node is when its part is the root).
@@ -761,7 +793,8 @@ class Encoder {
   // encodeUnit only: where the chunks go, and the stable ids of pm_'s handoff (by pm_ id) and of
   // the unit's first new vertex and tet (stableVertex).
   UnitEncoded* unit_ = nullptr;
-  bool unitRoot_ = false;  // the unit's top node is the whole mesh's root
+  const std::vector<uint8_t>* measureAt_ = nullptr;  // the input vertices a unit measures at (null: all)
+  bool unitRoot_ = false;                            // the unit's top node is the whole mesh's root
   UnitNode unitNode_;
   std::vector<uint32_t> handoffVertexStable_, handoffTetStable_;
   uint64_t vertexBegin_ = 0, tetBegin_ = 0;

@@ -63,6 +63,11 @@ struct UnitEncodeOptions {
   // As SimplifyPart::topIsRegion: false, the part is the root and its top node's chunks start at
   // firstChunkBytes and taper like encodeStream's root; true, all its chunks aim at chunkBytes.
   bool topIsRegion = false;
+  // Per vertex of the part's mesh, whether to measure the field error there (level_error.h): the
+  // vertices a part of the input at full resolution owns, so that each of its nodes gets the
+  // measured error in its region before its splits (UnitNode::fieldRms, fieldMax), as
+  // encodeStream gives its nodes. Null: nothing measured (a part made of coarse parts).
+  const std::vector<uint8_t>* measureAt = nullptr;
 };
 
 // One split chunk, not yet compressed: its index in the manifest is known only once every unit
@@ -82,6 +87,8 @@ struct UnitNode {
   uint32_t node = 0;
   uint32_t firstChunk = 0, chunkCount = 0;                            // in UnitEncoded::chunks
   uint64_t vertexBegin = 0, vertexEnd = 0, tetBegin = 0, tetEnd = 0;  // stable ids
+  // Its field error before its splits, measured at UnitEncodeOptions::measureAt; -1 when not.
+  double fieldRms = -1, fieldMax = -1;
 };
 
 struct UnitEncoded {
@@ -105,7 +112,8 @@ struct UnitEncoded {
 // mesh as simplified: positions, fields). The stream's order within the unit is that of
 // encodeStream (its nodes' sections from the last to the first, each newest collapse first), and
 // chunk sizes aim at the same bytes with an assumed compression ratio (the real one is known only
-// after compression). No field error is measured (the optional fieldRms/fieldMax keys).
+// after compression). The field error is measured by node only with UnitEncodeOptions::measureAt,
+// never by chunk.
 // Stable ids are read where s.vertexAlive/s.tetAlive hold; each must be below vertexBegin/tetBegin
 // and none taken twice (BadArgument otherwise), and the unit's ids must stay below 2^31 (TooLarge).
 // Like encodeStream, it releases s.tets.

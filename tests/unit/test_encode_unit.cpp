@@ -393,6 +393,32 @@ TEST(EncodeUnit, OneUnitWithTheBaseIdsIsTheWholeStream) {
   }
 }
 
+// Measured at every vertex (a rank's own part measures at the vertices it owns, its input at full
+// resolution), a unit's nodes have encodeStream's measured field errors, to the bit: the same
+// level meshes, measured at the same points. Without vertices to measure at, none.
+TEST(EncodeUnit, NodesMeasuredAtTheirVerticesHaveTheStreamsErrors) {
+  const Simplified& c = simplified();
+  SimplifyResult s1 = c.s, s2 = c.s, s3 = c.s;
+  UnitEncodeOptions o = baseOrder(c.s);
+  const std::vector<uint8_t> all(c.in.mesh.vertexCount(), 1);
+  o.measureAt = &all;
+  UnitEncoded u, plain;
+  Result r = encodeUnit(c.in.mesh, s1, c.in.m, o, u);
+  ASSERT_TRUE(r) << r.message;
+  EncodedStream e;
+  ASSERT_TRUE(encodeStream(c.in.mesh, s2, c.in.m, smallChunks(), e));
+  ASSERT_EQ(u.nodes.size(), e.nodes.size());
+  for (size_t k = 0; k < u.nodes.size(); ++k) {
+    EXPECT_GE(e.nodes[k].fieldMax, 0) << "node " << k;
+    EXPECT_EQ(u.nodes[k].fieldRms, e.nodes[k].fieldRms) << "node " << k;
+    EXPECT_EQ(u.nodes[k].fieldMax, e.nodes[k].fieldMax) << "node " << k;
+  }
+  EXPECT_GT(e.nodes[0].fieldMax, e.nodes.back().fieldMax) << "the base is coarser than the last level";
+  o.measureAt = nullptr;
+  ASSERT_TRUE(encodeUnit(c.in.mesh, s3, c.in.m, o, plain));
+  for (const UnitNode& n : plain.nodes) EXPECT_EQ(n.fieldMax, -1);
+}
+
 // Stable ids with gaps (as where other units' vertices and tets come between), in the same order
 // as the base's: every order by id is the same, so the records differ in the ids they write and
 // nothing else. j is the gapped id of the same vertex in every record (the new vertices' ids
