@@ -40,8 +40,19 @@ bool mulOverflows(uint64_t a, uint64_t b, uint64_t& out) { return __builtin_mul_
 // (meshio does the same for compressed data, but encodes header+data as one string otherwise).
 class ByteSource {
  public:
+  // Of base64 text, the characters from `from` to `to` (offsets in it) hold no white space and no
+  // padding: skip() jumps over groups there. Kept by the caller for text read more than once.
+  struct PlainSpan {
+    size_t from = 0, to = 0;
+  };
+
   static ByteSource raw(std::string_view bytes) { return ByteSource(bytes, false); }
-  static ByteSource base64(std::string_view text) { return ByteSource(text, true); }
+  // `plain`: where this text was found plain before (it grows as skip() checks more); may be null.
+  static ByteSource base64(std::string_view text, PlainSpan* plain = nullptr) {
+    ByteSource s(text, true);
+    s.plain_ = plain;
+    return s;
+  }
 
   // An upper bound on the bytes still available (exact for raw data).
   uint64_t available() const {
@@ -78,8 +89,11 @@ class ByteSource {
     return true;
   }
 
-  // Passes over the next n bytes. Base64 text is decoded on the way (white space or padding
-  // may sit anywhere in it, so a character offset cannot be computed), into a small buffer.
+  // Passes over the next n bytes. Of base64 text, whole groups are jumped over, four characters
+  // for three bytes, where the text ahead holds no white space or padding (every writer's text
+  // inside one encoded string): a process reading a window of a large array decodes the window,
+  // not what comes before it. Elsewhere (white space or padding may sit anywhere, so a character
+  // offset cannot be computed) the text is decoded on the way, into a small buffer.
   bool skip(uint64_t n) {
     if (!b64_) {
       if (data_.size() - pos_ < n) {
@@ -89,6 +103,13 @@ class ByteSource {
       pos_ += size_t(n);
       return true;
     }
+    const size_t pending = size_t(std::min<uint64_t>(n, uint64_t(pendingCount_ - pendingPos_)));
+    pendingPos_ += int(pending);
+    n -= pending;
+    if (const uint64_t groups = n / 3; groups > 0 && groups <= (data_.size() - pos_) / 4 && plainAhead(4 * groups)) {
+      pos_ += size_t(4 * groups);
+      n -= 3 * groups;
+    }
     uint8_t scratch[3 * 4096];
     for (; n > 0;) {
       const size_t take = size_t(std::min<uint64_t>(n, sizeof scratch));
@@ -96,6 +117,22 @@ class ByteSource {
       n -= take;
     }
     return true;
+  }
+
+  // The text from here holds the payload's last `bytes` bytes. When what is left of it, less
+  // white space at its end, is exactly as many characters as those bytes take as one base64
+  // string, there is no room in it for white space or padding before its end: it is plain, and
+  // skip() jumps over it without looking (the inline arrays of VTK and meshio; text of another
+  // length, wrapped into lines for one, is looked at before a jump).
+  void claimPlain(uint64_t bytes) {
+    if (!b64_) return;
+    const uint64_t decoded = uint64_t(pendingCount_ - pendingPos_);
+    if (bytes < decoded) return;
+    size_t end = data_.size();
+    while (end > pos_ && meaning()[uint8_t(data_[end - 1])] == kSpace) --end;
+    if (end - pos_ != (bytes - decoded + 2) / 3 * 4) return;
+    if (!plain_) plain_ = &ownPlain_;
+    *plain_ = {pos_, end};
   }
 
   // The next n bytes where they are, for a raw source that holds them (no copy); else null,
@@ -126,6 +163,23 @@ class ByteSource {
       return t;
     }();
     return table;
+  }
+
+  // Whether the next `chars` characters hold no white space and no padding ('='). What was
+  // found plain is remembered (plain_), so that text read a window at a time is checked once.
+  bool plainAhead(size_t chars) {
+    PlainSpan here{pos_, pos_};
+    PlainSpan& known = plain_ && plain_->from <= pos_ && pos_ <= plain_->to ? *plain_ : here;
+    const size_t end = pos_ + chars;
+    for (size_t at = known.to; at < end;) {
+      const size_t step = std::min<size_t>(end - at, size_t(1) << 20);
+      for (char c : {' ', '\n', '\r', '\t', '='})
+        if (std::memchr(data_.data() + at, c, step)) return false;
+      at += step;
+      known.to = at;
+    }
+    if (plain_ && &known == &here) *plain_ = here;
+    return true;
   }
 
   // Decodes whole groups straight into dst while the text is plain base64, four characters a
@@ -187,6 +241,8 @@ class ByteSource {
   std::string_view data_;
   size_t pos_ = 0;
   bool b64_;
+  PlainSpan* plain_ = nullptr;
+  PlainSpan ownPlain_;  // (plain_ when the caller keeps none)
   uint8_t pending_[3] = {0, 0, 0};
   int pendingCount_ = 0, pendingPos_ = 0;
   std::string error_;
@@ -204,6 +260,9 @@ struct Vtu {
   std::string_view appended;  // after '_' up to </AppendedData>
   size_t fileBytes = 0;
   std::set<std::string> encodings;  // seen, for ReadReport::format
+  // Base64 text found plain so far, by where it starts (the file's or the XML's text, which stay
+  // where they are while the file is read): a share reads an array a window at a time.
+  std::map<const char*, ByteSource::PlainSpan> plainText;
 };
 
 // Message prefix for one DataArray: "a.vtu: DataArray 'offsets'" (+ " in Piece 2").
@@ -246,6 +305,7 @@ Result readPayload(const Vtu& vtu, ByteSource& src, const ArrayRef& ref, uint64_
     if (n > src.available())
       return fail(Status::Truncated, ref.str() + ": needs " + std::to_string(n) + " bytes, at most " +
                                          std::to_string(src.available()) + " remain");
+    src.claimPlain(n);
     if (!src.skip(begin)) return srcError("reading the data");
     if ((data = src.inPlace(end - begin))) return Result::success();
     bytes.resize(end - begin);
@@ -299,8 +359,10 @@ Result readPayload(const Vtu& vtu, ByteSource& src, const ArrayRef& ref, uint64_
   // The blocks that hold [begin, end): those before are passed over, those after never read.
   const uint64_t firstBlock = end > begin ? begin / blockSize : 0,
                  endBlock = end > begin ? (end - 1) / blockSize + 1 : 0;
-  for (uint64_t b = 0; b < firstBlock; ++b)
-    if (!src.skip(csize[b])) return srcError("reading a compressed block");
+  src.claimPlain(compressedTotal);
+  uint64_t before = 0;
+  for (uint64_t b = 0; b < firstBlock; ++b) before += csize[b];  // (no overflow: checked above)
+  if (!src.skip(before)) return srcError("reading a compressed block");
   bytes.resize(size_t((endBlock == nblocks ? total : endBlock * blockSize) - firstBlock * blockSize));
   std::vector<uint8_t> packed;
   uint64_t at = 0;
@@ -459,7 +521,8 @@ Result readDataArray(Vtu& vtu, pugi::xml_node da, const ArrayRef& ref, uint64_t 
   ByteSource src = ByteSource::raw({});
   if (format == "binary") {
     vtu.encodings.insert("inline base64");
-    src = ByteSource::base64(arrayText(vtu, da, storage));
+    const std::string_view text = arrayText(vtu, da, storage);
+    src = ByteSource::base64(text, text.data() == storage.data() ? nullptr : &vtu.plainText[text.data()]);
   } else if (format == "appended") {
     if (!vtu.hasAppended)
       return fail(Status::Corrupt, ref.str() + ": format=\"appended\" but the file has no <AppendedData> section");
@@ -471,8 +534,8 @@ Result readDataArray(Vtu& vtu, pugi::xml_node da, const ArrayRef& ref, uint64_t 
       return fail(Status::Truncated, ref.str() + ": offset " + std::to_string(offset) + " is beyond the " +
                                          std::to_string(vtu.appended.size()) + " bytes of appended data");
     vtu.encodings.insert(vtu.appendedBase64 ? "appended base64" : "appended raw");
-    src = vtu.appendedBase64 ? ByteSource::base64(vtu.appended.substr(offset))
-                             : ByteSource::raw(vtu.appended.substr(offset));
+    const std::string_view text = vtu.appended.substr(offset);
+    src = vtu.appendedBase64 ? ByteSource::base64(text, &vtu.plainText[text.data()]) : ByteSource::raw(text);
   } else {
     return fail(Status::Unsupported,
                 ref.str() + ": format '" + std::string(format) + "' (expected ascii, binary or appended)");
@@ -566,11 +629,12 @@ struct PieceRows {
   std::vector<uint64_t> pointPick;
 };
 
-// Whether a DataArray's rows can be read a window at a time for the cost of the window: appended
-// raw data (compressed or not) is reached by offset; text (ASCII, base64) would be decoded again
-// from the array's start for every window.
-bool readsByWindow(const Vtu& vtu, pugi::xml_node da) {
-  return std::string_view(da.attribute("format").value()) == "appended" && !vtu.appendedBase64;
+// Whether a DataArray's rows can be read a window at a time for the cost of the window: binary
+// data, raw or base64, inline or appended, compressed or not, is reached by offset (base64 text
+// by four characters for three bytes where it is plain: ByteSource::skip); ASCII text would be
+// parsed again from the array's start for every window.
+bool readsByWindow(const Vtu&, pugi::xml_node da) {
+  return std::string_view(da.attribute("format").value()) != "ascii";
 }
 
 // The values of rows `rows` of an array of `rowCount` rows of `comps` components each
@@ -767,7 +831,7 @@ Result readPiece(Vtu& vtu, GridKind kind, const Grid& whole, pugi::xml_node piec
   return readPieceData(vtu, piece, where, np, nc, report, notePieceConversions, out, rows);
 }
 
-// The points a share reads (io/row_pick.h): of appended raw data only those its cells use
+// The points a share reads (io/row_pick.h): of binary data only those its cells use
 // (rows.pointPick, read by readRows), else the run their ids span. `conn` is renumbered to the
 // points read.
 void pickUsedPoints(const Vtu& vtu, pugi::xml_node piece, std::vector<int64_t>& conn, PieceRows& rows) {

@@ -5,9 +5,11 @@
 // the same points, and the counts the writers recorded in expected.json. Then damaged and hostile
 // listings and pieces, each refused with a message that names the piece.
 #include <gtest/gtest.h>
+#include <zlib.h>
 
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -241,6 +243,112 @@ TEST(PartitionedReaders, SharesReadOnlyThePointsTheirCellsUse) {
     test::expectSharesMakeTheWhole(path, count, "");
     test::expectSharesReadOnlyUsedPoints(path, count, "points read for them");
   }
+}
+
+// Base64 of `bytes`; with `lineEvery`, a line break after every so many characters (as some
+// writers wrap their text).
+std::string base64(const std::vector<uint8_t>& bytes, size_t lineEvery = 0) {
+  static const char* alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (size_t k = 0; k < bytes.size(); k += 3) {
+    const uint32_t b = uint32_t(bytes[k]) << 16 | (k + 1 < bytes.size() ? uint32_t(bytes[k + 1]) << 8 : 0) |
+                       (k + 2 < bytes.size() ? bytes[k + 2] : 0);
+    out += alphabet[b >> 18 & 63];
+    out += alphabet[b >> 12 & 63];
+    out += k + 1 < bytes.size() ? alphabet[b >> 6 & 63] : '=';
+    out += k + 2 < bytes.size() ? alphabet[b & 63] : '=';
+  }
+  if (!lineEvery) return out;
+  std::string wrapped;
+  for (size_t k = 0; k < out.size(); k += lineEvery) wrapped += out.substr(k, lineEvery) + "\n";
+  return wrapped;
+}
+
+// One DataArray's payload as VTK encodes it with UInt64 headers: the byte count and the data, or
+// (zlib) the block count, block size, last block's size and each block's compressed size, then
+// the blocks. Base64 text: the header and the blocks encoded apart, as VTK does for zlib data.
+template <class T>
+std::string encodedArray(const std::vector<T>& values, bool zlib, size_t lineEvery) {
+  std::vector<uint8_t> data(values.size() * sizeof(T));
+  std::memcpy(data.data(), values.data(), data.size());
+  auto words = [](std::initializer_list<uint64_t> w, std::vector<uint8_t>& out) {
+    for (uint64_t x : w) out.insert(out.end(), reinterpret_cast<uint8_t*>(&x), reinterpret_cast<uint8_t*>(&x) + 8);
+  };
+  std::vector<uint8_t> header;
+  if (!zlib) {
+    words({data.size()}, header);
+    header.insert(header.end(), data.begin(), data.end());
+    return base64(header, lineEvery);
+  }
+  const size_t block = 4096, blocks = (data.size() + block - 1) / block;
+  std::vector<uint8_t> packed;
+  words({blocks, block, data.size() - (blocks - 1) * block}, header);
+  for (size_t b = 0; b < blocks; ++b) {
+    const size_t n = std::min(block, data.size() - b * block);
+    uLongf size = compressBound(uLong(n));
+    std::vector<uint8_t> out(size);
+    EXPECT_EQ(compress(out.data(), &size, data.data() + b * block, uLong(n)), Z_OK);
+    words({size}, header);
+    packed.insert(packed.end(), out.begin(), out.begin() + std::ptrdiff_t(size));
+  }
+  return base64(header, lineEvery) + base64(packed, lineEvery);
+}
+
+// `mesh` as a .vtu of base64 data, as VTK, ParaView and meshio write it: inline or appended,
+// plain or zlib-compressed in blocks, its text on one line or wrapped.
+void writeBase64Vtu(const TetMesh& mesh, const std::string& path, bool appended, bool zlib, size_t lineEvery = 0) {
+  std::vector<int64_t> conn(mesh.tets.begin(), mesh.tets.end()), offsets;
+  std::vector<uint8_t> types(mesh.tetCount(), 10);
+  for (uint32_t t = 1; t <= mesh.tetCount(); ++t) offsets.push_back(4 * int64_t(t));
+  std::string tail;  // appended data
+  auto array = [&](const std::string& head, const std::string& text) {
+    if (!appended) return "<DataArray " + head + " format=\"binary\">\n" + text + "\n</DataArray>\n";
+    const std::string tag =
+        "<DataArray " + head + " format=\"appended\" offset=\"" + std::to_string(tail.size()) + "\"/>\n";
+    tail += text;
+    return tag;
+  };
+  std::string xml = std::string("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" ") +
+                    "byte_order=\"LittleEndian\" header_type=\"UInt64\"" +
+                    (zlib ? " compressor=\"vtkZLibDataCompressor\"" : "") + ">\n<UnstructuredGrid>\n<Piece " +
+                    "NumberOfPoints=\"" + std::to_string(mesh.vertexCount()) + "\" NumberOfCells=\"" +
+                    std::to_string(mesh.tetCount()) + "\">\n<PointData>\n";
+  xml += array("type=\"Float32\" Name=\"" + mesh.fields[0].name + "\"",
+               encodedArray(mesh.fields[0].values, zlib, lineEvery));
+  xml += "</PointData>\n<Points>\n";
+  xml += array("type=\"Float32\" NumberOfComponents=\"3\"", encodedArray(mesh.positions, zlib, lineEvery));
+  xml += "</Points>\n<Cells>\n";
+  xml += array("type=\"Int64\" Name=\"connectivity\"", encodedArray(conn, zlib, lineEvery));
+  xml += array("type=\"Int64\" Name=\"offsets\"", encodedArray(offsets, zlib, lineEvery));
+  xml += array("type=\"UInt8\" Name=\"types\"", encodedArray(types, zlib, lineEvery));
+  xml += "</Cells>\n</Piece>\n</UnstructuredGrid>\n";
+  if (appended) xml += "<AppendedData encoding=\"base64\">\n_" + tail + "\n</AppendedData>\n";
+  xml += "</VTKFile>\n";
+  ASSERT_TRUE(saveFile(path, xml));
+}
+
+// Base64 data, inline or appended, plain or compressed: a share reads only the points its cells
+// use too, jumping over the text before each window where it holds no line breaks, decoding its
+// way through where it does; the shares make the whole either way.
+TEST(PartitionedReaders, SharesOfBase64DataReadOnlyThePointsTheirCellsUse) {
+  const TetMesh shuffled = test::shuffledPoints(test::harmonicMesh(12));
+  const std::string dir = test::suiteDir("PartitionedReaders", "base64");
+  for (bool appended : {false, true})
+    for (bool zlib : {false, true})
+      for (size_t lineEvery : {size_t(0), size_t(76)}) {
+        const std::string path = dir + "/shuffled-" + (appended ? "appended" : "inline") + (zlib ? "-zlib" : "") +
+                                 (lineEvery ? "-wrapped" : "") + ".vtu";
+        SCOPED_TRACE(path);
+        writeBase64Vtu(shuffled, path, appended, zlib, lineEvery);
+        TetMesh whole;
+        ReadReport r;
+        ASSERT_TRUE(readMesh(path, whole, r)) << allNotes(r);
+        ASSERT_EQ(whole.tetCount(), shuffled.tetCount());
+        for (uint32_t count : {2u, 3u}) {
+          test::expectSharesMakeTheWhole(path, count, "");
+          test::expectSharesReadOnlyUsedPoints(path, count, "points read for them");
+        }
+      }
 }
 
 // A .vti or .vts of fewer pieces than processes: each reads a slab of layers of cells along k
