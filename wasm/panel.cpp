@@ -178,31 +178,29 @@ void levelSection(PageState& s, float width, float pixelsPerCssPixel) {
   std::snprintf(pct, sizeof pct, " (%.1f%%)", 100 * r.level);
   row("vertices", grouped(nv) + (nv != m.vertices ? " of " + grouped(m.vertices) + pct : ""));
   row("tets", grouped(nt) + (nt != m.tets ? " of " + grouped(m.tets) : ""));
-  // The error of the field that steered the simplification: measured at the input's vertices
-  // when the manifest has it, the simplifier's estimate otherwise.
+  // The error of the field that steered the simplification, in its units: measured at the
+  // input's vertices when the manifest has it (RMS and max of a level of the stream; the max alone
+  // where a set of nodes made the mesh), the simplifier's estimate otherwise.
   const int iso = m.findField(m.isoField);
-  const double err = r.fieldError;
-  if (r.fieldRms >= 0 && r.fieldMax >= 0 && iso >= 0) {
+  if (iso >= 0 && (r.fieldMax >= 0 || r.fieldError >= 0)) {
     const Range range = m.fields[size_t(iso)].range;
-    char buf[96];
     const double span = range.max - range.min;
-    if (r.fieldMax == 0)
+    char buf[96];
+    if (r.fieldMax == 0 || (r.fieldMax < 0 && r.fieldError == 0))
       std::snprintf(buf, sizeof buf, "none (full mesh)");
-    else if (span > 0)
+    else if (r.fieldMax >= 0 && r.fieldRms >= 0 && span > 0)
       std::snprintf(buf, sizeof buf, "RMS %.2g%%, max %.2g%% of range", 100 * r.fieldRms / span,
                     100 * r.fieldMax / span);
-    else
+    else if (r.fieldMax >= 0 && r.fieldRms >= 0)
       std::snprintf(buf, sizeof buf, "RMS %.3g, max %.3g", r.fieldRms, r.fieldMax);
-    row("field error", buf);
-  } else if (err >= 0 && s.settings.field >= 0) {
-    const Range range = m.fields[size_t(s.settings.field)].range;
-    char buf[64];
-    if (err == 0)
-      std::snprintf(buf, sizeof buf, "none (full mesh)");
-    else if (range.max > range.min)
-      std::snprintf(buf, sizeof buf, "up to %.3g (%.2g%% of range)", err, 100 * err / (range.max - range.min));
+    else if (r.fieldMax >= 0 && span > 0)
+      std::snprintf(buf, sizeof buf, "max %.2g%% of range", 100 * r.fieldMax / span);
+    else if (r.fieldMax >= 0)
+      std::snprintf(buf, sizeof buf, "max %.3g", r.fieldMax);
+    else if (span > 0)
+      std::snprintf(buf, sizeof buf, "up to %.3g (%.2g%% of range)", r.fieldError, 100 * r.fieldError / span);
     else
-      std::snprintf(buf, sizeof buf, "up to %.3g", err);
+      std::snprintf(buf, sizeof buf, "up to %.3g", r.fieldError);
     row("field error", buf);
   }
 }

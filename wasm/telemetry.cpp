@@ -15,10 +15,10 @@ std::string statsJson(const ViewerState& s) {
   for (const FieldInfo& f : m.fields)
     fields.push_back(json{{"name", f.name}, {"min", f.range.min}, {"max", f.range.max}});
   auto rect = [](const Rect& r) { return json{{"x", r.x}, {"y", r.y}, {"w", r.w}, {"h", r.h}}; };
-  auto time = [](double t) { return t >= 0 ? json(t) : json(nullptr); };
+  auto known = [](double x) { return x >= 0 ? json(x) : json(nullptr); };  // (-1: not known)
   uint32_t splitsTotal = 0;
   for (size_t c = 1; c < m.chunks.size(); ++c) splitsTotal += m.chunks[c].splits;
-  const double fieldError = fieldErrorBound(s);
+  const ShownError fieldError = shownFieldError(s);
   // The view a link keeps (field, isovalue, colour, slice, showBoundary), then everything else;
   // "level" here is the level shown, not the one asked for.
   json j = viewObject(s);
@@ -55,14 +55,14 @@ std::string statsJson(const ViewerState& s) {
       {"level", levelFraction(s)},
       {"live", s.level.live},
       {"paused", s.network.paused},
-      {"fieldError", fieldError >= 0 ? json(fieldError) : json(nullptr)},
-      {"fieldRms", levelChunk(s) && levelChunk(s)->fieldRms >= 0 ? json(levelChunk(s)->fieldRms) : json(nullptr)},
-      {"fieldMax", levelChunk(s) && levelChunk(s)->fieldMax >= 0 ? json(levelChunk(s)->fieldMax) : json(nullptr)},
+      {"fieldError", known(fieldError.estimate)},
+      {"fieldRms", known(fieldError.rms)},
+      {"fieldMax", known(fieldError.max)},
       {"baseVertices", ds.pm.baseVertices},
       {"hullTriangles", s.hull.triangleCount()},
       {"hullLines", s.hull.lineCount()},
-      {"firstSurfaceMs", time(s.telemetry.firstSurfaceMs)},
-      {"completeMs", time(s.telemetry.completeMs)},
+      {"firstSurfaceMs", known(s.telemetry.firstSurfaceMs)},
+      {"completeMs", known(s.telemetry.completeMs)},
       {"extractMs", s.telemetry.extractMs},
       {"refineMs", s.telemetry.refineMs},
       {"maxRefineMs", s.telemetry.maxRefineMs},

@@ -554,9 +554,37 @@ double targetLevel(const ViewerState& s) {
   return m.vertices ? double(s.dataset.pm.baseVertices + s.level.targetSplits) / m.vertices : 0.0;
 }
 
-double fieldErrorBound(const ViewerState& s) {
-  const ChunkInfo* c = levelChunk(s);
-  return c ? c->fieldError : -1;
+ShownError shownFieldError(const ViewerState& s) {
+  ShownError e;
+  if (const ChunkInfo* c = levelChunk(s)) {
+    e.estimate = c->fieldError;
+    e.rms = c->fieldRms;
+    e.max = c->fieldMax;
+    return e;
+  }
+  const Dataset& ds = s.dataset;
+  const Manifest& m = ds.manifest;
+  if (m.nodes.empty() || ds.chunksReceived == 0) return e;
+  // A node is applied when every split of its chunks is.
+  std::vector<uint8_t> chunkApplied(m.chunks.size(), 0);
+  for (uint32_t p = 0; p < ds.chunksApplied() && p < ds.received.size(); ++p) chunkApplied[ds.received[p]] = 1;
+  std::vector<uint8_t> applied(m.nodes.size(), 0);
+  for (size_t k = 0; k < m.nodes.size(); ++k) {
+    applied[k] = 1;
+    for (uint32_t c = m.nodes[k].firstChunk; c < m.nodes[k].firstChunk + m.nodes[k].chunkCount; ++c)
+      applied[k] &= chunkApplied[c];
+  }
+  e.estimate = e.max = 0;
+  bool measured = true;
+  for (size_t k = 0; k < m.nodes.size(); ++k) {
+    const NodeInfo& n = m.nodes[k];
+    if (applied[k] || (n.parent >= 0 && !applied[size_t(n.parent)])) continue;
+    e.estimate = std::max(e.estimate, n.fieldError);
+    measured = measured && n.fieldMax >= 0;
+    e.max = std::max(e.max, n.fieldMax);
+  }
+  if (!measured) e.max = -1;
+  return e;
 }
 
 const ChunkInfo* levelChunk(const ViewerState& s) {

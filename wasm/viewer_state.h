@@ -226,10 +226,21 @@ uint64_t memoryInUse(const ViewerState& s);
 // Derived figures for panel and stats.
 double levelFraction(const ViewerState& s);         // vertices shown / vertices of the full mesh
 double targetLevel(const ViewerState& s);           // the level asked for, as levelFraction; 1 while live
-double fieldErrorBound(const ViewerState& s);       // manifest estimate for the last complete chunk
 const ChunkInfo* levelChunk(const ViewerState& s);  // the last complete chunk (its measured errors), or null
-bool downloading(const ViewerState& s);             // chunks still to fetch, not paused, no error
-bool refining(const ViewerState& s);                // splits to apply or undo toward the target
+
+// The field error of the mesh shown (-1 where not known). A level of the stream in manifest order
+// has its last chunk's figures (levelChunk). A set of nodes (a plan) has the largest error of the
+// regions still before their splits: each node not applied whose parent is (or the root) has its
+// error before its splits in the manifest, whatever other regions hold, since a region's splits
+// change nothing outside it; a region all of whose nodes are applied is at full resolution. Its
+// RMS is not known (nodes do not count their input vertices); `max` is measured when every such
+// node has the measured figure, `estimate` is the simplifier's.
+struct ShownError {
+  double estimate = -1, rms = -1, max = -1;
+};
+ShownError shownFieldError(const ViewerState& s);
+bool downloading(const ViewerState& s);  // chunks still to fetch, not paused, no error
+bool refining(const ViewerState& s);     // splits to apply or undo toward the target
 
 // The interval tree (paper §4.2) is not kept while a level streams in: each split would cost a
 // third more, for isovalue changes that meanwhile test every tet (~10 ms at 1.5M tets in

@@ -242,7 +242,6 @@ class Encoder {
   // A node's first split is next: its manifest entry starts, and when it begins a level of the
   // tree, the field error of the mesh now (the previous level's last chunk) is measured, by node.
   void beginNode() {
-    const RegionTree& tree = s_.tree;
     const uint32_t n = spans_[span_].node;
     if (unit_) {
       unitNode_ = UnitNode{};

@@ -10,7 +10,7 @@ import os from 'node:os';
 import path from 'node:path';
 import { createServer } from '../support/server.mjs';
 import {
-  webDir, checkBuilds, launchBrowser, cli, makePack, cliIso, readManifest, assertSurfaceMatches, openViewer,
+  webDir, outDir, checkBuilds, launchBrowser, cli, makePack, cliIso, readManifest, assertSurfaceMatches, openViewer,
 } from './support.mjs';
 
 let tmp, dir, manifest, browser;
@@ -64,6 +64,10 @@ test('only the nodes the isovalue needs are fetched; the surface is exact, and a
     assert.equal(s.nodesLoaded, need.nodes, 'the nodes the CLI needed');
     assert.ok(s.bytesReceived < 0.8 * s.bytesTotal, `part of the dataset: ${s.bytesReceived} of ${s.bytesTotal}`);
     assert.equal(s.nodesTotal, manifest.nodes.length);
+    // The field error shown: the largest measured of the regions not refined, below the base's.
+    assert.ok(s.fieldMax > 0 && s.fieldMax < manifest.chunks[0].fieldMax, `field error ${s.fieldMax}`);
+    assert.equal(s.fieldRms, null, 'no RMS for a set of nodes');
+    await page.screenshot({ path: path.join(outDir, 'viewer-selective-exact.png') });
     const first = s.bytesReceived;
 
     // Dragging the isovalue re-plans: more nodes come and the surface is exact again.
@@ -84,6 +88,7 @@ test('only the nodes the isovalue needs are fetched; the surface is exact, and a
     assert.equal(s.nodesLoaded, s.nodesTotal);
     assert.equal(s.bytesReceived, s.bytesTotal);
     assert.ok(s.exact);
+    assert.equal(s.fieldMax, 0, 'every region refined');
     assertSurfaceMatches(s, cliIso(s.isovalue, { dir }), 'everything');
     assert.deepEqual(problems, []);
     await page.close();

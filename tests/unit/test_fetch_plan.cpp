@@ -279,3 +279,49 @@ TEST(FetchPlan, RegionsTheViewNoLongerNeedsAreGivenBackWhenMemoryIsShort) {
   EXPECT_LT(s.dataset.chunksReceived, m.chunks.size());
   expectFullResolutionSurface(s, whole.pm.mesh, "everything asked for");
 }
+
+// Where a plan of nodes made the mesh, the field error shown is the largest of the regions not yet
+// refined, each's measured error before its splits: the base's with the base alone, what a brute
+// force finds at every input vertex once the nodes an isovalue needs are in, none with everything.
+TEST(FetchPlan, TheFieldErrorShownIsTheLargestOfTheRegionsNotRefined) {
+  ViewerState s;
+  ASSERT_TRUE(openManifest(s, packedNodes().manifest).ok());
+  const Manifest& m = s.dataset.manifest;
+  const Range range = m.fields[0].range;
+  const double step = (range.max - range.min) / 65535.0;  // (the input is measured on the grid)
+  setIsovalue(s, range.min + 0.8f * (range.max - range.min));
+  offer(s, 0);
+  ShownError e = shownFieldError(s);
+  EXPECT_EQ(e.max, m.nodes[0].fieldMax);
+  EXPECT_EQ(e.max, m.chunks[0].fieldMax) << "the root's error before its splits is the base's";
+  EXPECT_EQ(e.estimate, m.nodes[0].fieldError);
+  EXPECT_EQ(e.rms, m.chunks[0].fieldRms) << "the base is a level of the stream";
+
+  for (uint32_t c : plannedChunks(s, ~0u))
+    if (c != 0) offer(s, c);
+  for (int k = 0; k < 100000 && refining(s); ++k) advance(s, g_ticks + 50, fakeNow);
+  ASSERT_TRUE(exactSurface(s));
+  TetMesh input = makeGridMesh(16);
+  addHarmonicField(input);
+  const TetMesh& shown = s.dataset.pm.mesh;
+  double largest = 0;
+  for (uint32_t v = 0; v < input.vertexCount(); ++v) {
+    uint32_t tet = 0;
+    double w[4] = {}, value = 0;
+    test::bestTet(shown, &input.positions[3 * size_t(v)], tet, w);
+    for (int c = 0; c < 4; ++c) value += w[c] * shown.fields[0].values[shown.tets[4 * size_t(tet) + size_t(c)]];
+    largest = std::max(largest, std::abs(value - input.fields[0].values[v]));
+  }
+  e = shownFieldError(s);
+  EXPECT_EQ(e.rms, -1) << "not known for a set of nodes";
+  EXPECT_NEAR(e.max, largest, 3 * step);
+  EXPECT_GT(e.max, 20 * step) << "regions the isovalue does not need are coarse";
+  EXPECT_LT(e.max, m.nodes[0].fieldMax);
+
+  setFetchMode(s, FetchMode::Everything);
+  for (uint32_t c : plannedChunks(s, ~0u)) offer(s, c);
+  for (int k = 0; k < 100000 && refining(s); ++k) advance(s, g_ticks + 50, fakeNow);
+  e = shownFieldError(s);
+  EXPECT_EQ(e.max, 0);
+  EXPECT_EQ(e.estimate, 0);
+}
