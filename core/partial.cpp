@@ -17,6 +17,20 @@ std::vector<uint32_t> nodesForIsovalue(const Manifest& m, int field, float isova
   return out;
 }
 
+FrontierError frontierFieldError(const Manifest& m, std::span<const uint8_t> applied) {
+  FrontierError e;
+  bool measured = true;
+  for (size_t k = 0; k < m.nodes.size() && k < applied.size(); ++k) {
+    const NodeInfo& n = m.nodes[k];
+    if (applied[k] || (n.parent >= 0 && !applied[size_t(n.parent)])) continue;
+    e.estimate = std::max(e.estimate, n.fieldError);
+    measured = measured && n.fieldMax >= 0;
+    e.measured = std::max(e.measured, n.fieldMax);
+  }
+  if (!measured) e.measured = -1;
+  return e;
+}
+
 std::vector<uint32_t> withAncestors(const Manifest& m, std::span<const uint32_t> nodes) {
   std::vector<uint8_t> in(m.nodes.size(), 0);
   for (uint32_t k : nodes)

@@ -30,6 +30,17 @@ std::vector<uint32_t> nodesForIsovalue(const Manifest& m, int field, float isova
 // Closes a set of nodes under "parent of": adds every ancestor, ascending.
 std::vector<uint32_t> withAncestors(const Manifest& m, std::span<const uint32_t> nodes);
 
+// The largest field error of a mesh made of the applied nodes (applied[k] per node): of the
+// regions still before their splits (each node not applied whose parent is, or the root), the
+// error before them. A region's splits change nothing outside it, so each such node's manifest
+// figure holds whatever the other regions hold; where every node is applied the mesh is the
+// input. `measured`: from NodeInfo::fieldMax, -1 when one of those nodes lacks it; `estimate`:
+// from NodeInfo::fieldError.
+struct FrontierError {
+  double estimate = 0, measured = 0;
+};
+FrontierError frontierFieldError(const Manifest& m, std::span<const uint8_t> applied);
+
 struct PartialDataset {
   static constexpr uint32_t kNotLoaded = ~0u;
   Manifest manifest;

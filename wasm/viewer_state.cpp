@@ -10,6 +10,7 @@
 
 #include "adjacency.h"
 #include "hash.h"
+#include "partial.h"
 #include "tet_tables.h"
 #include "view_settings.h"
 #include "viewer_memory.h"
@@ -574,16 +575,9 @@ ShownError shownFieldError(const ViewerState& s) {
     for (uint32_t c = m.nodes[k].firstChunk; c < m.nodes[k].firstChunk + m.nodes[k].chunkCount; ++c)
       applied[k] &= chunkApplied[c];
   }
-  e.estimate = e.max = 0;
-  bool measured = true;
-  for (size_t k = 0; k < m.nodes.size(); ++k) {
-    const NodeInfo& n = m.nodes[k];
-    if (applied[k] || (n.parent >= 0 && !applied[size_t(n.parent)])) continue;
-    e.estimate = std::max(e.estimate, n.fieldError);
-    measured = measured && n.fieldMax >= 0;
-    e.max = std::max(e.max, n.fieldMax);
-  }
-  if (!measured) e.max = -1;
+  const FrontierError f = frontierFieldError(m, applied);
+  e.estimate = f.estimate;
+  e.max = f.measured;
   return e;
 }
 

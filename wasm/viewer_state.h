@@ -229,12 +229,9 @@ double targetLevel(const ViewerState& s);           // the level asked for, as l
 const ChunkInfo* levelChunk(const ViewerState& s);  // the last complete chunk (its measured errors), or null
 
 // The field error of the mesh shown (-1 where not known). A level of the stream in manifest order
-// has its last chunk's figures (levelChunk). A set of nodes (a plan) has the largest error of the
-// regions still before their splits: each node not applied whose parent is (or the root) has its
-// error before its splits in the manifest, whatever other regions hold, since a region's splits
-// change nothing outside it; a region all of whose nodes are applied is at full resolution. Its
-// RMS is not known (nodes do not count their input vertices); `max` is measured when every such
-// node has the measured figure, `estimate` is the simplifier's.
+// has its last chunk's figures (levelChunk); a set of nodes (a plan) the largest of the regions
+// still before their splits (partial.h's frontierFieldError), without an RMS (nodes do not count
+// their input vertices).
 struct ShownError {
   double estimate = -1, rms = -1, max = -1;
 };

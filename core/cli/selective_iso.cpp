@@ -38,6 +38,11 @@ int runSelectiveIso(const SelectiveIsoOptions& o) {
     applied = uint32_t(pd.applied.size());
   }
   const double loadMs = sw.ms();
+  // The error of the field that steered the simplification, of the mesh loaded: in the regions
+  // the isovalue did not need refined (none of another field is in the manifest).
+  std::vector<uint8_t> loaded(m.nodes.size(), 0);
+  for (uint32_t k : pd.applied) loaded[k] = 1;
+  const double elsewhere = f == m.findField(m.isoField) ? frontierFieldError(m, loaded).measured : -1;
   Input whole;
   if ((o.check || !hierarchy))
     if (Result r = loadInput(o.dir, whole); !r) return reportError(r, o.json);
@@ -69,6 +74,7 @@ int runSelectiveIso(const SelectiveIsoOptions& o) {
               {"nodesTotal", m.nodes.size()},
               {"tets", mesh.tetCount()},
               {"tetsTotal", m.tets},
+              {"fieldMax", elsewhere >= 0 ? json(elsewhere) : json(nullptr)},
               {"loadMs", loadMs}};
     if (o.check) j["exact"] = exact;
     if (o.check && hierarchy) j["trianglesFull"] = reference.triangleCount();
@@ -79,6 +85,11 @@ int runSelectiveIso(const SelectiveIsoOptions& o) {
     std::printf("  needed    %u of %zu nodes, %.2f of %.2f MB (%.1f%%), %u of %u tets (%.0f ms)\n", applied,
                 m.nodes.size(), bytes / 1e6, total / 1e6, 100.0 * double(bytes) / double(total), mesh.tetCount(),
                 m.tets, loadMs);
+    if (hierarchy && elsewhere >= 0) {
+      const Range r = m.fields[size_t(f)].range;
+      std::printf("  elsewhere field error up to %.3g (%.2g%% of the range) in the regions left coarse\n", elsewhere,
+                  r.max > r.min ? 100 * elsewhere / (double(r.max) - r.min) : 0.0);
+    }
     if (!hierarchy) std::printf("  note      this dataset has no patch hierarchy: every chunk is needed\n");
     if (o.check)
       std::printf("  check     %s\n",

@@ -761,7 +761,9 @@ class CgnsReader {
         int64_t element = int64_t(first);
         for (size_t at = 0; at < kept->second.size(); ++element) {
           const cgsize_t* e = &kept->second[at];
-          const int entries = cgns::mixedEntries(e[0]);
+          const int entries = cgns::mixedEntries(e[0]);  // (checked as the window was read)
+          if (entries == 0 || size_t(entries) > kept->second.size() - at)
+            return fail(Status::Corrupt, where + ": element " + std::to_string(element) + " is damaged");
           const std::string name = elementTypeName(int(e[0]));
           if (Result r = addElement(z, where, name, cgnsType(name), e + 1, entries - 1, element, soup); !r) return r;
           at += size_t(entries);
