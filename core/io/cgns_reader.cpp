@@ -30,8 +30,9 @@
 // of fewer structured zones than processes, each at least `count` cells deep along its longest
 // index direction: of every zone the cells of layers index·L/count to (index + 1)·L/count along it
 // and their points (the layer where two processes' slabs meet is read by both, and joined by
-// core/dist). Other bases of fewer zones than processes (structured and unstructured zones
-// together) are read whole by every process.
+// core/dist). Of fewer zones than processes, structured and unstructured together, the slabs of
+// the one and the windows of the other. A base of fewer zones than processes with a structured
+// zone thinner than that is read whole by every process.
 #include <cgnslib.h>
 
 #include <algorithm>
@@ -325,14 +326,11 @@ class CgnsReader {
     return Result::success();
   }
 
-  // For one process of several, its zones only, its window of a single unstructured zone, or its
-  // slab of each of fewer structured zones (the header comment), numbered from its first.
+  // For one process of several, its zones only, or of fewer zones than processes its share of
+  // each (the header comment), numbered from its first.
   Result keepShareOfZones() {
     const uint64_t n = options_.shareCount, z = zones_.size();
-    const bool unstructured =
-        std::none_of(zones_.begin(), zones_.end(), [](const Zone& zone) { return zone.structured; });
-    if (n >= 2 && z < n && unstructured) return keepWindowsOfZones();
-    if (n >= 2 && z < n) return keepSlabsOfZones();
+    if (n >= 2 && z < n) return keepSharesOfZones();
     if (n < 2) return Result::success();
     const uint64_t from = z * options_.shareIndex / n, to = z * (options_.shareIndex + 1) / n;
     zones_ = std::vector<Zone>(zones_.begin() + std::ptrdiff_t(from), zones_.begin() + std::ptrdiff_t(to));
@@ -357,53 +355,63 @@ class CgnsReader {
     }
   }
 
-  // Of fewer structured zones than processes, each process's slab of every zone (the header
-  // comment), when every zone is deep enough for a layer of cells each; else all whole.
-  Result keepSlabsOfZones() {
-    const uint64_t n = options_.shareCount, k = options_.shareIndex;
-    auto longest = [](const Zone& z) { return int(std::max_element(z.dims, z.dims + 3) - z.dims); };
+  static int longestAxis(const Zone& z) { return int(std::max_element(z.dims, z.dims + 3) - z.dims); }
+
+  // Of fewer zones than processes, each process's share of every zone: a slab of a structured
+  // zone, a window of an unstructured one (the header comment); every zone whole when a
+  // structured one is too thin to give each process a layer of cells.
+  Result keepSharesOfZones() {
+    const uint64_t n = options_.shareCount;
     for (const Zone& z : zones_)
-      if (!z.structured || z.dims[longest(z)] - 1 < n) return Result::success();
-    uint64_t layers = 0, cellLayers = 0;
+      if (z.structured && z.dims[longestAxis(z)] - 1 < n) return Result::success();
+    uint64_t layers = 0, cellLayers = 0, elements = 0;
     for (Zone& z : zones_) {
-      const int a = longest(z);
-      const uint64_t K = z.dims[a] - 1, from = K * k / n, to = K * (k + 1) / n;
-      z.slabAxis = a;
-      z.slabFirst = from;
-      z.dims[a] = to - from + 1;
-      z.vertices = z.vertexCount = z.dims[0] * z.dims[1] * z.dims[2];
-      z.cells = z.cellCount = (z.dims[0] - 1) * (z.dims[1] - 1) * (z.dims[2] - 1);
-      layers += K;
-      cellLayers += to - from;
+      if (z.structured) {
+        slabOfZone(z, layers, cellLayers);
+      } else {
+        elements += z.cells;
+        if (Result r = windowOfZone(z); !r) return r;
+      }
     }
     numberZones();
     report_.shared = true;
-    report_.notes.push_back("read slab " + std::to_string(k + 1) + " of " + std::to_string(n) + " of " +
-                            (zones_.size() == 1 ? "the " : "each of the ") + zonesText(zones_.size(), "structured") +
-                            " (" + std::to_string(cellLayers) + " of " + std::to_string(layers) +
-                            " layers of cells), this process's share of the file");
+    const size_t unstructured = zones_.size() - structured_;
+    const std::string slabs = "slab " + std::to_string(options_.shareIndex + 1) + " of " + std::to_string(n) + " of " +
+                              (structured_ == 1 ? "the " : "each of the ") + zonesText(structured_, "structured") +
+                              " (" + std::to_string(cellLayers) + " of " + std::to_string(layers) + " layers of cells)";
+    uint64_t windowCells = 0, windowVertices = 0;
+    const Zone* one = nullptr;  // the unstructured zone, when there is one
+    for (const Zone& z : zones_)
+      if (!z.structured) windowCells += z.cellCount, windowVertices += z.verticesRead(), one = &z;
+    const std::string windows =
+        unstructured == 1 ? "elements " + std::to_string(one->cellFirst + 1) + " to " +
+                                std::to_string(one->cellFirst + one->cellCount) + " of " + std::to_string(one->cells) +
+                                (structured_ ? " of the unstructured zone" : "") + " and the " +
+                                std::to_string(one->verticesRead()) + " vertices they use"
+                          : std::to_string(windowCells) + " of the " + std::to_string(elements) +
+                                " elements (a share of each of the " + zonesText(unstructured, "unstructured") +
+                                ") and the " + std::to_string(windowVertices) + " vertices they use";
+    report_.notes.push_back("read " +
+                            (unstructured == 0  ? slabs
+                             : structured_ == 0 ? windows
+                                                : slabs + " and " + windows) +
+                            ", this process's share of the file");
     return Result::success();
   }
 
-  // Of fewer unstructured zones than processes, each process's window of every zone (the header
-  // comment).
-  Result keepWindowsOfZones() {
-    for (Zone& z : zones_)
-      if (Result r = windowOfZone(z); !r) return r;
-    numberZones();
-    uint64_t cells = 0;
-    for (const Zone& z : zones_) cells += z.cells;
-    report_.shared = true;
-    const Zone& z = zones_[0];
-    report_.notes.push_back(
-        zones_.size() == 1
-            ? "read elements " + std::to_string(z.cellFirst + 1) + " to " + std::to_string(z.cellFirst + z.cellCount) +
-                  " of " + std::to_string(z.cells) + " and the " + std::to_string(z.verticesRead()) +
-                  " vertices they use, this process's share of the file"
-            : "read " + std::to_string(totalSlots_) + " of the " + std::to_string(cells) +
-                  " elements (a share of each of the " + zonesText(zones_.size(), "unstructured") + ") and the " +
-                  std::to_string(totalVertices_) + " vertices they use, this process's share of the file");
-    return Result::success();
+  // A structured zone's slab for this process: the layers of cells from index·L/count to
+  // (index + 1)·L/count along its longest index direction, and their points.
+  void slabOfZone(Zone& z, uint64_t& layers, uint64_t& cellLayers) {
+    const uint64_t n = options_.shareCount, k = options_.shareIndex;
+    const int a = longestAxis(z);
+    const uint64_t K = z.dims[a] - 1, from = K * k / n, to = K * (k + 1) / n;
+    z.slabAxis = a;
+    z.slabFirst = from;
+    z.dims[a] = to - from + 1;
+    z.vertices = z.vertexCount = z.dims[0] * z.dims[1] * z.dims[2];
+    z.cells = z.cellCount = (z.dims[0] - 1) * (z.dims[1] - 1) * (z.dims[2] - 1);
+    layers += K;
+    cellLayers += to - from;
   }
 
   // The window of one unstructured zone: the share's elements and the vertices their corners use

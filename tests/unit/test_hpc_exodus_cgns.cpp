@@ -788,6 +788,71 @@ TEST(CgnsShares, MixedSectionsAreReadInWindows) {
   }
 }
 
+// Writes a base of two zones that meet at x = 1: an unstructured zone of the tets of a grid on
+// [-1, 1]³ and a structured zone of 5³ points on [1, 3] × [-1, 1]², point field f = x + 2y + 3z
+// in both (a hybrid mesh: a structured block beside an unstructured one).
+void writeCgnsHybrid(const std::string& path) {
+  const TetMesh grid = test::harmonicMesh(5);
+  auto f = [](double x, double y, double z) { return x + 2 * y + 3 * z; };
+  int fn = -1, base = 0, zone = 0, coord = 0, section = 0, sol = 0, field = 0;
+  ASSERT_EQ(cg_open(path.c_str(), CG_MODE_WRITE, &fn), CG_OK) << cg_get_error();
+  ASSERT_EQ(cg_base_write(fn, "Base", 3, 3, &base), CG_OK);
+  const char* names[3] = {"CoordinateX", "CoordinateY", "CoordinateZ"};
+  cgsize_t size[9] = {cgsize_t(grid.vertexCount()), cgsize_t(grid.tetCount()), 0};
+  ASSERT_EQ(cg_zone_write(fn, base, "tets", size, CGNS_ENUMV(Unstructured), &zone), CG_OK);
+  std::vector<double> values;
+  for (int a = 0; a < 3; ++a) {
+    std::vector<double> x;
+    for (uint32_t v = 0; v < grid.vertexCount(); ++v) x.push_back(grid.positions[3 * size_t(v) + size_t(a)]);
+    ASSERT_EQ(cg_coord_write(fn, base, zone, CGNS_ENUMV(RealDouble), names[a], x.data(), &coord), CG_OK);
+  }
+  for (uint32_t v = 0; v < grid.vertexCount(); ++v)
+    values.push_back(f(grid.positions[3 * v], grid.positions[3 * v + 1], grid.positions[3 * v + 2]));
+  std::vector<cgsize_t> conn;
+  for (uint32_t id : grid.tets) conn.push_back(cgsize_t(id + 1));
+  ASSERT_EQ(cg_section_write(fn, base, zone, "Tets", CGNS_ENUMV(TETRA_4), 1, cgsize_t(grid.tetCount()), 0, conn.data(),
+                             &section),
+            CG_OK);
+  ASSERT_EQ(cg_sol_write(fn, base, zone, "Solution", CGNS_ENUMV(Vertex), &sol), CG_OK);
+  ASSERT_EQ(cg_field_write(fn, base, zone, sol, CGNS_ENUMV(RealDouble), "f", values.data(), &field), CG_OK);
+
+  const cgsize_t n = 5;
+  cgsize_t block[9] = {n, n, n, n - 1, n - 1, n - 1, 0, 0, 0};
+  ASSERT_EQ(cg_zone_write(fn, base, "block", block, CGNS_ENUMV(Structured), &zone), CG_OK);
+  std::vector<double> xyz[3];
+  values.clear();
+  for (cgsize_t k = 0; k < n; ++k)
+    for (cgsize_t j = 0; j < n; ++j)
+      for (cgsize_t i = 0; i < n; ++i) {
+        const double p[3] = {1 + 0.5 * double(i), -1 + 0.5 * double(j), -1 + 0.5 * double(k)};
+        for (int a = 0; a < 3; ++a) xyz[a].push_back(p[a]);
+        values.push_back(f(p[0], p[1], p[2]));
+      }
+  for (int a = 0; a < 3; ++a)
+    ASSERT_EQ(cg_coord_write(fn, base, zone, CGNS_ENUMV(RealDouble), names[a], xyz[a].data(), &coord), CG_OK);
+  ASSERT_EQ(cg_sol_write(fn, base, zone, "Solution", CGNS_ENUMV(Vertex), &sol), CG_OK);
+  ASSERT_EQ(cg_field_write(fn, base, zone, sol, CGNS_ENUMV(RealDouble), "f", values.data(), &field), CG_OK);
+  ASSERT_EQ(cg_close(fn), CG_OK);
+}
+
+// A base of fewer zones than processes, structured and unstructured together: each process reads
+// a slab of the structured zone and a window of the unstructured one.
+TEST(CgnsShares, HybridBasesAreReadInSlabsAndWindows) {
+  ScratchDir dir("cgns-hybrid");
+  const std::string path = dir.path + "/hybrid.cgns";
+  writeCgnsHybrid(path);
+  for (uint32_t count : {3u, 4u}) test::expectSharesMakeTheWhole(path, count);
+  TetMesh m;
+  ReadReport r;
+  ASSERT_TRUE(readMesh(path, m, r, test::shareOf(1, 3)));
+  EXPECT_TRUE(hasNote(r,
+                      "read slab 2 of 3 of the 1 structured zone (1 of 4 layers of cells) and elements 129 to 256 of "
+                      "384 of the unstructured zone and the"))
+      << allNotes(r);
+  ASSERT_TRUE(readMesh(path, m, r = ReadReport{}, test::shareOf(1, 5)));
+  EXPECT_FALSE(r.shared) << "a block of 4 layers cannot give 5 processes one each";
+}
+
 // A CGNS base of as many zones as processes or more: each reads its zones whole. A base of one
 // unstructured zone: each reads its elements and the vertices they use, with its rows of the
 // solutions (a time series here: the step's solution). Fewer structured zones than processes:
