@@ -123,6 +123,13 @@ class XdmfReader {
   Result mixedRows(pugi::xml_node item, const std::string& where, int64_t base, uint64_t total, uint64_t from,
                    uint64_t to, uint64_t declared, xdmf::MixedCells& out);
   Result appendMixed(const std::string& where, const xdmf::MixedCells& cells, uint64_t vertexBase, uint64_t points);
+  // Walks a Mixed topology of `total` values from its first, a window at a time where its data
+  // reads windows for their cost (HDF5), else read whole, until the walker is done or the values
+  // end (`at`: the values walked).
+  Result walkMixed(pugi::xml_node item, const std::string& what, uint64_t total, xdmf::MixedWalker& walker,
+                   xdmf::MixedCells& out, uint64_t& at);
+  // The cells of a Mixed topology that does not declare their count: all walked, none kept.
+  Result countMixed(pugi::xml_node item, const std::string& where, uint64_t total, uint64_t& cells);
   Result readPoints(pugi::xml_node geo, const std::string& where, uint64_t& points);
   // rows: given, only those rows of each attribute are read (a share of the grid).
   Result readAttributes(const std::vector<pugi::xml_node>& attributes, const std::string& where,
@@ -313,13 +320,12 @@ Result XdmfReader::appendMixed(const std::string& where, const xdmf::MixedCells&
   return Result::success();
 }
 
-Result XdmfReader::mixedRows(pugi::xml_node item, const std::string& where, int64_t base, uint64_t total, uint64_t from,
-                             uint64_t to, uint64_t declared, xdmf::MixedCells& out) {
-  const std::string what = where + " Topology";
-  xdmf::MixedWalker walker(where, base, from, to, /*skippedNodes=*/false);
+Result XdmfReader::walkMixed(pugi::xml_node item, const std::string& what, uint64_t total, xdmf::MixedWalker& walker,
+                             xdmf::MixedCells& out, uint64_t& at) {
   const bool byWindow = doc_.readsRowsAlone(item, total);
-  uint64_t at = 0, window = io::kPickWindow;
+  uint64_t window = io::kPickWindow;
   Values<int64_t> v;
+  at = 0;
   while (!walker.done() && at < total) {
     const uint64_t n = byWindow ? std::min(window, total - at) : total;
     if (Result r = byWindow ? doc_.integerRows(item, what, total, at, n, v) : doc_.integers(item, what, v); !r)
@@ -332,11 +338,29 @@ Result XdmfReader::mixedRows(pugi::xml_node item, const std::string& where, int6
     at += used;
     window = used ? io::kPickWindow : 2 * window;  // (a cell longer than the window: a larger one)
   }
+  return Result::success();
+}
+
+Result XdmfReader::mixedRows(pugi::xml_node item, const std::string& where, int64_t base, uint64_t total, uint64_t from,
+                             uint64_t to, uint64_t declared, xdmf::MixedCells& out) {
+  const std::string what = where + " Topology";
+  xdmf::MixedWalker walker(where, base, from, to, /*skippedNodes=*/false);
+  uint64_t at = 0;
+  if (Result r = walkMixed(item, what, total, walker, out, at); !r) return r;
   // Every cell up to the share's last was found; the last share also sees the values end there.
   if (walker.cells() < to || (to == declared && at != total))
     return fail(Status::Corrupt, what + ": NumberOfElements=" + std::to_string(declared) +
                                      " but the Mixed data holds " + (walker.cells() < to ? "only " : "more than ") +
                                      std::to_string(walker.cells()) + " cells");
+  return Result::success();
+}
+
+Result XdmfReader::countMixed(pugi::xml_node item, const std::string& where, uint64_t total, uint64_t& cells) {
+  xdmf::MixedWalker walker(where, 0, UINT64_MAX, UINT64_MAX);  // (keeps none)
+  xdmf::MixedCells none;
+  uint64_t at = 0;
+  if (Result r = walkMixed(item, where + " Topology", total, walker, none, at); !r) return r;
+  cells = walker.cells();
   return Result::success();
 }
 
@@ -417,7 +441,8 @@ Result XdmfReader::pointRows(pugi::xml_node geo, const std::string& where, uint6
 // (index + 1)·N/count, and the points they use (the run from the smallest id to the largest, or
 // only those: io/row_pick.h), with those rows of every attribute. Of one cell type the cells are
 // rows of the topology; of Mixed cells the topology is walked from its first cell (a window at a
-// time where its data allows) to find them. Each process reads about a count-th of the cells;
+// time where its data allows) to find them, after a walk that counts them when the topology does
+// not say how many. Each process reads about a count-th of the cells;
 // the points on the cuts are read by both sides and joined later by their coordinates. done
 // stays false (nothing read) for a grid this cannot cut: a topology of no declared size, or an
 // attribute of a function space (its dofs are not per point or cell).
@@ -458,7 +483,9 @@ Result XdmfReader::readShareOfGrid(pugi::xml_node topo, pugi::xml_node geo, cons
     bool hasCount = false;
     uint64_t declared = 0;
     if (Result r = declaredCells(topo, what, hasCount, declared); !r) return r;
-    if (!hasCount || dims.size() != 1) return Result::success();
+    if (dims.size() != 1) return Result::success();
+    if (!hasCount)
+      if (Result r = countMixed(item, where, dims[0], declared); !r) return r;
     share(declared);
     if (Result r = mixedRows(item, where, base, dims[0], from, to, declared, cells); !r) return r;
   }
@@ -497,8 +524,8 @@ Result XdmfReader::readShareOfGrid(pugi::xml_node topo, pugi::xml_node geo, cons
 }
 
 // What a grid is, for sharing it: a grid of volume cells tetstream reads, one whose cells can be
-// shared out (readShareOfGrid: a declared size, and of Mixed cells a declared count; no
-// attribute of a function space), and its Geometry element (after references).
+// shared out (readShareOfGrid: a declared size; no attribute of a function space), and its
+// Geometry element (after references).
 Result XdmfReader::gridShape(pugi::xml_node grid, const std::vector<pugi::xml_node>& companions,
                              const std::string& where, bool& volume, bool& byRows, const void*& geometry) {
   volume = byRows = false;
@@ -524,9 +551,8 @@ Result XdmfReader::gridShape(pugi::xml_node grid, const std::vector<pugi::xml_no
   pugi::xml_node item;
   if (Result r = doc_.dataItem(topos[0], where + " Topology", item); !r) return r;
   const std::vector<uint64_t> dims = doc_.declaredDims(item);
-  // Mixed cells are found by walking the topology: its size and cell count must be declared.
-  byRows = mixed ? dims.size() == 1 && (topos[0].attribute("NumberOfElements") || topos[0].attribute("Dimensions"))
-                 : cellRowsDeclared(dims, uint64_t(kind->nodes));
+  // Mixed cells are found by walking the topology (counted first when it does not say how many).
+  byRows = mixed ? dims.size() == 1 : cellRowsDeclared(dims, uint64_t(kind->nodes));
   return Result::success();
 }
 

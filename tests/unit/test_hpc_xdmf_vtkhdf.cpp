@@ -236,8 +236,9 @@ void writeMixedXdmf(const TetMesh& mesh, const std::string& dir) {
 }
 
 // One grid of Mixed cells read by several processes: each walks the topology's codes to its
-// share of the cells and reads only the points they use; together the shares hold every tet of
-// the whole once. Node ids lose the BaseOffset, type codes do not.
+// share of the cells (counting them first when the topology does not say how many) and reads
+// only the points they use; together the shares hold every tet of the whole once. Node ids lose
+// the BaseOffset, type codes do not.
 TEST(XdmfShares, MixedCellsAreSharedByWalkingTheirCodes) {
   ScratchDir dir("xdmf-mixed-shares");
   const TetMesh mesh = test::shuffledPoints(test::harmonicMesh(6));
@@ -253,6 +254,17 @@ TEST(XdmfShares, MixedCellsAreSharedByWalkingTheirCodes) {
   for (uint32_t count : {2u, 3u, 5u}) {
     test::expectSharesMakeTheWhole(path, count, "c");
     test::expectSharesReadOnlyUsedPoints(path, count, "points they use");
+  }
+  // Without NumberOfElements the cells are counted by a first walk.
+  std::string xml = loadFile(path);
+  const size_t at = xml.find(" NumberOfElements=");
+  ASSERT_NE(at, std::string::npos);
+  xml.erase(at, xml.find('"', xml.find('"', at) + 1) + 1 - at);
+  const std::string uncounted = dir.path + "/uncounted.xdmf";
+  ASSERT_TRUE(saveFile(uncounted, xml));
+  for (uint32_t count : {2u, 3u}) {
+    test::expectSharesMakeTheWhole(uncounted, count, "c");
+    test::expectSharesReadOnlyUsedPoints(uncounted, count, "points they use");
   }
   for (const char* name : {"xdmf_mixed.xdmf", "xdmf_mixed_quadratic.xdmf"})  // ("col": cell data)
     for (uint32_t count : {2u, 3u}) test::expectSharesMakeTheWhole(hpcPath(name), count, "col");
