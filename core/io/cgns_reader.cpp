@@ -109,6 +109,18 @@ std::string elementTypeName(int code) {
   return n ? n : "";
 }
 
+// What the element type of a valid code is to the readers, looked up once per code (MIXED
+// sections name a type per element).
+const CgnsType& typeOfCode(cgsize_t code) {
+  static const std::vector<CgnsType> byCode = [] {
+    std::vector<CgnsType> t(size_t(NofValidElementTypes));
+    for (int c = 0; c < NofValidElementTypes; ++c) t[size_t(c)] = cgnsType(elementTypeName(c));
+    return t;
+  }();
+  static const CgnsType none;
+  return code >= 0 && code < NofValidElementTypes ? byCode[size_t(code)] : none;
+}
+
 // "1 structured zone", "12 unstructured zones".
 std::string zonesText(size_t n, const char* kind) {
   return std::to_string(n) + " " + kind + (n == 1 ? " zone" : " zones");
@@ -460,8 +472,7 @@ class CgnsReader {
     uint64_t lo = UINT64_MAX, hi = 0;
     auto eachCorner = [&](auto&& visit) {
       for (const auto& [s, sec] : read)
-        forEachElement(sec, z.windowConnectivity[s], [&](const std::string& type, const cgsize_t* nodes, int count) {
-          const CgnsType kind = cgnsType(type);
+        forEachElement(sec, z.windowConnectivity[s], [&](const CgnsType& kind, const cgsize_t* nodes, int count) {
           if (!kind.volume) return;
           for (int q = 0; q < std::min(count, kShapeCorners[int(kind.shape)]); ++q)
             if (nodes[q] >= 1 && uint64_t(nodes[q]) <= z.vertices) visit(uint64_t(nodes[q] - 1));
@@ -481,7 +492,7 @@ class CgnsReader {
     return Result::success();
   }
 
-  // Calls visit(type name, nodes, node count) for each element of a section's connectivity: of a
+  // Calls visit(its type, nodes, node count) for each element of a section's connectivity: of a
   // MIXED section each element's code says its type (checked when it was read), else every
   // element is the section's type.
   template <class Visit>
@@ -490,14 +501,15 @@ class CgnsReader {
       for (size_t at = 0; at < conn.size();) {
         const int entries = cgns::mixedEntries(conn[at]);
         if (entries == 0 || size_t(entries) > conn.size() - at) return;
-        visit(elementTypeName(int(conn[at])), &conn[at + 1], entries - 1);
+        visit(typeOfCode(conn[at]), &conn[at + 1], entries - 1);
         at += size_t(entries);
       }
       return;
     }
     int npe = 0;
     if (cg_npe(sec.etype, &npe) != CG_OK || npe < 1) return;
-    for (size_t at = 0; at + size_t(npe) <= conn.size(); at += size_t(npe)) visit(sec.type, &conn[at], npe);
+    const CgnsType kind = cgnsType(sec.type);
+    for (size_t at = 0; at + size_t(npe) <= conn.size(); at += size_t(npe)) visit(kind, &conn[at], npe);
   }
 
   // Section s of zone z.
