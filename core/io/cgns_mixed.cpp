@@ -81,8 +81,8 @@ Result badElement(const std::string& where, cgsize_t element, cgsize_t code) {
                                    std::to_string(code) + ", not one a MIXED section may hold");
 }
 
-// Whether the elements of `conn` (starting with element `element`) agree with `offsets`, theirs
-// rebased to conn's first entry.
+// Whether the elements whose codes and nodes `conn` holds agree with `offsets` (theirs, and the
+// next one's: conn's first entry is at offsets[0]).
 bool agrees(std::span<const cgsize_t> conn, std::span<const cgsize_t> offsets) {
   size_t at = 0;
   for (size_t k = 0; k + 1 < offsets.size(); ++k) {

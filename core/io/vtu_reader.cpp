@@ -290,10 +290,20 @@ struct PieceRows {
 
 // Whether a DataArray's rows can be read a window at a time for the cost of the window: binary
 // data, raw or base64, inline or appended, compressed or not, is reached by offset (base64 text
-// by four characters for three bytes where it is plain: ByteSource::skip); ASCII text would be
-// parsed again from the array's start for every window.
-bool readsByWindow(const Vtu&, pugi::xml_node da) {
-  return std::string_view(da.attribute("format").value()) != "ascii";
+// by four characters for three bytes where it is plain: ByteSource::skip). Text that would be
+// read again from the array's start for every window is read once instead: ASCII, and inline
+// base64 with white space inside (wrapped into lines).
+bool readsByWindow(const Vtu& vtu, pugi::xml_node da) {
+  const std::string_view format = da.attribute("format").value();
+  if (format != "binary") return format == "appended";
+  std::string storage;
+  std::string_view text = arrayText(vtu, da, storage);
+  const size_t first = text.find_first_not_of(" \t\r\n"), last = text.find_last_not_of(" \t\r\n");
+  if (first == std::string_view::npos) return true;
+  text = text.substr(first, last + 1 - first);
+  for (char c : {' ', '\n', '\r', '\t'})
+    if (std::memchr(text.data(), c, text.size())) return false;
+  return true;
 }
 
 // The values of rows `rows` of an array of `rowCount` rows of `comps` components each
@@ -491,11 +501,12 @@ Result readPiece(Vtu& vtu, GridKind kind, const Grid& whole, pugi::xml_node piec
 }
 
 // The points a share reads (io/row_pick.h): of binary data only those its cells use
-// (rows.pointPick, read by readRows), else the run their ids span. `conn` is renumbered to the
-// points read.
-void pickUsedPoints(const Vtu& vtu, pugi::xml_node piece, std::vector<int64_t>& conn, PieceRows& rows) {
+// (rows.pointPick, read by readRows: a window at a time, or the run once where windows would
+// cost more), else the run their ids span. `conn` is renumbered to the points read.
+void pickUsedPoints(pugi::xml_node piece, std::vector<int64_t>& conn, PieceRows& rows) {
   rows.pointPick.clear();
-  if (rows.points > 0 && readsByWindow(vtu, piece.child("Points").child("DataArray"))) {
+  if (rows.points > 0 &&
+      std::string_view(piece.child("Points").child("DataArray").attribute("format").value()) != "ascii") {
     rows.pointPick = io::pickUsedRows(conn, rows.pointFirst, rows.points);
   } else {
     for (int64_t& id : conn) id -= int64_t(rows.pointFirst);
@@ -571,7 +582,7 @@ Result readPieceShare(Vtu& vtu, pugi::xml_node piece, const std::string& label, 
   }
   rows.pointFirst = hi < 0 ? 0 : uint64_t(lo);
   rows.points = hi < 0 ? 0 : uint64_t(hi + 1 - lo);
-  pickUsedPoints(vtu, piece, conn, rows);
+  pickUsedPoints(piece, conn, rows);
   const uint64_t pointsRead = rows.pointPick.empty() ? rows.points : rows.pointPick.size();
 
   TetMesh& mesh = out.mesh;
