@@ -24,11 +24,15 @@ Result readFileBytes(const std::string& path, uint64_t limit, std::vector<uint8_
   return err ? fail(Status::IoError, path + ": read error") : Result::success();
 }
 
+uint32_t Dataset::placeOfSplit(uint32_t g) const {
+  // A binary search: a hierarchy's view holds thousands of chunks, and every split asks.
+  const auto after = std::upper_bound(chunkFirstSplit.begin() + 2, chunkFirstSplit.end(), g);
+  return uint32_t(after - chunkFirstSplit.begin()) - 1;
+}
+
 uint32_t Dataset::chunksApplied() const {
   if (chunksReceived == 0) return 0;
-  uint32_t n = 1;
-  while (n < chunksReceived && chunkFirstSplit[n + 1] <= pm.splitsApplied()) ++n;
-  return n;
+  return std::min(placeOfSplit(pm.splitsApplied()), chunksReceived);
 }
 
 uint32_t Dataset::splitsThroughChunk(uint32_t index) const {
@@ -159,8 +163,7 @@ void dropChunksFrom(Dataset& ds, uint32_t place) {
 // Applies split g = ds.splitsApplied() from its chunk's payload.
 Result redoNext(Dataset& ds, std::vector<uint32_t>& changed) {
   const uint32_t g = ds.splitsApplied();
-  uint32_t c = 1;
-  while (ds.chunkFirstSplit[c + 1] <= g) ++c;
+  const uint32_t c = ds.placeOfSplit(g);
   const uint32_t first = ds.chunkFirstSplit[c], end = ds.chunkFirstSplit[c + 1];
   const uint32_t index = ds.received[c];
   const int32_t node = ds.nodeOfChunk(index);

@@ -66,6 +66,9 @@ struct Dataset {
   uint32_t splitsApplied() const { return pm.splitsApplied(); }
   // Chunks whose every split is applied (the base counts once received), in places.
   uint32_t chunksApplied() const;
+  // The place of the chunk that holds split g (g < splitsReceived(); at splitsReceived(), the
+  // number of places).
+  uint32_t placeOfSplit(uint32_t g) const;
   // Splits needed to reach the end of the chunk in place `place` (0 for the base); for places not
   // received yet, counted as if the next chunks came in manifest order.
   uint32_t splitsThroughChunk(uint32_t place) const;

@@ -15,7 +15,7 @@ using json = nlohmann::json;
 
 constexpr size_t kMaxManifestBytes = kManifestLimitBytes;
 constexpr int kMaxDepth = 32;
-constexpr size_t kMaxChunks = 65536;
+constexpr size_t kMaxChunks = kManifestMaxChunks;
 constexpr size_t kMaxFields = 64;
 constexpr uint64_t kMaxChunkBytes = 256ull << 20;
 constexpr uint64_t kMaxRawBytes = kMaxChunkRawBytes;
@@ -363,7 +363,7 @@ Result parseManifest(std::string_view text, Manifest& m) {
   const json* chunks = r.member(doc, "chunks", "");
   if (!chunks) return bad(r.error);
   if (!chunks->is_array() || chunks->empty() || chunks->size() > kMaxChunks)
-    return bad("'chunks' must be an array of 1 to 65536 chunks");
+    return bad("'chunks' must be an array of 1 to " + std::to_string(kMaxChunks) + " chunks");
   for (size_t i = 0; i < chunks->size(); ++i) {
     const json& c = (*chunks)[i];
     std::string path = "chunks[" + std::to_string(i) + "].";

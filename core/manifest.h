@@ -16,8 +16,10 @@ namespace tetstream {
 // its own version, kChunkVersion.
 inline constexpr uint32_t kFormatVersion = 2;
 inline constexpr uint32_t kChunkVersion = 1;
-// The largest manifest a reader takes (FORMAT.md §5): room for the most chunks and nodes.
+// The largest manifest a reader takes (FORMAT.md §5), in bytes and in chunks. The packer keeps
+// its manifests within both (PackOptions::maxLeaves) and refuses to write one that is not.
 inline constexpr uint64_t kManifestLimitBytes = 64ull << 20;
+inline constexpr size_t kManifestMaxChunks = size_t(1) << 18;
 inline constexpr const char* kLibraryVersion = "0.3.0";
 
 // The most a chunk of `bytes` compressed bytes may declare after decompression: zstd on mesh

@@ -234,7 +234,7 @@ Runner addPack(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--leaf-vertices", o->leafVertices,
                   "largest region of the patch hierarchy, in vertices (smaller: a viewer fetches less for one "
-                  "isovalue, in more files; 0: one region)")
+                  "isovalue, in more files; 0: one region; raised where it would make over 16,384 leaves)")
       ->capture_default_str();
   sub->add_option("--zstd-level", o->level, "zstd compression level")->check(CLI::Range(1, 22))->capture_default_str();
   sub->add_option("--max-memory", o->maxMemoryGb,

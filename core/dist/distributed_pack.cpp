@@ -157,6 +157,8 @@ Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& 
   std::vector<uint64_t> ownedPerRank(static_cast<size_t>(N), 0);
   ownedPerRank[size_t(me)] = ownedCount(part);
   comm.sumInPlace(ownedPerRank);
+  const uint32_t leafVertices =
+      leafVerticesFor(*std::max_element(ownedPerRank.begin(), ownedPerRank.end()), uint32_t(N), opt, notes);
   auto simplifyUnit = [&](Unit& u, const CarriedVertexState* carried) {
     const RankTree::Group& g = tree.groups[size_t(u.group)];
     SimplifyPart sp = shared;
@@ -170,7 +172,7 @@ Result packDistributed(Comm& comm, const std::string& input, const ReadOptions& 
     so.weightField = opt.weights[1];
     so.weightShape = opt.weights[2];
     so.threads = opt.threads;
-    so.leafVertices = g.low < 0 ? opt.leafVertices : 0;  // (a combined part is one region: the cut)
+    so.leafVertices = g.low < 0 ? leafVertices : 0;  // (a combined part is one region: the cut)
     so.fitValues = opt.fitValues;
     so.field = iso;
     so.maxError = opt.maxError;

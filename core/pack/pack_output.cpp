@@ -43,6 +43,15 @@ Result writeWholeFile(const std::string& path, const void* data, size_t size) {
 }
 
 Result writeManifestFiles(const std::string& outDir, const Manifest& m) {
+  // Checked before anything in the folder changes: an earlier pack there stays readable.
+  if (m.chunks.size() > kManifestMaxChunks)
+    return fail(Status::TooLarge, "the pack has " + std::to_string(m.chunks.size()) + " chunks, more than the " +
+                                      std::to_string(kManifestMaxChunks) +
+                                      " a reader takes: use larger --chunk-kb or --leaf-vertices");
+  const std::string json = writeManifest(m);
+  if (json.size() > kManifestLimitBytes)
+    return fail(Status::TooLarge, "the pack's manifest would be " + std::to_string(json.size() >> 20) +
+                                      " MiB, more than the 64 MiB a reader takes: use larger --leaf-vertices");
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator(fs::path(outDir) / "chunks", ec)) {
     std::string rel = "chunks/" + entry.path().filename().string();
@@ -51,7 +60,6 @@ Result writeManifestFiles(const std::string& outDir, const Manifest& m) {
     for (const ChunkInfo& c : m.chunks) referenced |= c.file == rel;
     if (ours && !referenced) fs::remove(entry.path(), ec);
   }
-  const std::string json = writeManifest(m);
   Result r = writeWholeFile((fs::path(outDir) / "manifest.json").string(), json.data(), json.size());
   // The manifest gzipped beside it, written after it (so it is never the older of the two, which
   // servers take as stale): a large hierarchy's manifest is megabytes of JSON, fetched before

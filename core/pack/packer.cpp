@@ -81,6 +81,23 @@ Result checkMemoryFor(const TetMesh& mesh, const PackOptions& opt) {
   return Result::success();
 }
 
+uint32_t leafVerticesFor(uint64_t largestPart, uint32_t parts, const PackOptions& opt,
+                         std::vector<std::string>& notes) {
+  if (opt.leafVertices == 0 || opt.maxLeaves == 0) return opt.leafVertices;
+  // Each part's tree halves its regions until each holds at most the leaf size
+  // (simplify_tree.cpp): with ceil(largestPart / P), P a power of two, no part has more than P
+  // leaves, and P · parts ≤ maxLeaves.
+  uint64_t perPart = 1;
+  while (2 * perPart * std::max(parts, 1u) <= opt.maxLeaves) perPart *= 2;
+  const uint64_t least = (largestPart + perPart - 1) / perPart;
+  if (least <= opt.leafVertices) return opt.leafVertices;
+  const uint32_t leaf = uint32_t(std::min<uint64_t>(least, UINT32_MAX));
+  notes.push_back("regions of up to " + std::to_string(leaf) + " vertices instead of " +
+                  std::to_string(opt.leafVertices) + ": at most " + std::to_string(opt.maxLeaves) +
+                  " leaf regions keep the manifest small enough to open at once");
+  return leaf;
+}
+
 Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt, PackSummary& summary) {
   summary = PackSummary{};
   const auto start = std::chrono::steady_clock::now();
@@ -183,7 +200,7 @@ Result packMesh(TetMesh mesh, const std::string& outDir, const PackOptions& opt,
   so.weightField = opt.weights[1];
   so.weightShape = opt.weights[2];
   so.threads = opt.threads;
-  so.leafVertices = opt.leafVertices;
+  so.leafVertices = leafVerticesFor(mesh.vertexCount(), 1, opt, summary.notes);
   so.fitValues = opt.fitValues;
   so.field = iso;
   so.recordReadSets = opt.orderSplits;
