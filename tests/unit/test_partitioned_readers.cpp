@@ -272,12 +272,17 @@ std::string encodedArray(const std::vector<T>& values, bool zlib, size_t lineEve
   std::vector<uint8_t> data(values.size() * sizeof(T));
   std::memcpy(data.data(), values.data(), data.size());
   auto words = [](std::initializer_list<uint64_t> w, std::vector<uint8_t>& out) {
-    for (uint64_t x : w) out.insert(out.end(), reinterpret_cast<uint8_t*>(&x), reinterpret_cast<uint8_t*>(&x) + 8);
+    for (uint64_t x : w) {  // (resize and copy: GCC 12 takes inserts here for overflows)
+      const size_t at = out.size();
+      out.resize(at + 8);
+      std::memcpy(out.data() + at, &x, 8);
+    }
   };
   std::vector<uint8_t> header;
   if (!zlib) {
     words({data.size()}, header);
-    header.insert(header.end(), data.begin(), data.end());
+    header.resize(8 + data.size());
+    if (!data.empty()) std::memcpy(header.data() + 8, data.data(), data.size());
     return base64(header, lineEvery);
   }
   const size_t block = 4096, blocks = (data.size() + block - 1) / block;
