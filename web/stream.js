@@ -137,6 +137,7 @@ function loadManifest(manifestUrl) {
 
 // FORMAT.md §1: a chunk's file is "chunks/" and a name of [0-9a-z.-] (no "..").
 const CHUNK_FILE = /^chunks\/[0-9a-z.-]+$/;
+const MAX_CHUNKS = 262144; // FORMAT.md §5
 
 // The chunk names and sizes of a manifest the viewer has not read yet, when every name passes
 // the file rule: used only to start fetching the base while the program still downloads and
@@ -148,7 +149,7 @@ export function peekChunks(bytes) {
     const m = JSON.parse(new TextDecoder().decode(bytes));
     // Versions 1 and 2 list their chunk files alike (FORMAT.md §1); nodes are the viewer's to read.
     if (m.format !== 'tetstream' || ![1, 2].includes(m.formatVersion) || !Array.isArray(m.chunks)) return null;
-    if (!m.chunks.length || m.chunks.length > 65536) return null;
+    if (!m.chunks.length || m.chunks.length > MAX_CHUNKS) return null;
     const names = [], sizes = [];
     for (const c of m.chunks) {
       if (typeof c.file !== 'string' || !CHUNK_FILE.test(c.file) || c.file.includes('..')) return null;

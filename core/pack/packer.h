@@ -34,7 +34,7 @@ struct PackOptions {
   int threads = 2;               // threads that evaluate collapse costs and measure levels (1 or 2; same output)
   uint32_t leafVertices = 2048;  // largest region of the patch hierarchy (SimplifyOptions)
   // At most this many leaves (leafVerticesFor): every node is a manifest entry, which a viewer
-  // fetches and reads before the first picture (about 90 bytes gzipped and 50 µs in wasm each).
+  // fetches and reads before the first picture (about 90 bytes gzipped and 40 µs in wasm each).
   uint32_t maxLeaves = 16384;
   uint32_t renumberMinTets = 50000;  // renumber scattered meshes from this size (pack/renumber.h)
   // Progress for displays: phase ("validate", "simplify", "encode", "write"), items done and
