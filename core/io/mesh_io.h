@@ -100,7 +100,8 @@ struct ReadOptions {
   // file of at least shareCount partitions, or a VTK XML file of at least shareCount <Piece>s:
   // the partitions or pieces likewise. A .vtu of fewer pieces: the cells in those rows of each
   // piece and their points; a .vti or .vts of fewer pieces, each at least shareCount cells deep
-  // along k: those layers of cells of each piece. An XDMF file of at least shareCount volume grids
+  // along some axis: those layers of cells of each piece (along k where it is deep enough, else
+  // j, else i). An XDMF file of at least shareCount volume grids
   // (a spatial collection): those grids, each whole. Of fewer grids, each of one cell type: the
   // cells in those rows of its topology and their points. An Exodus II file: the elements in those
   // rows of its blocks (in file order) and their nodes. A CGNS base of at least shareCount zones:

@@ -285,7 +285,7 @@ Result readExtent(pugi::xml_node node, const char* attr, const std::string& wher
 struct PieceRows {
   uint64_t pointFirst = 0, points = UINT64_MAX;
   uint64_t cellFirst = 0, cells = UINT64_MAX;
-  std::vector<uint64_t> pointPick;
+  std::vector<uint64_t> pointPick, cellPick;  // when not empty: only these rows (ascending)
 };
 
 // Whether a DataArray's rows can be read a window at a time for the cost of the window: binary
@@ -349,7 +349,7 @@ Result readPieceData(Vtu& vtu, pugi::xml_node piece, const std::string& where, u
       uint64_t comps;
       if (Result r = readComponents(da, ref, comps); !r) return r;
       std::vector<double> values;
-      if (Result r = cells ? readRows(vtu, da, ref, nc, comps, rows.cellFirst, rows.cells, {}, values)
+      if (Result r = cells ? readRows(vtu, da, ref, nc, comps, rows.cellFirst, rows.cells, rows.cellPick, values)
                            : readRows(vtu, da, ref, np, comps, rows.pointFirst, rows.points, rows.pointPick, values);
           !r)
         return r;
@@ -402,12 +402,33 @@ Result readPointRows(Vtu& vtu, pugi::xml_node piece, const std::string& where, u
   return Result::success();
 }
 
-// Of a structured piece, `slab` (when given) names the share of its layers of cells along k
-// (the slowest index, so that its points and cells are runs of the arrays) to read: layers
-// index·L/count to (index + 1)·L/count and their points.
+// Of a structured piece, `slab` (when given) names the share of its layers of cells along one
+// axis to read: layers index·L/count to (index + 1)·L/count and their points.
 struct Slab {
   uint32_t index = 0, count = 1;
 };
+
+// The axis a piece is cut into `count` slabs along: k when it has that many layers of cells (k
+// is the slowest index, so a slab's points and cells are runs of the arrays), else j (a run in
+// each k plane), else i (a run in each row); -1 when no axis has that many.
+int slabAxis(const Grid& g, uint32_t count) {
+  for (int axis = 2; axis >= 0; --axis)
+    if (g.n(axis) - 1 >= count) return axis;
+  return -1;
+}
+
+// The rows of slab [from, to] along `axis` (0 or 1) of an ni x nj x nk block of rows (points, or
+// cells with one fewer along each axis), ascending.
+std::vector<uint64_t> slabRows(uint64_t ni, uint64_t nj, uint64_t nk, int axis, uint64_t from, uint64_t to) {
+  std::vector<uint64_t> out;
+  const uint64_t iFrom = axis == 0 ? from : 0, iTo = axis == 0 ? to : ni - 1;
+  const uint64_t jFrom = axis == 1 ? from : 0, jTo = axis == 1 ? to : nj - 1;
+  out.reserve((iTo - iFrom + 1) * (jTo - jFrom + 1) * nk);
+  for (uint64_t k = 0; k < nk; ++k)
+    for (uint64_t j = jFrom; j <= jTo; ++j)
+      for (uint64_t i = iFrom; i <= iTo; ++i) out.push_back(i + ni * (j + nj * k));
+  return out;
+}
 
 Result readPiece(Vtu& vtu, GridKind kind, const Grid& whole, pugi::xml_node piece, const std::string& where,
                  MeshPiece& out, ReadReport& report, bool notePieceConversions, const Slab* slab = nullptr) {
@@ -435,12 +456,22 @@ Result readPiece(Vtu& vtu, GridKind kind, const Grid& whole, pugi::xml_node piec
       return fail(Status::Truncated, where + ": Extent declares " + std::to_string(np) + " points, far more than a " +
                                          std::to_string(vtu.fileBytes) + "-byte file can carry data for");
     if (slab) {
-      const uint64_t layers = g.n(2) - 1, from = layers * slab->index / slab->count,
+      const int axis = slabAxis(g, slab->count);
+      if (axis < 0) return fail(Status::Corrupt, where + ": too thin to cut into " + std::to_string(slab->count));
+      const uint64_t layers = g.n(axis) - 1, from = layers * slab->index / slab->count,
                      to = layers * (slab->index + 1) / slab->count, plane = g.n(0) * g.n(1);
-      rows = {from * plane, (to - from + 1) * plane, from * (g.n(0) - 1) * (g.n(1) - 1),
-              (to - from) * (g.n(0) - 1) * (g.n(1) - 1)};
-      g.extent[4] += int64_t(from);
-      g.extent[5] = g.extent[4] + int64_t(to - from);
+      if (axis == 2) {
+        rows = {from * plane, (to - from + 1) * plane, from * (g.n(0) - 1) * (g.n(1) - 1),
+                (to - from) * (g.n(0) - 1) * (g.n(1) - 1)};
+      } else {
+        rows.pointPick = slabRows(g.n(0), g.n(1), g.n(2), axis, from, to);
+        rows.cellPick = slabRows(g.n(0) - 1, g.n(1) - 1, g.n(2) - 1, axis, from, to - 1);
+        rows.pointFirst = rows.cellFirst = 0;
+        rows.points = rows.pointPick.size();
+        rows.cells = rows.cellPick.size();
+      }
+      g.extent[2 * axis] += int64_t(from);
+      g.extent[2 * axis + 1] = g.extent[2 * axis] + int64_t(to - from);
     }
   }
   // What is read of the piece: all of it, or a slab's rows.
@@ -470,7 +501,8 @@ Result readPiece(Vtu& vtu, GridKind kind, const Grid& whole, pugi::xml_node piec
                                            g.direction[3 * c + 2] * d[2]));
         }
   } else if (np > 0) {
-    if (Result r = readPointRows(vtu, piece, where, np, {rows.pointFirst, rows.points}, mesh); !r) return r;
+    if (Result r = readPointRows(vtu, piece, where, np, {rows.pointFirst, rows.points}, mesh, rows.pointPick); !r)
+      return r;
   }
 
   // Cells
@@ -666,11 +698,12 @@ Result readPieces(Vtu& vtu, GridKind kind, const Grid& whole, const std::vector<
   return Result::success();
 }
 
-// Of fewer structured pieces than processes, each at least shareCount cells deep along k: the
-// slab `slab` of every piece (readPiece).
+// Of fewer structured pieces than processes, each at least shareCount cells deep along some
+// axis: the slab `slab` of every piece (readPiece, slabAxis).
 Result readSlabShares(Vtu& vtu, GridKind kind, const Grid& whole, const std::vector<pugi::xml_node>& nodes,
                       const std::string& label, const Slab& slab, std::vector<MeshPiece>& pieces, ReadReport& report) {
   uint64_t cells = 0, cellsRead = 0;
+  std::string axes;              // the axes the pieces are cut along, each once
   pieces.reserve(nodes.size());  // bounded: each is an element of the file
   for (size_t k = 0; k < nodes.size(); ++k) {
     MeshPiece& piece = pieces.emplace_back();
@@ -681,12 +714,14 @@ Result readSlabShares(Vtu& vtu, GridKind kind, const Grid& whole, const std::vec
     readExtent(nodes[k], "Extent", label, g);  // (read above)
     cells += (g.n(0) - 1) * (g.n(1) - 1) * (g.n(2) - 1);
     cellsRead += piece.soup.inputCells;
+    const char axis = "ijk"[slabAxis(g, slab.count)];
+    if (axes.find(axis) == std::string::npos) axes += axes.empty() ? std::string(1, axis) : std::string(" and ") + axis;
   }
   report.shared = true;
   report.notes.push_back(
       "read slab " + std::to_string(slab.index + 1) + " of " + std::to_string(slab.count) + " of " +
       (nodes.size() == 1 ? std::string("the grid") : "each of the " + std::to_string(nodes.size()) + " pieces") +
-      " along k (" + std::to_string(cellsRead) + " of " + std::to_string(cells) +
+      " along " + axes + " (" + std::to_string(cellsRead) + " of " + std::to_string(cells) +
       " cells), this process's share of the file");
   return Result::success();
 }
@@ -829,7 +864,7 @@ Result vtkio::readVtuPieces(std::string_view bytes, const std::string& label, st
   bool slabs = fewer && kind != GridKind::Unstructured;
   for (pugi::xml_node p : nodes) {
     Grid g;
-    slabs = slabs && readExtent(p, "Extent", label, g) && g.n(2) - 1 >= shareCount;
+    slabs = slabs && readExtent(p, "Extent", label, g) && slabAxis(g, shareCount) >= 0;
   }
   Result r = fewer && kind == GridKind::Unstructured
                  ? readCellShares(vtu, nodes, label, shareIndex, shareCount, pieces, report)

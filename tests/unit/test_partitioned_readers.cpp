@@ -357,19 +357,66 @@ TEST(PartitionedReaders, SharesOfBase64DataReadOnlyThePointsTheirCellsUse) {
 }
 
 // A .vti or .vts of fewer pieces than processes: each reads a slab of layers of cells along k
-// and their points, when every piece has a layer for each process; else the whole file.
+// and their points when every piece has a layer for each process, else along j, else along i;
+// else the whole file.
 TEST(PartitionedReaders, SlabsOfAStructuredGridMakeTheWhole) {
   for (const char* name : {"formats/grid43.vti", "formats/grid43.vts", "formats/grid43_binary.vts"}) {
     test::expectSharesMakeTheWhole(fixturePath(name), 2, "cid");  // (2 layers of cells along k)
+    test::expectSharesMakeTheWhole(fixturePath(name), 3, "cid");  // (2 along k and j, 3 along i)
     TetMesh m;
     ReadReport r;
-    ASSERT_TRUE(readMesh(fixturePath(name), m, r, test::shareOf(1, 3)));
-    EXPECT_FALSE(r.shared) << name << ": 3 processes, 2 layers: read whole";
+    ASSERT_TRUE(readMesh(fixturePath(name), m, r, test::shareOf(1, 4)));
+    EXPECT_FALSE(r.shared) << name << ": 4 processes, at most 3 layers: read whole";
   }
   TetMesh m;
   ReadReport r;
   ASSERT_TRUE(readMesh(fixturePath("formats/grid43.vti"), m, r, test::shareOf(0, 2)));
   EXPECT_TRUE(hasNote(r, "read slab 1 of 2 of the grid along k (6 of 12 cells)")) << allNotes(r);
+  ReadReport alongI;
+  ASSERT_TRUE(readMesh(fixturePath("formats/grid43.vts"), m, alongI, test::shareOf(2, 3)));
+  EXPECT_TRUE(hasNote(alongI, "read slab 3 of 3 of the grid along i (4 of 12 cells)")) << allNotes(alongI);
+}
+
+// A grid one cell deep (as layered models write them, wide and thin) is cut along j: each share's
+// points carry the whole's values, cell data included away from the cuts.
+TEST(PartitionedReaders, SlabsOfAThinGridGoAlongJ) {
+  std::string points, cells;
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 6; ++j)
+      for (int i = 0; i < 3; ++i) points += std::to_string(i + 10 * j + 100 * k) + " ";
+  for (int j = 0; j < 5; ++j)
+    for (int i = 0; i < 2; ++i) cells += std::to_string(7 * i + 3 * j) + " ";
+  const std::string path = test::tempDir("thin-grid") + "/thin.vti";
+  ASSERT_TRUE(saveFile(path, R"(<VTKFile type="ImageData" version="1.0" byte_order="LittleEndian">
+<ImageData WholeExtent="0 2 0 5 0 1" Origin="0 0 0" Spacing="1 1 1"><Piece Extent="0 2 0 5 0 1">
+<PointData><DataArray type="Float32" Name="f" format="ascii">)" +
+                                 points + R"(</DataArray></PointData>
+<CellData><DataArray type="Int32" Name="cid" format="ascii">)" +
+                                 cells + R"(</DataArray></CellData>
+</Piece></ImageData></VTKFile>)"));
+  TetMesh whole;
+  ReadReport wr;
+  ASSERT_TRUE(readMesh(path, whole, wr));
+  for (uint32_t count : {2u, 3u, 5u}) {
+    test::expectSharesMakeTheWhole(path, count, "cid");
+    for (uint32_t k = 0; k < count; ++k) {
+      TetMesh part;
+      ReadReport r;
+      ASSERT_TRUE(readMesh(path, part, r, test::shareOf(k, count)));
+      const float from = float(5 * k / count), to = float(5 * (k + 1) / count);
+      EXPECT_TRUE(hasNote(r, "along j")) << allNotes(r);
+      const int cid = part.findField("cid");
+      ASSERT_GE(cid, 0);
+      for (uint32_t v = 0; v < part.vertexCount(); ++v) {
+        const float* p = &part.positions[3 * v];
+        if ((p[1] == from && from > 0) || (p[1] == to && to < 5)) continue;  // on a cut: cells of one side
+        const int64_t w = test::findVertex(whole, p[0], p[1], p[2]);
+        ASSERT_GE(w, 0);
+        EXPECT_EQ(part.fields[size_t(cid)].values[v], whole.fields[size_t(whole.findField("cid"))].values[size_t(w)])
+            << "share " << k << " of " << count << " at (" << p[0] << ", " << p[1] << ", " << p[2] << ")";
+      }
+    }
+  }
 }
 
 // A listing of fewer files than processes: the processes of a file each read a share of its cells
