@@ -410,9 +410,17 @@ struct Slab {
 
 // The axis a piece is cut into `count` slabs along: k when it has that many layers of cells (k
 // is the slowest index, so a slab's points and cells are runs of the arrays), else j (a run in
-// each k plane), else i (a run in each row); -1 when no axis has that many.
-int slabAxis(const Grid& g, uint32_t count) {
-  for (int axis = 2; axis >= 0; --axis)
+// each k plane), else i (a run in each row). -1 when no axis has that many, or when the piece
+// has no cells or j or i would list more rows than a file of `fileBytes` could carry values
+// for (16 a byte, at least 2^20, as for ImageData): a hostile Extent must not make that list
+// huge. Such a piece is read whole, which checks its arrays before it allocates.
+int slabAxis(const Grid& g, uint32_t count, uint64_t fileBytes) {
+  if (g.n(2) - 1 >= count) return 2;
+  uint64_t points = 1;
+  for (int axis = 0; axis < 3; ++axis)
+    if (g.n(axis) < 2 || __builtin_mul_overflow(points, g.n(axis), &points)) return -1;
+  if (points > std::max<uint64_t>(uint64_t(1) << 20, 16 * fileBytes)) return -1;
+  for (int axis = 1; axis >= 0; --axis)
     if (g.n(axis) - 1 >= count) return axis;
   return -1;
 }
@@ -456,7 +464,7 @@ Result readPiece(Vtu& vtu, GridKind kind, const Grid& whole, pugi::xml_node piec
       return fail(Status::Truncated, where + ": Extent declares " + std::to_string(np) + " points, far more than a " +
                                          std::to_string(vtu.fileBytes) + "-byte file can carry data for");
     if (slab) {
-      const int axis = slabAxis(g, slab->count);
+      const int axis = slabAxis(g, slab->count, vtu.fileBytes);
       if (axis < 0) return fail(Status::Corrupt, where + ": too thin to cut into " + std::to_string(slab->count));
       const uint64_t layers = g.n(axis) - 1, from = layers * slab->index / slab->count,
                      to = layers * (slab->index + 1) / slab->count, plane = g.n(0) * g.n(1);
@@ -714,7 +722,7 @@ Result readSlabShares(Vtu& vtu, GridKind kind, const Grid& whole, const std::vec
     readExtent(nodes[k], "Extent", label, g);  // (read above)
     cells += (g.n(0) - 1) * (g.n(1) - 1) * (g.n(2) - 1);
     cellsRead += piece.soup.inputCells;
-    const char axis = "ijk"[slabAxis(g, slab.count)];
+    const char axis = "ijk"[slabAxis(g, slab.count, vtu.fileBytes)];
     if (axes.find(axis) == std::string::npos) axes += axes.empty() ? std::string(1, axis) : std::string(" and ") + axis;
   }
   report.shared = true;
@@ -864,7 +872,7 @@ Result vtkio::readVtuPieces(std::string_view bytes, const std::string& label, st
   bool slabs = fewer && kind != GridKind::Unstructured;
   for (pugi::xml_node p : nodes) {
     Grid g;
-    slabs = slabs && readExtent(p, "Extent", label, g) && slabAxis(g, shareCount) >= 0;
+    slabs = slabs && readExtent(p, "Extent", label, g) && slabAxis(g, shareCount, vtu.fileBytes) >= 0;
   }
   Result r = fewer && kind == GridKind::Unstructured
                  ? readCellShares(vtu, nodes, label, shareIndex, shareCount, pieces, report)

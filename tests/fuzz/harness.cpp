@@ -316,11 +316,13 @@ void meshFile(const char* extension, const uint8_t* data, size_t size) {
     ReadReport halfReport;
     if (readXdmf(bytes, "fuzz.xdmf", std::nullopt, share, half, halfReport)) checkReaderPromise(half);
   }
-  if (std::string_view(extension) == ".vtu") {
+  // Of a structured grid, slabs along k, or j, or i (the fewer layers, the more axes tried).
+  const std::string_view ext(extension);
+  if (ext == ".vtu" || ext == ".vti" || ext == ".vts") {
     for (uint32_t count : {2u, 3u}) {
       TetMesh part;
       ReadReport partReport;
-      if (readVtu(bytes, "fuzz.vtu", part, partReport, 1, count)) checkReaderPromise(part);
+      if (readVtu(bytes, std::string("fuzz") + extension, part, partReport, 1, count)) checkReaderPromise(part);
     }
   }
 }
