@@ -408,18 +408,22 @@ struct Slab {
   uint32_t index = 0, count = 1;
 };
 
+// The most points a file of `fileBytes` could carry values for: 16 a byte, at least 2^20. Until
+// its arrays are read, a huge Extent may be a lie; this bounds what is set up for it before.
+uint64_t mostPointsIn(uint64_t fileBytes) { return std::max<uint64_t>(uint64_t(1) << 20, 16 * fileBytes); }
+
 // The axis a piece is cut into `count` slabs along: k when it has that many layers of cells (k
 // is the slowest index, so a slab's points and cells are runs of the arrays), else j (a run in
 // each k plane), else i (a run in each row). -1 when no axis has that many, or when the piece
 // has no cells or j or i would list more rows than a file of `fileBytes` could carry values
-// for (16 a byte, at least 2^20, as for ImageData): a hostile Extent must not make that list
-// huge. Such a piece is read whole, which checks its arrays before it allocates.
+// for (mostPointsIn): a hostile Extent must not make that list huge. Such a piece is read whole,
+// which checks its arrays before it allocates.
 int slabAxis(const Grid& g, uint32_t count, uint64_t fileBytes) {
   if (g.n(2) - 1 >= count) return 2;
   uint64_t points = 1;
   for (int axis = 0; axis < 3; ++axis)
     if (g.n(axis) < 2 || __builtin_mul_overflow(points, g.n(axis), &points)) return -1;
-  if (points > std::max<uint64_t>(uint64_t(1) << 20, 16 * fileBytes)) return -1;
+  if (points > mostPointsIn(fileBytes)) return -1;
   for (int axis = 1; axis >= 0; --axis)
     if (g.n(axis) - 1 >= count) return axis;
   return -1;
@@ -458,9 +462,8 @@ Result readPiece(Vtu& vtu, GridKind kind, const Grid& whole, pugi::xml_node piec
     }
     np = n;
     nc = c;
-    // ImageData stores no coordinates: until its arrays arrive, a huge extent is a lie. Cap it
-    // by what the file could carry (16 points per byte, at least 2^20).
-    if (kind == GridKind::Image && np > std::max<uint64_t>(uint64_t(1) << 20, 16 * uint64_t(vtu.fileBytes)))
+    // ImageData stores no coordinates: until its arrays arrive, a huge extent is a lie.
+    if (kind == GridKind::Image && np > mostPointsIn(vtu.fileBytes))
       return fail(Status::Truncated, where + ": Extent declares " + std::to_string(np) + " points, far more than a " +
                                          std::to_string(vtu.fileBytes) + "-byte file can carry data for");
     if (slab) {
